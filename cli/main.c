@@ -1,0 +1,59 @@
+/* main.c: the rtspheres program: picks the subcommand and hands it the remaining
+ * arguments. Exit codes: 0 ok, 1 runtime failure (diff: images differ), 2 bad input/usage. */
+#include <stdio.h>
+#include <string.h>
+
+#include "commands.h"
+#include "status.h"
+#include "version.h"
+
+static void print_usage(FILE *stream)
+{
+    fprintf(stream,
+            "usage: rtspheres COMMAND [options]\n"
+            "\n"
+            "commands:\n"
+            "  render SCENE -o OUTPUT   render a scene file to .exr/.png/.jpg/.hdr\n"
+            "  diff A B                 compare two images (exit 0 pass, 1 fail, 2 error)\n"
+            "  info                     show the EGL device and OpenGL renderer that would be used\n"
+            "\n"
+            "Run 'rtspheres COMMAND --help' for a command's options.\n");
+}
+
+int exit_code_for_status(int status)
+{
+    switch ((rt_status)status) {
+    case RT_OK: return EXIT_OK;
+    case RT_ERROR_INPUT: return EXIT_BAD_INPUT;
+    case RT_ERROR_RUNTIME:
+    case RT_ERROR_NO_DEVICE:
+    case RT_ERROR_INTERRUPTED: return EXIT_RUNTIME;
+    }
+    return EXIT_RUNTIME;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        print_usage(stderr);
+        return EXIT_BAD_INPUT;
+    }
+    const char *command = argv[1];
+    if (strcmp(command, "render") == 0)
+        return command_render(argc - 1, argv + 1);
+    if (strcmp(command, "diff") == 0)
+        return command_diff(argc - 1, argv + 1);
+    if (strcmp(command, "info") == 0)
+        return command_info(argc - 1, argv + 1);
+    if (strcmp(command, "--help") == 0 || strcmp(command, "-h") == 0 || strcmp(command, "help") == 0) {
+        print_usage(stdout);
+        return EXIT_OK;
+    }
+    if (strcmp(command, "--version") == 0) {
+        printf("rtspheres %s\n", RTSPHERES_VERSION);
+        return EXIT_OK;
+    }
+    fprintf(stderr, "rtspheres: unknown command '%s'\n\n", command);
+    print_usage(stderr);
+    return EXIT_BAD_INPUT;
+}

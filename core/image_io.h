@@ -1,0 +1,89 @@
+/* image_io.h: reading and writing images through OpenImageIO (a thin C shim over C++).
+ *
+ * Pixel layout of rt_image: 32-bit floats, channels interleaved, rows top to bottom,
+ * pixels[(y * width + x) * channels + c]. Channel names are "R","G","B","A" unless
+ * channel_names says otherwise.
+ *
+ * Writing picks the format from the file extension:
+ *   .exr        linear float32, all channels and names kept, attributes stored as metadata
+ *   .hdr        linear float (RGB only)
+ *   .png .jpg .jpeg .tif .tiff  8-bit sRGB: multiplied by 2^exposure, clamped to [0,1],
+ *               sRGB-encoded; alpha (if any) is written linearly
+ * Writing goes to a temporary file in the destination's directory which is renamed over
+ * the destination only when it is complete: a failed write leaves any existing file as
+ * it was and no partial file behind.
+ *
+ * Reading returns what the file stores, converted to float: 8-bit files come back in
+ * [0,1] in their own encoding (sRGB stays sRGB). Channel names are kept.
+ *
+ * Defaults of image_write_options (all zero): exposure 0 stops, no attributes,
+ * channel names from the channel count.
+ */
+#ifndef RT_IMAGE_IO_H
+#define RT_IMAGE_IO_H
+
+#include "status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IMAGE_MAX_CHANNELS 32
+#define IMAGE_CHANNEL_NAME_MAX 32
+
+typedef struct rt_image {
+    int width, height, channels;
+    float *pixels;               /* owned; free with image_free() */
+    char channel_names[IMAGE_MAX_CHANNELS][IMAGE_CHANNEL_NAME_MAX];  /* "" = default name */
+} rt_image;
+
+typedef enum image_attribute_type {
+    IMAGE_ATTRIBUTE_STRING = 0,
+    IMAGE_ATTRIBUTE_INT,
+    IMAGE_ATTRIBUTE_FLOAT,
+} image_attribute_type;
+
+/* One metadata entry, e.g. {"rtspheres:spp", IMAGE_ATTRIBUTE_INT, .int_value = 64}. */
+typedef struct image_attribute {
+    const char *name;
+    image_attribute_type type;
+    const char *string_value;
+    long long int_value;
+    double float_value;
+} image_attribute;
+
+typedef struct image_write_options {
+    float exposure;              /* stops, for 8-bit outputs only */
+    const image_attribute *attributes;
+    int attribute_count;
+} image_write_options;
+
+/* Returns options with every field at its default (all zero). */
+image_write_options image_write_options_defaults(void);
+
+/* Allocates a width x height x channels image filled with zeros, with default channel
+ * names. Returns RT_ERROR_RUNTIME when memory runs out. Free with image_free(). */
+rt_status image_create(rt_image *image, int width, int height, int channels, rt_error *error);
+
+/* Frees image->pixels and zeroes *image. */
+void image_free(rt_image *image);
+
+/* Writes image to path (format by extension, see above). options may be NULL.
+ * Unknown extension: RT_ERROR_INPUT. Failed write: RT_ERROR_RUNTIME, destination intact. */
+rt_status image_write(const char *path, const rt_image *image, const image_write_options *options,
+                      rt_error *error);
+
+/* Reads the image at path into *out (allocated; caller frees with image_free()).
+ * Missing, unreadable or malformed file: RT_ERROR_INPUT naming the file. */
+rt_status image_read(const char *path, rt_image *out, rt_error *error);
+
+/* Reads one metadata attribute of the file as text into value (at most value_size bytes,
+ * NUL-terminated). Returns RT_OK, or RT_ERROR_INPUT if the file or attribute is missing. */
+rt_status image_read_attribute(const char *path, const char *name, char *value, int value_size,
+                               rt_error *error);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
