@@ -1,3 +1,76 @@
-/* TEMPORARY placeholder while the renderer is written; replaced before any commit. */
+/* command_info.c: `rtspheres info`: which EGL platform/device and OpenGL renderer a
+ * render would use, and the limits that matter. */
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+
 #include "commands.h"
-int command_info(int argc, char **argv) { (void)argc; (void)argv; return EXIT_RUNTIME; }
+#include "gpu.h"
+#include "version.h"
+
+static void print_help(FILE *stream)
+{
+    fprintf(stream, "usage: rtspheres info [--device N]\n"
+                    "  --device N   use EGL device N (0-based, as listed here) instead of choosing\n");
+}
+
+int command_info(int argc, char **argv)
+{
+    static const struct option long_options[] = {
+        {"device", required_argument, NULL, 'd'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+    };
+    gpu_options options = gpu_options_defaults();
+    int option;
+    while ((option = getopt_long(argc, argv, "h", long_options, NULL)) != -1) {
+        switch (option) {
+        case 'd': {
+            char *end = NULL;
+            long device = strtol(optarg, &end, 10);
+            if (end == optarg || *end != '\0' || device < 0 || device > 255) {
+                fprintf(stderr, "rtspheres info: --device wants a device number (0, 1, ...), not '%s'\n", optarg);
+                return EXIT_BAD_INPUT;
+            }
+            options.device = (int)device + 1;
+            break;
+        }
+        case 'h':
+            print_help(stdout);
+            return EXIT_OK;
+        default:
+            print_help(stderr);
+            return EXIT_BAD_INPUT;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "rtspheres info: unexpected argument '%s'\n", argv[optind]);
+        return EXIT_BAD_INPUT;
+    }
+    gpu_context *context = NULL;
+    rt_error error = {{0}};
+    rt_status status = gpu_create(&options, &context, &error);
+    if (status != RT_OK) {
+        fprintf(stderr, "rtspheres info: %s\n", error.message);
+        return exit_code_for_status(status);
+    }
+    gpu_info info;
+    gpu_get_info(context, &info);
+    printf("rtspheres %s\n", RTSPHERES_VERSION);
+    if (info.device_index >= 0)
+        printf("EGL platform:     device %d of %d (%s)\n", info.device_index, info.device_count,
+               info.device_extensions);
+    else
+        printf("EGL platform:     %s (Mesa), %d EGL device%s seen\n", info.platform, info.device_count,
+               info.device_count == 1 ? "" : "s");
+    printf("EGL:              %s, %s\n", info.egl_vendor, info.egl_version);
+    printf("GL vendor:        %s\n", info.gl_vendor);
+    printf("GL renderer:      %s%s\n", info.gl_renderer, info.software ? " (software, on the CPU)" : "");
+    printf("GL version:       %s\n", info.gl_version);
+    printf("GLSL version:     %s\n", info.glsl_version);
+    printf("max texture size: %d\n", info.max_texture_size);
+    printf("max draw buffers: %d\n", info.max_draw_buffers);
+    printf("max fragment atomic counters: %d\n", info.max_fragment_atomic_counters);
+    gpu_destroy(context);
+    return EXIT_OK;
+}

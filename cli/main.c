@@ -16,6 +16,7 @@ static void print_usage(FILE *stream)
             "  render SCENE -o OUTPUT   render a scene file to .exr/.png/.jpg/.hdr\n"
             "  diff A B                 compare two images (exit 0 pass, 1 fail, 2 error)\n"
             "  info                     show the EGL device and OpenGL renderer that would be used\n"
+            "  stats IMAGE              per-channel mean/min/max of an image and its rtspheres metadata\n"
             "\n"
             "Run 'rtspheres COMMAND --help' for a command's options.\n");
 }
@@ -45,6 +46,8 @@ int main(int argc, char **argv)
         return command_diff(argc - 1, argv + 1);
     if (strcmp(command, "info") == 0)
         return command_info(argc - 1, argv + 1);
+    if (strcmp(command, "stats") == 0)
+        return command_stats(argc - 1, argv + 1);
     if (strcmp(command, "--help") == 0 || strcmp(command, "-h") == 0 || strcmp(command, "help") == 0) {
         print_usage(stdout);
         return EXIT_OK;

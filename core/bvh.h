@@ -7,8 +7,9 @@
  * first + count - 1]. primitive_indices[k] is the index, in the caller's input array, of
  * the k-th primitive in leaf order: the packer writes primitives in that order.
  *
- * The builder uses the surface area heuristic over binned centroids; it never makes a
- * tree deeper than config.max_depth (then it splits at the median, or makes a leaf).
+ * The builder uses the surface area heuristic over binned centroids (splitting at the
+ * median when all centroids coincide); it never makes a tree deeper than
+ * config.max_depth: a node at that depth becomes a leaf whatever its size.
  *
  * Defaults of bvh_build_config (zero means default):
  *   max_leaf_size 4, bin_count 16, max_depth BVH_MAX_DEPTH (48),
@@ -54,7 +55,8 @@ bvh_build_config bvh_build_config_defaults(void);
 
 /* Builds a BVH over count primitive boxes. config may be NULL for defaults.
  * count 0 gives one empty leaf (node_count 1, count 0 is then "interior with no
- * children"; callers check primitive_count). Boxes with NaN are RT_ERROR_INPUT.
+ * children"; callers check primitive_count). Boxes with NaN or infinite coordinates,
+ * or min > max, and invalid configs are RT_ERROR_INPUT.
  * The caller frees *out with bvh_free(). */
 rt_status bvh_build(const bvh_box *boxes, uint32_t count, const bvh_build_config *config,
                     bvh *out, rt_error *error);

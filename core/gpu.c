@@ -1,0 +1,607 @@
+/* gpu.c: EGL context and the GLSL tracer; the only file that calls egl* and gl*.
+ * See gpu.h for the order of set-up and how failures are told apart. */
+#include "gpu.h"
+
+#include <epoxy/egl.h>
+#include <epoxy/gl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene.h"
+#include "shader_sources.h"
+
+#define STATE_TARGET_COUNT 7
+enum {
+    STATE_ORIGIN, STATE_DIRECTION, STATE_THROUGHPUT, STATE_RADIANCE,
+    STATE_COUNTERS, STATE_ACCUMULATED, STATE_STATISTICS,
+};
+static const char *const state_sampler_names[STATE_TARGET_COUNT] = {
+    "state_origin", "state_direction", "state_throughput", "state_radiance",
+    "state_counters", "state_accumulated", "state_statistics",
+};
+
+struct gpu_context {
+    EGLDisplay display;
+    EGLContext context;
+    gpu_info info;
+    gpu_options options;
+};
+
+struct gpu_tracer {
+    gpu_context *context;
+    int width, height;
+    GLuint program;
+    GLuint vertex_array;
+    GLuint packed_texture;
+    int packed_width_log2;
+    GLuint state_textures[2][STATE_TARGET_COUNT];
+    GLuint framebuffers[2];
+    GLuint counter_buffer;
+    int current;                 /* which state set holds the latest pass */
+};
+
+gpu_options gpu_options_defaults(void)
+{
+    return (gpu_options){0};
+}
+
+/* Returns a readable name for an EGL error code. */
+static const char *egl_error_name(EGLint code)
+{
+    switch (code) {
+    case EGL_SUCCESS: return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
+    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
+    case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
+    default: return "EGL error";
+    }
+}
+
+/* True when the space-separated list contains name as a whole word. */
+static bool has_extension(const char *list, const char *name)
+{
+    if (list == NULL)
+        return false;
+    size_t length = strlen(name);
+    for (const char *p = list; (p = strstr(p, name)) != NULL; p += length)
+        if ((p == list || p[-1] == ' ') && (p[length] == ' ' || p[length] == '\0'))
+            return true;
+    return false;
+}
+
+static void copy_string(char *destination, size_t size, const char *source)
+{
+    snprintf(destination, size, "%s", source ? source : "");
+}
+
+static void GLAPIENTRY debug_message_callback(GLenum source, GLenum type, GLuint id, GLenum severity,
+                                              GLsizei length, const GLchar *message, const void *user)
+{
+    (void)source; (void)type; (void)id; (void)severity; (void)length;
+    const gpu_context *context = user;
+    if (context->options.log != NULL) {
+        char line[1200];
+        snprintf(line, sizeof line, "GL: %s", message);
+        context->options.log(context->options.log_context, line);
+    }
+}
+
+/* Appends one failed attempt's message to the list of what was tried ("; " between),
+ * cutting it short when the buffer is full. */
+static void append_attempt(char *tried, size_t size, const char *message)
+{
+    size_t used = strlen(tried);
+    if (used > 0 && used + 2 < size) {
+        memcpy(tried + used, "; ", 3);
+        used += 2;
+    }
+    for (; *message != '\0' && used + 1 < size; used++)
+        tried[used] = *message++;
+    tried[used] = '\0';
+}
+
+/* Initialises display and creates + binds a GL 4.5 core context on it. Returns RT_OK or
+ * RT_ERROR_RUNTIME naming the failing call (the display is terminated on failure). */
+static rt_status create_context_on(gpu_context *context, EGLDisplay display, const char *what, rt_error *error)
+{
+    EGLint major = 0, minor = 0;
+    if (!eglInitialize(display, &major, &minor))
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: EGL driver failure: eglInitialize on %s failed (%s)",
+                            what, egl_error_name(eglGetError()));
+    const char *display_extensions = eglQueryString(display, EGL_EXTENSIONS);
+    if (!has_extension(display_extensions, "EGL_KHR_surfaceless_context")) {
+        eglTerminate(display);
+        return rt_error_set(error, RT_ERROR_RUNTIME,
+                            "GPU: %s has no EGL_KHR_surfaceless_context; cannot render without a window", what);
+    }
+    if (!eglBindAPI(EGL_OPENGL_API)) {
+        eglTerminate(display);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s does not offer desktop OpenGL (%s)", what,
+                            egl_error_name(eglGetError()));
+    }
+    EGLConfig config = EGL_NO_CONFIG_KHR;
+    if (!has_extension(display_extensions, "EGL_KHR_no_config_context")) {
+        EGLint count = 0;
+        const EGLint wanted[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+        if (!eglChooseConfig(display, wanted, &config, 1, &count) || count < 1) {
+            eglTerminate(display);
+            return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s has no OpenGL config", what);
+        }
+    }
+    const EGLint attributes[] = {
+        EGL_CONTEXT_MAJOR_VERSION, 4,
+        EGL_CONTEXT_MINOR_VERSION, 5,
+        EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+        EGL_CONTEXT_OPENGL_DEBUG, context->options.debug_output ? EGL_TRUE : EGL_FALSE,
+        EGL_NONE,
+    };
+    EGLContext gl_context = eglCreateContext(display, config, EGL_NO_CONTEXT, attributes);
+    if (gl_context == EGL_NO_CONTEXT) {
+        EGLint code = eglGetError();
+        eglTerminate(display);
+        return rt_error_set(error, RT_ERROR_RUNTIME,
+                            "GPU: %s cannot create an OpenGL 4.5 core context (%s)", what, egl_error_name(code));
+    }
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, gl_context)) {
+        EGLint code = eglGetError();
+        eglDestroyContext(display, gl_context);
+        eglTerminate(display);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: eglMakeCurrent on %s failed (%s)", what,
+                            egl_error_name(code));
+    }
+    context->display = display;
+    context->context = gl_context;
+    copy_string(context->info.egl_vendor, sizeof context->info.egl_vendor, eglQueryString(display, EGL_VENDOR));
+    copy_string(context->info.egl_version, sizeof context->info.egl_version, eglQueryString(display, EGL_VERSION));
+    return RT_OK;
+}
+
+/* Reads renderer strings and limits of the current context into context->info. */
+static void read_gl_info(gpu_context *context)
+{
+    gpu_info *info = &context->info;
+    copy_string(info->gl_vendor, sizeof info->gl_vendor, (const char *)glGetString(GL_VENDOR));
+    copy_string(info->gl_renderer, sizeof info->gl_renderer, (const char *)glGetString(GL_RENDERER));
+    copy_string(info->gl_version, sizeof info->gl_version, (const char *)glGetString(GL_VERSION));
+    copy_string(info->glsl_version, sizeof info->glsl_version,
+                (const char *)glGetString(GL_SHADING_LANGUAGE_VERSION));
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &info->max_texture_size);
+    glGetIntegerv(GL_MAX_DRAW_BUFFERS, &info->max_draw_buffers);
+    glGetIntegerv(GL_MAX_COLOR_ATTACHMENTS, &info->max_color_attachments);
+    glGetIntegerv(GL_MAX_FRAGMENT_ATOMIC_COUNTERS, &info->max_fragment_atomic_counters);
+    info->software = strstr(info->gl_renderer, "llvmpipe") != NULL || strstr(info->gl_renderer, "softpipe") != NULL
+                     || strstr(info->gl_renderer, "swrast") != NULL;
+}
+
+rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *error)
+{
+    *out = NULL;
+    gpu_context *context = calloc(1, sizeof *context);
+    if (context == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory");
+    context->options = options ? *options : gpu_options_defaults();
+    context->info.device_index = -1;
+
+    const char *client_extensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    bool platform_base = has_extension(client_extensions, "EGL_EXT_platform_base");
+    bool platform_device = platform_base && has_extension(client_extensions, "EGL_EXT_platform_device")
+                           && has_extension(client_extensions, "EGL_EXT_device_enumeration");
+    bool platform_surfaceless = platform_base && has_extension(client_extensions, "EGL_MESA_platform_surfaceless");
+
+    rt_status status = RT_ERROR_NO_DEVICE;
+    rt_error attempt = {{0}};
+    char tried[1024] = "";
+
+    EGLDeviceEXT devices[16];
+    EGLint device_count = 0;
+    if (platform_device && !eglQueryDevicesEXT(16, devices, &device_count))
+        device_count = 0;
+    context->info.device_count = device_count;
+
+    if (context->options.device > 0) {
+        int index = context->options.device - 1;
+        if (index >= device_count) {
+            free(context);
+            return rt_error_set(error, RT_ERROR_INPUT, "GPU: --device %d asked for, but there %s %d EGL device%s",
+                                context->options.device, device_count == 1 ? "is" : "are", (int)device_count,
+                                device_count == 1 ? "" : "s");
+        }
+        EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[index], NULL);
+        char what[64];
+        snprintf(what, sizeof what, "EGL device %d", index);
+        status = display == EGL_NO_DISPLAY
+                     ? rt_error_set(&attempt, RT_ERROR_RUNTIME, "GPU: no display for %s", what)
+                     : create_context_on(context, display, what, &attempt);
+        if (status == RT_OK) {
+            context->info.device_index = index;
+            copy_string(context->info.platform, sizeof context->info.platform, "device");
+        }
+    } else {
+        /* Hardware devices first: a device without EGL_MESA_device_software is a real GPU. */
+        for (int pass = 0; pass < 2 && status != RT_OK; pass++) {
+            for (int index = 0; index < device_count && status != RT_OK; index++) {
+                const char *device_extensions = eglQueryDeviceStringEXT(devices[index], EGL_EXTENSIONS);
+                bool software = has_extension(device_extensions, "EGL_MESA_device_software");
+                if (software != (pass == 1))
+                    continue;
+                /* Mesa's software device is the same llvmpipe as the surfaceless platform;
+                 * prefer the latter, which is what every Mesa install has been tested with. */
+                if (software && platform_surfaceless)
+                    continue;
+                EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[index], NULL);
+                if (display == EGL_NO_DISPLAY)
+                    continue;
+                char what[64];
+                snprintf(what, sizeof what, "EGL device %d", index);
+                status = create_context_on(context, display, what, &attempt);
+                if (status == RT_OK) {
+                    context->info.device_index = index;
+                    copy_string(context->info.platform, sizeof context->info.platform, "device");
+                    copy_string(context->info.device_extensions, sizeof context->info.device_extensions,
+                                device_extensions);
+                } else {
+                    append_attempt(tried, sizeof tried, attempt.message);
+                }
+            }
+        }
+        if (status != RT_OK && platform_surfaceless) {
+            EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
+            if (display != EGL_NO_DISPLAY) {
+                status = create_context_on(context, display, "the Mesa surfaceless platform", &attempt);
+                if (status == RT_OK)
+                    copy_string(context->info.platform, sizeof context->info.platform, "surfaceless");
+                else
+                    append_attempt(tried, sizeof tried, attempt.message);
+            }
+        }
+    }
+
+    if (status != RT_OK) {
+        free(context);
+        if (tried[0] != '\0')
+            return rt_error_set(error, RT_ERROR_RUNTIME, "%s", tried);
+        if (attempt.message[0] != '\0')
+            return rt_error_set(error, status, "%s", attempt.message);
+        return rt_error_set(error, RT_ERROR_NO_DEVICE,
+                            "GPU: no usable EGL device: no GPU driver offers EGL_EXT_platform_device and Mesa's "
+                            "surfaceless platform is missing. Install Mesa (apt-get install libegl-mesa0 "
+                            "libgl1-mesa-dri) or your GPU vendor's EGL driver");
+    }
+
+    read_gl_info(context);
+    if (context->options.debug_output && epoxy_has_gl_extension("GL_KHR_debug")) {
+        glEnable(GL_DEBUG_OUTPUT);
+        glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+        glDebugMessageCallback(debug_message_callback, context);
+    }
+    *out = context;
+    return RT_OK;
+}
+
+void gpu_destroy(gpu_context *context)
+{
+    if (context == NULL)
+        return;
+    eglMakeCurrent(context->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(context->display, context->context);
+    eglTerminate(context->display);
+    free(context);
+}
+
+void gpu_get_info(const gpu_context *context, gpu_info *info)
+{
+    *info = context->info;
+}
+
+/* ---- tracer ------------------------------------------------------------------------- */
+
+/* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
+static rt_status check_gl(const char *step, rt_error *error)
+{
+    GLenum code = glGetError();
+    if (code == GL_NO_ERROR)
+        return RT_OK;
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    const char *name = code == GL_OUT_OF_MEMORY ? "GL_OUT_OF_MEMORY"
+                       : code == GL_INVALID_VALUE ? "GL_INVALID_VALUE"
+                       : code == GL_INVALID_OPERATION ? "GL_INVALID_OPERATION"
+                       : code == GL_INVALID_ENUM ? "GL_INVALID_ENUM"
+                       : code == GL_INVALID_FRAMEBUFFER_OPERATION ? "GL_INVALID_FRAMEBUFFER_OPERATION"
+                                                                   : "GL error";
+    return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s failed (%s, 0x%04x)", step, name, code);
+}
+
+/* Compiles one shader stage from the given source parts. Returns the shader, or 0 with
+ * the compiler's log in error. */
+static GLuint compile_stage(GLenum stage, const char *const *parts, int part_count, rt_error *error)
+{
+    GLuint shader = glCreateShader(stage);
+    glShaderSource(shader, part_count, parts, NULL);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[800];
+        glGetShaderInfoLog(shader, sizeof log, NULL, log);
+        rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the %s shader does not compile: %s",
+                     stage == GL_VERTEX_SHADER ? "vertex" : "tracer", log);
+        glDeleteShader(shader);
+        return 0;
+    }
+    return shader;
+}
+
+/* Builds the tracer program: "#version 450 core" + packed_layout.h + tracer.frag. */
+static rt_status build_program(gpu_tracer *tracer, rt_error *error)
+{
+    const char *version = "#version 450 core\n";
+    const char *vertex_parts[] = {version, shader_source_fullscreen_vertex};
+    const char *fragment_parts[] = {version, shader_source_packed_layout, "#line 1 1\n",
+                                    shader_source_tracer_fragment};
+    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
+    if (vertex == 0)
+        return RT_ERROR_RUNTIME;
+    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 4, error);
+    if (fragment == 0) {
+        glDeleteShader(vertex);
+        return RT_ERROR_RUNTIME;
+    }
+    GLuint program = glCreateProgram();
+    glAttachShader(program, vertex);
+    glAttachShader(program, fragment);
+    glLinkProgram(program);
+    glDeleteShader(vertex);
+    glDeleteShader(fragment);
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[800];
+        glGetProgramInfoLog(program, sizeof log, NULL, log);
+        glDeleteProgram(program);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer does not link: %s", log);
+    }
+    tracer->program = program;
+    return RT_OK;
+}
+
+/* Uploads the packed scene into a square-ish RGBA32UI texture whose width is a power of
+ * two, checked against GL_MAX_TEXTURE_SIZE. */
+static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels, uint32_t texel_count,
+                                     rt_error *error)
+{
+    int max_size = tracer->context->info.max_texture_size;
+    int width_log2 = 0;
+    while ((1u << width_log2) * (uint64_t)(1u << width_log2) < texel_count && (1 << (width_log2 + 1)) <= max_size)
+        width_log2++;
+    uint32_t width = 1u << width_log2;
+    uint64_t rows = (texel_count + width - 1) / width;
+    if (rows == 0)
+        rows = 1;
+    if (rows > (uint64_t)max_size)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "GPU: the packed scene needs %u texels, more than a %dx%d texture "
+                            "(GL_MAX_TEXTURE_SIZE %d) holds: %llu rows too many",
+                            texel_count, max_size, max_size, max_size,
+                            (unsigned long long)(rows - (uint64_t)max_size));
+    uint32_t *padded = calloc((size_t)width * rows, 4 * sizeof(uint32_t));
+    if (padded == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory packing the scene");
+    memcpy(padded, texels, (size_t)texel_count * 4 * sizeof(uint32_t));
+    glGenTextures(1, &tracer->packed_texture);
+    glBindTexture(GL_TEXTURE_2D, tracer->packed_texture);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32UI, (GLsizei)width, (GLsizei)rows, 0, GL_RGBA_INTEGER,
+                 GL_UNSIGNED_INT, padded);
+    free(padded);
+    tracer->packed_width_log2 = width_log2;
+    return check_gl("uploading the packed scene", error);
+}
+
+/* Creates both sets of state textures (zeroed) and their framebuffers. */
+static rt_status create_state(gpu_tracer *tracer, rt_error *error)
+{
+    int max_size = tracer->context->info.max_texture_size;
+    if (tracer->width > max_size || tracer->height > max_size)
+        return rt_error_set(error, RT_ERROR_INPUT, "GPU: image %dx%d is larger than GL_MAX_TEXTURE_SIZE %d",
+                            tracer->width, tracer->height, max_size);
+    if (tracer->context->info.max_draw_buffers < STATE_TARGET_COUNT)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
+                            STATE_TARGET_COUNT, tracer->context->info.max_draw_buffers);
+    GLenum draw_buffers[STATE_TARGET_COUNT];
+    for (int set = 0; set < 2; set++) {
+        glGenTextures(STATE_TARGET_COUNT, tracer->state_textures[set]);
+        glGenFramebuffers(1, &tracer->framebuffers[set]);
+        glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[set]);
+        for (int target = 0; target < STATE_TARGET_COUNT; target++) {
+            bool integer = target == STATE_COUNTERS;
+            glBindTexture(GL_TEXTURE_2D, tracer->state_textures[set][target]);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            glTexStorage2D(GL_TEXTURE_2D, 1, integer ? GL_RGBA32UI : GL_RGBA32F, tracer->width, tracer->height);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + target, GL_TEXTURE_2D,
+                                   tracer->state_textures[set][target], 0);
+            draw_buffers[target] = GL_COLOR_ATTACHMENT0 + target;
+        }
+        glDrawBuffers(STATE_TARGET_COUNT, draw_buffers);
+        GLenum complete = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+        if (complete != GL_FRAMEBUFFER_COMPLETE)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the state framebuffer is incomplete (0x%04x)",
+                                complete);
+        const GLfloat zero[4] = {0, 0, 0, 0};
+        const GLuint zero_uint[4] = {0, 0, 0, 0};
+        for (int target = 0; target < STATE_TARGET_COUNT; target++) {
+            if (target == STATE_COUNTERS)
+                glClearBufferuiv(GL_COLOR, target, zero_uint);
+            else
+                glClearBufferfv(GL_COLOR, target, zero);
+        }
+    }
+    rt_status status = check_gl("creating the state textures", error);
+    if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
+        return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for a %dx%d image's state (%d MB)",
+                            tracer->width, tracer->height,
+                            (int)((double)tracer->width * tracer->height * 16 * 2 * STATE_TARGET_COUNT / 1e6));
+    return status;
+}
+
+static void set_vec3(GLuint program, const char *name, const float value[3])
+{
+    glUniform3f(glGetUniformLocation(program, name), value[0], value[1], value[2]);
+}
+
+/* Sets every uniform of the tracer from the parameters. */
+static void set_parameters(gpu_tracer *tracer, const gpu_tracer_parameters *p)
+{
+    GLuint program = tracer->program;
+    glUseProgram(program);
+    glUniform2i(glGetUniformLocation(program, "image_size"), p->width, p->height);
+    set_vec3(program, "camera_origin", p->camera_origin);
+    set_vec3(program, "camera_lower_left", p->camera_lower_left);
+    set_vec3(program, "camera_horizontal", p->camera_horizontal);
+    set_vec3(program, "camera_vertical", p->camera_vertical);
+    set_vec3(program, "camera_u", p->camera_u);
+    set_vec3(program, "camera_v", p->camera_v);
+    glUniform1f(glGetUniformLocation(program, "lens_radius"), p->lens_radius);
+    glUniform1i(glGetUniformLocation(program, "sky_type"), p->sky_type);
+    set_vec3(program, "sky_bottom", p->sky_bottom);
+    set_vec3(program, "sky_top", p->sky_top);
+    glUniform1ui(glGetUniformLocation(program, "seed"), p->seed);
+    glUniform1ui(glGetUniformLocation(program, "sample_start"), p->sample_start);
+    glUniform1ui(glGetUniformLocation(program, "samples_per_pixel"), p->samples_per_pixel);
+    glUniform1ui(glGetUniformLocation(program, "max_depth"), p->max_depth);
+    glUniform1ui(glGetUniformLocation(program, "russian_roulette_depth"), p->russian_roulette_depth);
+    glUniform1i(glGetUniformLocation(program, "pass_work_budget"), (GLint)p->pass_work_budget);
+    glUniform1i(glGetUniformLocation(program, "packed_width_log2"), tracer->packed_width_log2);
+    glUniform1i(glGetUniformLocation(program, "packed_scene"), STATE_TARGET_COUNT);
+    for (int target = 0; target < STATE_TARGET_COUNT; target++)
+        glUniform1i(glGetUniformLocation(program, state_sampler_names[target]), target);
+}
+
+rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
+                            const gpu_tracer_parameters *parameters, gpu_tracer **out, rt_error *error)
+{
+    *out = NULL;
+    gpu_tracer *tracer = calloc(1, sizeof *tracer);
+    if (tracer == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory");
+    tracer->context = context;
+    tracer->width = parameters->width;
+    tracer->height = parameters->height;
+    rt_status status = build_program(tracer, error);
+    if (status == RT_OK)
+        status = upload_packed_scene(tracer, packed_texels, texel_count, error);
+    if (status == RT_OK)
+        status = create_state(tracer, error);
+    if (status != RT_OK) {
+        gpu_tracer_destroy(tracer);
+        return status;
+    }
+    glGenVertexArrays(1, &tracer->vertex_array);
+    glGenBuffers(1, &tracer->counter_buffer);
+    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
+    glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), NULL, GL_DYNAMIC_READ);
+    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, tracer->counter_buffer);
+    set_parameters(tracer, parameters);
+    status = check_gl("setting up the tracer", error);
+    if (status != RT_OK) {
+        gpu_tracer_destroy(tracer);
+        return status;
+    }
+    *out = tracer;
+    return RT_OK;
+}
+
+rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_error *error)
+{
+    int source = tracer->current, target = 1 - tracer->current;
+    const GLuint zero[2] = {0, 0};
+    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
+    glBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof zero, zero);
+    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[target]);
+    glViewport(0, 0, tracer->width, tracer->height);
+    glUseProgram(tracer->program);
+    for (int state = 0; state < STATE_TARGET_COUNT; state++) {
+        glActiveTexture(GL_TEXTURE0 + state);
+        glBindTexture(GL_TEXTURE_2D, tracer->state_textures[source][state]);
+    }
+    glActiveTexture(GL_TEXTURE0 + STATE_TARGET_COUNT);
+    glBindTexture(GL_TEXTURE_2D, tracer->packed_texture);
+    glBindVertexArray(tracer->vertex_array);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    GLuint counters[2] = {0, 0};
+    glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof counters, counters);
+    tracer->current = target;
+    report->unfinished_pixels = counters[0];
+    report->samples_finished = counters[1];
+    return check_gl("a tracer pass", error);
+}
+
+void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
+{
+    glUseProgram(tracer->program);
+    glUniform1i(glGetUniformLocation(tracer->program, "pass_work_budget"), (GLint)budget);
+}
+
+/* Reads one state texture of the latest set into rows top to bottom. */
+static void read_state(gpu_tracer *tracer, int state, float *rgba)
+{
+    size_t row_floats = (size_t)tracer->width * 4;
+    float *bottom_up = malloc(row_floats * tracer->height * sizeof(float));
+    if (bottom_up == NULL)
+        return;
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[tracer->current][state]);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, bottom_up);
+    for (int row = 0; row < tracer->height; row++)
+        memcpy(rgba + (size_t)row * row_floats, bottom_up + (size_t)(tracer->height - 1 - row) * row_floats,
+               row_floats * sizeof(float));
+    free(bottom_up);
+}
+
+rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, gpu_tracer_totals *totals, rt_error *error)
+{
+    glActiveTexture(GL_TEXTURE0);
+    read_state(tracer, STATE_ACCUMULATED, rgba);
+    if (totals != NULL) {
+        size_t count = (size_t)tracer->width * tracer->height;
+        float *statistics = malloc(count * 4 * sizeof(float));
+        if (statistics == NULL)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading statistics");
+        read_state(tracer, STATE_STATISTICS, statistics);
+        totals->path_segments = 0;
+        totals->traversal_overflows = 0;
+        for (size_t i = 0; i < count; i++) {
+            totals->path_segments += statistics[i * 4 + 0];
+            totals->traversal_overflows += statistics[i * 4 + 1];
+        }
+        free(statistics);
+    }
+    return check_gl("reading the result", error);
+}
+
+void gpu_tracer_destroy(gpu_tracer *tracer)
+{
+    if (tracer == NULL)
+        return;
+    for (int set = 0; set < 2; set++) {
+        glDeleteTextures(STATE_TARGET_COUNT, tracer->state_textures[set]);
+        glDeleteFramebuffers(1, &tracer->framebuffers[set]);
+    }
+    glDeleteTextures(1, &tracer->packed_texture);
+    glDeleteBuffers(1, &tracer->counter_buffer);
+    glDeleteVertexArrays(1, &tracer->vertex_array);
+    glDeleteProgram(tracer->program);
+    free(tracer);
+}

@@ -1,0 +1,121 @@
+/* gpu.h: the only module that talks to EGL and OpenGL.
+ *
+ * Context set-up, in order (as piglit does it): check EGL client extensions; try the
+ * EGL devices of EGL_EXT_platform_device (hardware devices first, so a real GPU wins;
+ * gpu_options.device picks one); then EGL_MESA_platform_surfaceless (Mesa's llvmpipe on a
+ * CPU-only machine); create a desktop OpenGL 4.5 core context with no surface and no
+ * config; everything renders into framebuffer objects.
+ *
+ * Failures are told apart: RT_ERROR_NO_DEVICE when no EGL platform or device is there at
+ * all (the message says what to install), RT_ERROR_RUNTIME when one is there but the
+ * driver fails (the message names the EGL/GL call and its error).
+ *
+ * The tracer part runs the GLSL path tracer (glsl/tracer.frag) over ping-pong state
+ * textures, one bounded pass at a time (see render.h for why).
+ *
+ * Defaults of gpu_options (all zero): automatic device choice, no GL debug output.
+ */
+#ifndef RT_GPU_H
+#define RT_GPU_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "status.h"
+
+typedef struct gpu_options {
+    int device;                  /* 0: automatic; N >= 1: use EGL device N-1 (see `info`) */
+    bool debug_output;           /* KHR_debug messages to the debug callback (--verbose) */
+    void (*log)(void *log_context, const char *message);  /* where debug messages go */
+    void *log_context;
+} gpu_options;
+
+typedef struct gpu_info {
+    char platform[64];           /* "device" or "surfaceless" */
+    int device_index;            /* EGL device used (0-based), -1 for surfaceless */
+    int device_count;            /* EGL devices seen */
+    char device_extensions[512]; /* of the chosen device, "" for surfaceless */
+    char egl_vendor[128], egl_version[128];
+    char gl_vendor[128], gl_renderer[256], gl_version[128], glsl_version[128];
+    int max_texture_size;
+    int max_draw_buffers;
+    int max_color_attachments;
+    int max_fragment_atomic_counters;
+    bool software;               /* a CPU rasteriser (llvmpipe, softpipe) */
+} gpu_info;
+
+typedef struct gpu_context gpu_context;
+
+/* Returns options with every field at its default (all zero). */
+gpu_options gpu_options_defaults(void);
+
+/* Creates the EGL display and an OpenGL 4.5 core context and makes it current.
+ * options may be NULL. On success *out is the context; free it with gpu_destroy(). */
+rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *error);
+
+/* Releases the context and the display. NULL is ignored. */
+void gpu_destroy(gpu_context *context);
+
+/* Copies what was chosen and the limits that matter into *info. */
+void gpu_get_info(const gpu_context *context, gpu_info *info);
+
+/* ---- the tracer -------------------------------------------------------------------- */
+
+/* Per-render parameters of the tracer shader. Vectors are world space. */
+typedef struct gpu_tracer_parameters {
+    int width, height;                    /* the image; passes cover all of it */
+    float camera_origin[3];
+    float camera_lower_left[3];           /* point on the focus plane at the image's bottom left */
+    float camera_horizontal[3];           /* focus-plane vector across the image width */
+    float camera_vertical[3];             /* focus-plane vector up the image height */
+    float camera_u[3], camera_v[3];       /* lens axes (right, up), unit length */
+    float lens_radius;
+    int sky_type;                         /* SKY_* of scene.h */
+    float sky_bottom[3], sky_top[3];
+    uint32_t seed;
+    uint32_t sample_start;                /* first sample index (sample ranges) */
+    uint32_t samples_per_pixel;
+    uint32_t max_depth;
+    uint32_t russian_roulette_depth;      /* first bounce at which paths may end at random */
+    uint32_t pass_work_budget;            /* work units a pixel may start in one pass */
+} gpu_tracer_parameters;
+
+/* What one pass reports. */
+typedef struct gpu_pass_report {
+    uint32_t unfinished_pixels;           /* pixels that still have samples to run */
+    uint32_t samples_finished;            /* samples that ended in this pass */
+} gpu_pass_report;
+
+/* Sums read back at the end of a render. */
+typedef struct gpu_tracer_totals {
+    double path_segments;                 /* rays traced (camera + scattered) */
+    double traversal_overflows;           /* traversals cut at the hard work cap (must be 0) */
+} gpu_tracer_totals;
+
+typedef struct gpu_tracer gpu_tracer;
+
+/* Compiles the tracer, uploads the packed scene (texel_count texels of 4 uint32 each,
+ * see packed_layout.h) and creates the state textures for parameters->width x height.
+ * Too large for the device (texture size, memory) is RT_ERROR_INPUT saying which limit.
+ * Free with gpu_tracer_destroy(). */
+rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
+                            const gpu_tracer_parameters *parameters, gpu_tracer **out, rt_error *error);
+
+/* Runs one pass: every unfinished pixel does at most pass_work_budget units of work,
+ * keeps its unfinished path in the state textures, and starts new samples while it has
+ * budget and samples left. Waits for the pass to finish and fills *report. */
+rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_error *error);
+
+/* Changes the work budget of the following passes. The image does not depend on it (the
+ * random numbers belong to samples, not passes); only the time per pass does. */
+void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
+
+/* Reads the accumulated result: rgba receives width*height*4 floats, rows top to bottom,
+ * (sum of finished samples' radiance r, g, b, number of finished samples).
+ * totals may be NULL. */
+rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, gpu_tracer_totals *totals, rt_error *error);
+
+/* Frees the tracer's GL objects. NULL is ignored. */
+void gpu_tracer_destroy(gpu_tracer *tracer);
+
+#endif

@@ -1,0 +1,159 @@
+/* render.c: see render.h. Plain C: the GL work is gpu.c's. */
+#include "render.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "camera.h"
+#include "pack.h"
+
+#define INITIAL_ADAPTIVE_BUDGET 64
+#define MINIMUM_ADAPTIVE_BUDGET 16
+#define MAXIMUM_ADAPTIVE_BUDGET 16384
+#define DEFAULT_TARGET_PASS_SECONDS 0.25
+#define DEFAULT_RUSSIAN_ROULETTE_DEPTH 4
+
+render_options render_options_defaults(void)
+{
+    return (render_options){0};
+}
+
+static double seconds_now(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return now.tv_sec + now.tv_nsec * 1e-9;
+}
+
+/* Fills the tracer's parameters from the scene, its camera frame and the options. */
+static void tracer_parameters(const scene *s, const camera_frame *frame, const render_options *options,
+                              gpu_tracer_parameters *p)
+{
+    memset(p, 0, sizeof *p);
+    p->width = s->render.width;
+    p->height = s->render.height;
+    memcpy(p->camera_origin, frame->origin, sizeof p->camera_origin);
+    memcpy(p->camera_lower_left, frame->lower_left, sizeof p->camera_lower_left);
+    memcpy(p->camera_horizontal, frame->horizontal, sizeof p->camera_horizontal);
+    memcpy(p->camera_vertical, frame->vertical, sizeof p->camera_vertical);
+    memcpy(p->camera_u, frame->u, sizeof p->camera_u);
+    memcpy(p->camera_v, frame->v, sizeof p->camera_v);
+    p->lens_radius = frame->lens_radius;
+    p->sky_type = s->sky.type;
+    memcpy(p->sky_bottom, s->sky.bottom, sizeof p->sky_bottom);
+    memcpy(p->sky_top, s->sky.top, sizeof p->sky_top);
+    p->seed = s->render.seed;
+    p->sample_start = options->sample_start;
+    p->samples_per_pixel = (uint32_t)s->render.samples_per_pixel;
+    p->max_depth = (uint32_t)s->render.max_depth;
+    p->russian_roulette_depth = options->russian_roulette_depth ? options->russian_roulette_depth
+                                                                : DEFAULT_RUSSIAN_ROULETTE_DEPTH;
+    p->pass_work_budget = options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET;
+}
+
+rt_status render_scene(gpu_context *context, const scene *s, const render_options *options,
+                       render_result *result, rt_error *error)
+{
+    double start = seconds_now();
+    memset(result, 0, sizeof *result);
+    render_options defaults = render_options_defaults();
+    if (options == NULL)
+        options = &defaults;
+
+    camera_frame frame;
+    rt_status status = camera_frame_compute(&s->camera, s->render.width, s->render.height, &frame, error);
+    if (status != RT_OK)
+        return status;
+    packed_scene packed;
+    status = pack_scene(s, NULL, &packed, error);
+    if (status != RT_OK)
+        return status;
+    result->bvh_depth = packed.bvh_depth;
+    result->bvh_build_seconds = packed.bvh_build_seconds;
+    result->packed_bytes = packed.texel_count * 16u;
+
+    gpu_tracer_parameters parameters;
+    tracer_parameters(s, &frame, options, &parameters);
+    gpu_tracer *tracer = NULL;
+    status = gpu_tracer_create(context, packed.texels, packed.texel_count, &parameters, &tracer, error);
+    packed_scene_free(&packed);
+    if (status != RT_OK)
+        return status;
+
+    render_progress progress = {
+        .samples_total = (uint64_t)s->render.width * s->render.height * s->render.samples_per_pixel,
+    };
+    bool interrupted = false;
+    bool adaptive = options->pass_work_budget == 0;
+    double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
+                                                             : DEFAULT_TARGET_PASS_SECONDS;
+    double budget = parameters.pass_work_budget;
+    for (;;) {
+        gpu_pass_report report;
+        double pass_start = seconds_now();
+        status = gpu_tracer_run_pass(tracer, &report, error);
+        if (status != RT_OK)
+            break;
+        if (adaptive) {
+            /* Pass time grows roughly linearly with the budget; move towards the target
+             * by at most a factor of 4 per pass so one odd pass cannot swing it far. */
+            double pass_seconds = seconds_now() - pass_start;
+            double scale = pass_seconds > 0 ? target_seconds / pass_seconds : 4.0;
+            scale = scale < 0.5 ? 0.5 : scale > 4.0 ? 4.0 : scale;
+            budget *= scale;
+            budget = budget < MINIMUM_ADAPTIVE_BUDGET ? MINIMUM_ADAPTIVE_BUDGET
+                     : budget > MAXIMUM_ADAPTIVE_BUDGET ? MAXIMUM_ADAPTIVE_BUDGET : budget;
+            gpu_tracer_set_pass_work_budget(tracer, (uint32_t)budget);
+        }
+        progress.passes++;
+        progress.samples_done += report.samples_finished;
+        progress.elapsed_seconds = seconds_now() - start;
+        if (progress.passes == 1)
+            result->first_pass_seconds = progress.elapsed_seconds;
+        if (options->progress != NULL)
+            options->progress(options->progress_context, &progress);
+        if (report.unfinished_pixels == 0)
+            break;
+        if (options->stop_requested != NULL && *options->stop_requested) {
+            interrupted = true;
+            break;
+        }
+    }
+
+    if (status == RT_OK)
+        status = image_create(&result->image, s->render.width, s->render.height, 4, error);
+    gpu_tracer_totals totals = {0};
+    if (status == RT_OK)
+        status = gpu_tracer_read(tracer, result->image.pixels, &totals, error);
+    gpu_tracer_destroy(tracer);
+    if (status != RT_OK) {
+        image_free(&result->image);
+        return status;
+    }
+    if (totals.traversal_overflows > 0) {
+        image_free(&result->image);
+        return rt_error_set(error, RT_ERROR_RUNTIME,
+                            "RENDER: %.0f ray traversals exceeded the shader's hard work cap and were cut short; "
+                            "the image would be wrong. The scene's BVH is degenerate (many overlapping primitives)",
+                            totals.traversal_overflows);
+    }
+
+    /* Sums to means; the count stays in the fourth channel. */
+    float *pixels = result->image.pixels;
+    size_t pixel_count = (size_t)s->render.width * s->render.height;
+    for (size_t i = 0; i < pixel_count; i++) {
+        float count = pixels[4 * i + 3];
+        result->samples += (uint64_t)count;
+        for (int c = 0; c < 3; c++)
+            pixels[4 * i + c] = count > 0 ? pixels[4 * i + c] / count : 0.0f;
+    }
+    snprintf(result->image.channel_names[3], IMAGE_CHANNEL_NAME_MAX, "samples");
+    result->passes = progress.passes;
+    result->path_segments = totals.path_segments;
+    result->seconds = seconds_now() - start;
+    if (interrupted)
+        return rt_error_set(error, RT_ERROR_INTERRUPTED, "RENDER: interrupted after %llu of %llu samples",
+                            (unsigned long long)result->samples, (unsigned long long)progress.samples_total);
+    return RT_OK;
+}

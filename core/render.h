@@ -1,0 +1,71 @@
+/* render.h: renders a scene: camera frame, packing, GPU tracer passes, result image.
+ *
+ * A render is a sequence of bounded passes (see gpu.h and glsl/tracer.frag for why:
+ * llvmpipe's 65,535-iteration loop cap and GPU watchdogs). Passes repeat until every
+ * pixel has run all its samples, or until *stop_requested becomes non-zero (checked
+ * between passes), in which case the samples finished so far are returned with their
+ * per-pixel counts and the status is RT_ERROR_INTERRUPTED.
+ *
+ * The result image has 4 channels: R, G, B (the mean radiance of the finished samples,
+ * linear) and "samples" (how many samples each pixel finished), rows top to bottom.
+ *
+ * Defaults of render_options (zero means default):
+ *   pass_work_budget: adaptive: starts at 64 work units per pixel per pass (a unit is
+ *     one BVH node visit or one primitive test) and is scaled after each pass so that a
+ *     pass takes about target_pass_seconds, between 16 and 16384 units (the shader's
+ *     hard cap per traversal is 60,000, under llvmpipe's 65,535). A non-zero value is
+ *     used for every pass. The image does not depend on it, only the time per pass.
+ *   target_pass_seconds 0.25 (short passes keep progress, Ctrl-C and GPU watchdogs happy),
+ *   russian_roulette_depth 4 (paths may end at random from the 5th segment on),
+ *   sample_start 0, no progress callback, no stop flag.
+ */
+#ifndef RT_RENDER_H
+#define RT_RENDER_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "gpu.h"
+#include "image_io.h"
+#include "scene.h"
+#include "status.h"
+
+typedef struct render_progress {
+    uint64_t samples_done;
+    uint64_t samples_total;
+    double elapsed_seconds;
+    int passes;
+} render_progress;
+
+typedef struct render_options {
+    uint32_t pass_work_budget;
+    double target_pass_seconds;
+    uint32_t russian_roulette_depth;
+    uint32_t sample_start;
+    void (*progress)(void *progress_context, const render_progress *progress);
+    void *progress_context;
+    const volatile sig_atomic_t *stop_requested;
+} render_options;
+
+typedef struct render_result {
+    rt_image image;              /* R, G, B, samples; free with image_free() */
+    uint64_t samples;            /* samples finished over all pixels */
+    double seconds;              /* whole render, including set-up */
+    double first_pass_seconds;   /* from the start until the first pass finished */
+    double path_segments;        /* rays traced, counted by the shader */
+    int passes;
+    int bvh_depth;
+    double bvh_build_seconds;
+    uint32_t packed_bytes;
+} render_result;
+
+/* Returns options with every field at its default (all zero). */
+render_options render_options_defaults(void);
+
+/* Renders s with the scene's render settings on context. options may be NULL. On RT_OK
+ * and on RT_ERROR_INTERRUPTED, result->image holds the image (the caller frees it with
+ * image_free()); on other errors it is empty. */
+rt_status render_scene(gpu_context *context, const scene *s, const render_options *options,
+                       render_result *result, rt_error *error);
+
+#endif

@@ -1,0 +1,71 @@
+#!/bin/sh
+# test-analytic.sh: scenes whose correct image is known in closed form, so they check
+# correctness itself (golden images only catch change).
+#   usage: sh tests/render/test-analytic.sh PROGRAM SCRATCH_DIR
+set -u
+program=$1
+scratch=$2
+. "$(dirname "$0")/lib.sh"
+
+# White furnace: a convex diffuse sphere of albedo a in a uniform white sky. A camera ray
+# that hits it scatters once and escapes, so its pixels are exactly a (0.5, and 0.8 with
+# -D albedo=0.8). The crop is well inside the sphere's silhouette.
+for albedo in 0.5 0.8; do
+    out="$scratch/furnace-$albedo.exr"
+    if "$program" render scenes/furnace.txt -o "$out" --size 64x64 --spp 16 -D albedo=$albedo --quiet; then
+        for channel in R G B; do
+            mean=$(channel_mean "$out" $channel 20,20,44,44)
+            if within "$mean" "$albedo" 0.01; then pass "furnace albedo $albedo channel $channel (mean $mean)"
+            else fail "furnace albedo $albedo channel $channel" "mean $mean, expected $albedo within 1%"; fi
+        done
+        range=$(channel_range "$out" G 20,20,44,44)
+        if within "${range% *}" "$albedo" 0.001 && within "${range#* }" "$albedo" 0.001; then
+            pass "furnace albedo $albedo: every pixel exactly the albedo (min/max $range)"
+        else fail "furnace albedo $albedo pixel range" "min/max $range, expected $albedo"; fi
+    else
+        fail "furnace albedo $albedo" "render failed"
+    fi
+done
+
+# Clear glass in a white sky: nothing absorbs, every path ends in the sky: 1 everywhere.
+out="$scratch/glass-furnace.exr"
+if "$program" render scenes/glass-furnace.txt -o "$out" --size 64x64 --spp 64 --quiet; then
+    for channel in R G B; do
+        mean=$(channel_mean "$out" $channel)
+        if within "$mean" 1 0.01; then pass "glass furnace channel $channel (mean $mean)"
+        else fail "glass furnace channel $channel" "mean $mean, expected 1 within 1%"; fi
+    done
+else
+    fail "glass furnace" "render failed"
+fi
+
+# A diffuse plane (radius-1000 sphere) under a uniform sky: exactly albedo * sky = 0.6
+# in every pixel; anything darker is self-intersection on the big sphere.
+out="$scratch/plane.exr"
+if "$program" render tests/render/scenes/plane-under-sky.txt -o "$out" --quiet; then
+    mean=$(channel_mean "$out" G)
+    range=$(channel_range "$out" G)
+    if within "$mean" 0.6 0.01; then pass "plane under uniform sky: mean $mean"
+    else fail "plane under uniform sky" "mean $mean, expected 0.6 within 1%"; fi
+    if within "${range% *}" 0.6 0.001; then pass "plane under uniform sky: no darker pixel (min $range)"
+    else fail "plane under uniform sky: min/max" "$range, expected 0.6 everywhere"; fi
+else
+    fail "plane under uniform sky" "render failed"
+fi
+
+# Two estimators of one image: Russian roulette from the first bounce versus none before
+# the depth limit. Both are unbiased, so the image means agree within noise.
+a="$scratch/roulette-early.exr"
+b="$scratch/roulette-late.exr"
+if "$program" render scenes/materials/lambertian.txt -o "$a" --size 64x36 --spp 256 --roulette-depth 1 --quiet &&
+   "$program" render scenes/materials/lambertian.txt -o "$b" --size 64x36 --spp 256 --roulette-depth 1000 --quiet; then
+    for channel in R G B; do
+        mean_a=$(channel_mean "$a" $channel)
+        mean_b=$(channel_mean "$b" $channel)
+        if within "$mean_a" "$mean_b" 0.01; then pass "Russian roulette unbiased, channel $channel ($mean_a vs $mean_b)"
+        else fail "Russian roulette unbiased, channel $channel" "$mean_a vs $mean_b differ by more than 1%"; fi
+    done
+else
+    fail "Russian roulette estimators" "render failed"
+fi
+finish

@@ -1,0 +1,57 @@
+#!/bin/sh
+# test-pass-budget.sh: the per-pass work bound. llvmpipe silently ends every loop of a
+# shader invocation after 65,535 iterations in total, so a renderer that runs a long path
+# in one invocation renders a wrong image with no error. These scenes need far more than
+# that per sample; the shader counts the segments it traced, and the image must not
+# depend on how the work is split into passes.
+#   usage: sh tests/render/test-pass-budget.sh PROGRAM SCRATCH_DIR
+set -u
+program=$1
+scratch=$2
+. "$(dirname "$0")/lib.sh"
+
+# Every sample in the mirror cell runs exactly depth = 20000 segments (see the scene).
+for budget in adaptive 7 5000; do
+    out="$scratch/mirror-cell-$budget.exr"
+    option=""
+    [ "$budget" = adaptive ] || option="--pass-budget $budget"
+    # shellcheck disable=SC2086
+    if "$program" render tests/render/scenes/mirror-cell.txt -o "$out" --quiet $option; then
+        segments=$(metadata "$out" path_segments)
+        samples=$(metadata "$out" samples_finished)
+        if [ "$segments" = 1280000 ] && [ "$samples" = 64 ]; then
+            pass "mirror cell, pass budget $budget: all 64 samples ran all 20000 segments"
+        else
+            fail "mirror cell, pass budget $budget" "$samples samples, $segments segments; expected 64 and 1280000"
+        fi
+    else
+        fail "mirror cell, pass budget $budget" "render failed"
+    fi
+done
+
+# Long random paths between mirrors and diffuse balls: the same image however the work
+# is split (one pass per few segments, or as much as the budget allows).
+reference="$scratch/deep-adaptive.exr"
+if "$program" render scenes/deep-mirrors.txt -o "$reference" --size 16x16 --spp 2 --quiet; then
+    segments=$(metadata "$reference" path_segments)
+    if awk -v s="$segments" 'BEGIN { exit !(s / (16 * 16 * 2) > 300) }'; then
+        pass "deep mirrors: $segments segments, over 300 per sample"
+    else
+        fail "deep mirrors" "only $segments segments; the scene no longer stresses the bound"
+    fi
+    for budget in 50 3000; do
+        out="$scratch/deep-$budget.exr"
+        if "$program" render scenes/deep-mirrors.txt -o "$out" --size 16x16 --spp 2 --pass-budget $budget --quiet; then
+            if "$program" diff "$out" "$reference" --fail 0 --failpercent 0 --quiet >/dev/null; then
+                pass "deep mirrors: pass budget $budget gives the same image"
+            else
+                fail "deep mirrors: pass budget $budget" "image differs from the adaptive render"
+            fi
+        else
+            fail "deep mirrors, pass budget $budget" "render failed"
+        fi
+    done
+else
+    fail "deep mirrors" "render failed"
+fi
+finish
