@@ -1,9 +1,9 @@
 /* scene_parse.h: reads the rtspheres scene text format (version 1) into a scene.
  *
- * The format is documented in README.md ("Scene format"). Every error is reported as
+ * The format is documented in docs/scene-format.md (linked from README.md). Every error is reported as
  *   "FILE:LINE:COLUMN: what was found, and what was expected"
  * (1-based line and column, FILE as given or as resolved for an include) and returned
- * as RT_ERROR_INPUT. A file that cannot be read is RT_ERROR_INPUT too.
+ * as RT_ERROR_INPUT. A file that cannot be read is RT_ERROR_INPUT too. error may be NULL.
  *
  * Variables: `set NAME VALUE` in the file defines $NAME. A define passed in
  * scene_parse_options (from the command line's -D NAME=VALUE) wins over the file's

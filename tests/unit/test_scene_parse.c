@@ -1,0 +1,1163 @@
+/* test_scene_parse.c: unit tests of the scene text parser (core/scene_parse.c). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <ftw.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "scene_parse.h"
+
+/* ------------------------------------------------------------------ helpers */
+
+/* cmocka 1.1 compares floats only in single precision: this checks doubles. */
+#define assert_double_equal(actual, expected, tolerance) \
+    check_double_equal((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
+
+static void check_double_equal(double actual, double expected, double tolerance, const char *text,
+                               const char *file, int line)
+{
+    if (!(fabs(actual - expected) <= tolerance)) {
+        print_error("%s is %.17g, expected %.17g (tolerance %g)\n", text, actual, expected, tolerance);
+        _fail(file, line);
+    }
+}
+
+#define assert_vector_equal(vector, x, y, z)            \
+    do {                                                \
+        assert_double_equal((vector)[0], (x), 1e-6);    \
+        assert_double_equal((vector)[1], (y), 1e-6);    \
+        assert_double_equal((vector)[2], (z), 1e-6);    \
+    } while (0)
+
+/* True when *s is byte for byte what scene_defaults() makes (scene_free leaves that too). */
+static bool scene_is_default(const scene *s)
+{
+    scene defaults;
+    scene_defaults(&defaults);
+    return memcmp(s, &defaults, sizeof defaults) == 0;
+}
+
+/* Parses text (named "s.txt") and fails the test unless it succeeds. The caller frees *out. */
+#define parse_ok(text, options, out) check_parse_ok((text), "s.txt", (options), (out), __FILE__, __LINE__)
+
+static void check_parse_ok(const char *text, const char *name, const scene_parse_options *options, scene *out,
+                           const char *file, int line)
+{
+    rt_error error = {{0}};
+    rt_status status = scene_load_string(text, name, options, out, &error);
+    if (status != RT_OK) {
+        print_error("parsing failed with status %d: %s\n", status, error.message);
+        _fail(file, line);
+    }
+}
+
+/* Parses text (named "s.txt") and checks that it fails with RT_ERROR_INPUT, that the
+ * message starts with prefix (usually "FILE:LINE:COLUMN: ") and contains phrase (ends
+ * with it, when phrase ends in '$'), and that the output scene is left as
+ * scene_defaults(). */
+#define assert_parse_error(text, prefix, phrase) \
+    check_parse_error((text), NULL, (prefix), (phrase), __FILE__, __LINE__)
+#define assert_parse_error_with(text, options, prefix, phrase) \
+    check_parse_error((text), (options), (prefix), (phrase), __FILE__, __LINE__)
+
+/* The checks shared by string and file errors; see assert_parse_error. */
+static void check_message(rt_status status, const char *message, const scene *s, const char *prefix,
+                          const char *phrase, const char *file, int line)
+{
+    if (status != RT_ERROR_INPUT) {
+        print_error("expected RT_ERROR_INPUT with '%s%s', got status %d (%s)\n", prefix, phrase, status, message);
+        _fail(file, line);
+    }
+    /* A phrase ending in '$' must end the message (so "found -0.1$" rejects -0.1000001). */
+    size_t phrase_length = strlen(phrase), message_length = strlen(message);
+    bool at_end = phrase_length > 0 && phrase[phrase_length - 1] == '$';
+    bool phrase_found = at_end ? message_length >= phrase_length - 1 &&
+                                     strncmp(message + message_length - (phrase_length - 1), phrase,
+                                             phrase_length - 1) == 0
+                               : strstr(message, phrase) != NULL;
+    if (strncmp(message, prefix, strlen(prefix)) != 0 || !phrase_found) {
+        print_error("expected a message starting with '%s' and containing '%s', got:\n  %s\n", prefix, phrase,
+                    message);
+        _fail(file, line);
+    }
+    if (!scene_is_default(s)) {
+        print_error("the scene was not left as scene_defaults() after: %s\n", message);
+        _fail(file, line);
+    }
+}
+
+/* See assert_parse_error. */
+static void check_parse_error(const char *text, const scene_parse_options *options, const char *prefix,
+                              const char *phrase, const char *file, int line)
+{
+    scene s;
+    rt_error error = {{0}};
+    rt_status status = scene_load_string(text, "s.txt", options, &s, &error);
+    check_message(status, error.message, &s, prefix, phrase, file, line);
+}
+
+/* Returns default options with the given -D defines. */
+static scene_parse_options options_with_defines(const scene_define *defines, int count)
+{
+    scene_parse_options options = scene_parse_options_defaults();
+    options.defines = defines;
+    options.define_count = count;
+    return options;
+}
+
+/* ---- temporary directory for file tests (one per test, removed afterwards) */
+
+typedef struct temporary_directory {
+    char path[64];
+} temporary_directory;
+
+/* Setup: makes a fresh directory under /tmp and stores it in *state. */
+static int create_directory(void **state)
+{
+    temporary_directory *directory = malloc(sizeof *directory);
+    if (directory == NULL)
+        return -1;
+    strcpy(directory->path, "/tmp/rtspheres-scene-test.XXXXXX");
+    if (mkdtemp(directory->path) == NULL) {
+        free(directory);
+        return -1;
+    }
+    *state = directory;
+    return 0;
+}
+
+/* nftw callback: removes one file or (emptied) directory. */
+static int remove_entry(const char *path, const struct stat *info, int type, struct FTW *walk)
+{
+    (void)info;
+    (void)type;
+    (void)walk;
+    return remove(path);
+}
+
+/* Teardown: removes the test's directory and everything in it. */
+static int remove_directory(void **state)
+{
+    temporary_directory *directory = *state;
+    int result = nftw(directory->path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+    free(directory);
+    return result;
+}
+
+/* Returns "DIRECTORY/name" in buffer. */
+static const char *path_in(void **state, const char *name, char *buffer, size_t size)
+{
+    const temporary_directory *directory = *state;
+    snprintf(buffer, size, "%s/%s", directory->path, name);
+    return buffer;
+}
+
+/* Writes length bytes of content to DIRECTORY/name, creating one level of subdirectory. */
+static void write_bytes(void **state, const char *name, const char *content, size_t length)
+{
+    char path[256];
+    path_in(state, name, path, sizeof path);
+    const char *slash = strchr(name, '/');
+    if (slash != NULL) {
+        char directory[256];
+        snprintf(directory, sizeof directory, "%s/%.*s", ((temporary_directory *)*state)->path,
+                 (int)(slash - name), name);
+        mkdir(directory, 0700);
+    }
+    FILE *file = fopen(path, "wb");
+    assert_non_null(file);
+    assert_int_equal(fwrite(content, 1, length, file), length);
+    assert_int_equal(fclose(file), 0);
+}
+
+/* Writes the string content to DIRECTORY/name. */
+static void write_text(void **state, const char *name, const char *content)
+{
+    write_bytes(state, name, content, strlen(content));
+}
+
+/* Loads DIRECTORY/name and checks the error as check_parse_error does; prefix and
+ * phrase may contain one "%s" each, replaced by the directory. */
+#define assert_file_error(state, name, options, prefix, phrase) \
+    check_file_error((state), (name), (options), (prefix), (phrase), __FILE__, __LINE__)
+
+/* See assert_file_error. */
+static void check_file_error(void **state, const char *name, const scene_parse_options *options,
+                             const char *prefix_format, const char *phrase_format, const char *file, int line)
+{
+    const char *directory = ((temporary_directory *)*state)->path;
+    char path[256], prefix[512], phrase[1024];
+    path_in(state, name, path, sizeof path);
+    snprintf(prefix, sizeof prefix, prefix_format, directory);
+    snprintf(phrase, sizeof phrase, phrase_format, directory, directory, directory, directory);
+    scene s;
+    rt_error error = {{0}};
+    rt_status status = scene_load_file(path, options, &s, &error);
+    check_message(status, error.message, &s, prefix, phrase, file, line);
+}
+
+/* Loads DIRECTORY/name into *out, failing the test unless it succeeds; the caller frees *out. */
+static void load_file_ok(void **state, const char *name, const scene_parse_options *options, scene *out)
+{
+    char path[256];
+    rt_error error = {{0}};
+    rt_status status = scene_load_file(path_in(state, name, path, sizeof path), options, out, &error);
+    if (status != RT_OK)
+        fail_msg("loading %s failed: %s", name, error.message);
+}
+
+/* ------------------------------------------------------------------ defaults and statements */
+
+static void test_empty_text_gives_defaults(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("", NULL, &s);
+    assert_true(scene_is_default(&s));
+    assert_int_equal(s.render.width, 640);
+    assert_int_equal(s.render.height, 360);
+    assert_int_equal(s.render.samples_per_pixel, 64);
+    assert_int_equal(s.render.max_depth, 16);
+    assert_int_equal(s.render.seed, 1);
+    assert_vector_equal(s.camera.look_from, 0, 0, 1);
+    assert_double_equal(s.camera.vertical_fov_degrees, 40, 0);
+    assert_int_equal(s.sky.type, SKY_GRADIENT);
+    scene_free(&s);
+
+    parse_ok("# only a comment\n\n   \t\n# another\n", NULL, &s);
+    assert_true(scene_is_default(&s));
+    scene_free(&s);
+
+    scene_parse_options options = scene_parse_options_defaults();
+    assert_null(options.defines);
+    assert_int_equal(options.define_count, 0);
+    assert_int_equal(options.max_include_depth, 0);
+    parse_ok("\n", &options, &s);
+    assert_true(scene_is_default(&s));
+    scene_free(&s);
+}
+
+static void test_camera_clauses(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("camera from 1 2 3 at 4 5 6 up 0 0 1 fov 50 aperture 0.1 focus 7.5\n", NULL, &s);
+    assert_vector_equal(s.camera.look_from, 1, 2, 3);
+    assert_vector_equal(s.camera.look_at, 4, 5, 6);
+    assert_vector_equal(s.camera.up, 0, 0, 1);
+    assert_double_equal(s.camera.vertical_fov_degrees, 50, 1e-6);
+    assert_double_equal(s.camera.aperture, 0.1, 1e-7);
+    assert_double_equal(s.camera.focus_distance, 7.5, 0);
+    scene_free(&s);
+
+    /* Any order, and a clause left out keeps its default. */
+    parse_ok("camera focus 2 fov 179.5 at 0 1 0 from 0 1 5", NULL, &s);
+    assert_vector_equal(s.camera.look_from, 0, 1, 5);
+    assert_vector_equal(s.camera.look_at, 0, 1, 0);
+    assert_vector_equal(s.camera.up, 0, 1, 0);
+    assert_double_equal(s.camera.vertical_fov_degrees, 179.5, 1e-5);
+    assert_double_equal(s.camera.aperture, 0, 0);
+    assert_double_equal(s.camera.focus_distance, 2, 0);
+    scene_free(&s);
+
+    /* Several statements: later clauses override earlier ones. A bare camera is fine. */
+    parse_ok("camera fov 30 from 0 0 9\ncamera\ncamera fov 60\n", NULL, &s);
+    assert_double_equal(s.camera.vertical_fov_degrees, 60, 0);
+    assert_vector_equal(s.camera.look_from, 0, 0, 9);
+    scene_free(&s);
+}
+
+static void test_render_clauses(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("render size 320 200 spp 16 depth 8 seed 42", NULL, &s);
+    assert_int_equal(s.render.width, 320);
+    assert_int_equal(s.render.height, 200);
+    assert_int_equal(s.render.samples_per_pixel, 16);
+    assert_int_equal(s.render.max_depth, 8);
+    assert_int_equal(s.render.seed, 42);
+    scene_free(&s);
+
+    parse_ok("render seed 4294967295 depth 100000\nrender spp (2^30) size 16384 1\nrender seed 0", NULL, &s);
+    assert_int_equal(s.render.seed, 0);
+    assert_int_equal(s.render.max_depth, 100000);
+    assert_int_equal(s.render.samples_per_pixel, 1073741824);
+    assert_int_equal(s.render.width, 16384);
+    assert_int_equal(s.render.height, 1);
+    scene_free(&s);
+
+    parse_ok("render seed 4294967295", NULL, &s);
+    assert_int_equal(s.render.seed, 4294967295u);
+    scene_free(&s);
+}
+
+static void test_sky(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("sky gradient 0.1 0.2 0.3  0.4 0.5 0.6", NULL, &s);
+    assert_int_equal(s.sky.type, SKY_GRADIENT);
+    assert_vector_equal(s.sky.bottom, 0.1, 0.2, 0.3);
+    assert_vector_equal(s.sky.top, 0.4, 0.5, 0.6);
+    scene_free(&s);
+
+    parse_ok("sky gradient 0 0 0 1 1 1\nsky constant 2 3 4", NULL, &s);
+    assert_int_equal(s.sky.type, SKY_CONSTANT);
+    assert_vector_equal(s.sky.bottom, 2, 3, 4);
+    assert_vector_equal(s.sky.top, 2, 3, 4);
+    scene_free(&s);
+
+    parse_ok("sky constant 1 1 1\nsky gradient 0 0 0 1 1 1", NULL, &s);   /* the last sky wins */
+    assert_int_equal(s.sky.type, SKY_GRADIENT);
+    assert_vector_equal(s.sky.bottom, 0, 0, 0);
+    scene_free(&s);
+}
+
+static void test_materials(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material matte lambertian 0.5 0.25 0.125\n"
+             "material shiny metal 0.9 0.8 0.7\n"
+             "material brushed metal 0.9 0.8 0.7 fuzz 0.3\n"
+             "material glass dielectric 1.5\n"
+             "material lamp emissive 1 0.5 0.25\n"
+             "material bright emissive 1 0.5 0.25 strength 4\n"
+             "material dark-lamp.2 emissive 1 1 1 strength 0\n", NULL, &s);
+    assert_int_equal(s.material_count, 7);
+
+    assert_string_equal(s.materials[0].name, "matte");
+    assert_int_equal(s.materials[0].type, MATERIAL_LAMBERTIAN);
+    assert_vector_equal(s.materials[0].albedo, 0.5, 0.25, 0.125);
+    assert_vector_equal(s.materials[0].emission, 0, 0, 0);
+    assert_double_equal(s.materials[0].fuzz, 0, 0);
+    assert_double_equal(s.materials[0].index_of_refraction, 0, 0);
+
+    assert_int_equal(s.materials[1].type, MATERIAL_METAL);
+    assert_vector_equal(s.materials[1].albedo, 0.9, 0.8, 0.7);
+    assert_double_equal(s.materials[1].fuzz, 0, 0);              /* default fuzz */
+    assert_int_equal(s.materials[2].type, MATERIAL_METAL);
+    assert_double_equal(s.materials[2].fuzz, 0.3, 1e-7);
+
+    assert_int_equal(s.materials[3].type, MATERIAL_DIELECTRIC);
+    assert_double_equal(s.materials[3].index_of_refraction, 1.5, 0);
+    assert_vector_equal(s.materials[3].albedo, 0, 0, 0);
+
+    assert_int_equal(s.materials[4].type, MATERIAL_EMISSIVE);
+    assert_vector_equal(s.materials[4].emission, 1, 0.5, 0.25);  /* default strength 1 */
+    assert_vector_equal(s.materials[4].albedo, 0, 0, 0);
+    assert_vector_equal(s.materials[5].emission, 4, 2, 1);       /* colour x strength */
+    assert_string_equal(s.materials[6].name, "dark-lamp.2");
+    assert_vector_equal(s.materials[6].emission, 0, 0, 0);
+    scene_free(&s);
+
+    /* The fuzz and strength of the boundaries are valid. */
+    parse_ok("material a metal 1 1 1 fuzz 1\nmaterial b metal 0 0 0 fuzz 0\nmaterial c lambertian 0 0 0", NULL, &s);
+    assert_double_equal(s.materials[0].fuzz, 1, 0);
+    scene_free(&s);
+}
+
+static void test_spheres(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material red lambertian 1 0 0\nmaterial blue lambertian 0 0 1\n"
+             "sphere 1 2 3 0.5 blue\nsphere -1 -2.5 .5 1e-3 red\nsphere +3 0 0 100 blue\n", NULL, &s);
+    assert_int_equal(s.sphere_count, 3);
+    assert_vector_equal(s.spheres[0].center, 1, 2, 3);
+    assert_double_equal(s.spheres[0].radius, 0.5, 0);
+    assert_int_equal(s.spheres[0].material, 1);
+    assert_vector_equal(s.spheres[1].center, -1, -2.5, 0.5);
+    assert_double_equal(s.spheres[1].radius, 1e-3, 1e-10);
+    assert_int_equal(s.spheres[1].material, 0);
+    assert_vector_equal(s.spheres[2].center, 3, 0, 0);
+    scene_free(&s);
+}
+
+static void test_comments_spacing_and_line_endings(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material m lambertian 1 1 1 # a comment\n"
+             "\t sphere\t0 0 0   1 m#comment right after a token\n"
+             "render spp 2\r\n"
+             "camera fov 30\r\n"
+             "   # indented comment\n"
+             "render depth 3", NULL, &s);
+    assert_int_equal(s.sphere_count, 1);
+    assert_int_equal(s.render.samples_per_pixel, 2);
+    assert_double_equal(s.camera.vertical_fov_degrees, 30, 0);
+    assert_int_equal(s.render.max_depth, 3);
+    scene_free(&s);
+
+    /* A UTF-8 byte order mark is skipped; UTF-8 text in comments is fine. */
+    parse_ok("\xEF\xBB\xBF" "camera fov 20 # café ✓ 日本\n", NULL, &s);
+    assert_double_equal(s.camera.vertical_fov_degrees, 20, 0);
+    scene_free(&s);
+}
+
+/* ------------------------------------------------------------------ numbers and variables */
+
+static void test_number_forms(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("set y 2\n"
+             "set t 0\n"
+             "material m lambertian 1 1 1\n"
+             "sphere (1 + 2) (-$y) ( 4*cos($t) ) $y m\n"
+             "sphere -2.5 .5 1e-3 +3 m\n"
+             "sphere (2*pi) (sqrt(16) - max(1, 2)) (-2^2) (1/4) m\n", NULL, &s);
+    assert_vector_equal(s.spheres[0].center, 3, -2, 4);
+    assert_double_equal(s.spheres[0].radius, 2, 0);
+    assert_vector_equal(s.spheres[1].center, -2.5, 0.5, 1e-3);
+    assert_double_equal(s.spheres[1].radius, 3, 0);
+    assert_vector_equal(s.spheres[2].center, 2 * 3.14159265358979, 2, -4);
+    assert_double_equal(s.spheres[2].radius, 0.25, 0);
+    scene_free(&s);
+}
+
+static void test_set_and_variables(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("set a 2\n"
+             "set b $a * 3        # the rest of the line is one expression\n"
+             "set angle 2*pi*0.25\n"
+             "set a 5             # setting again is allowed: later wins\n"
+             "set a $a + 1\n"
+             "set _Long_name9 (1)\n"
+             "camera fov ($b * 10) aperture $_Long_name9\n"
+             "render spp $a\n"
+             "camera focus (sin($angle))\n", NULL, &s);
+    assert_double_equal(s.camera.vertical_fov_degrees, 60, 0);
+    assert_double_equal(s.camera.aperture, 1, 0);
+    assert_int_equal(s.render.samples_per_pixel, 6);
+    assert_double_equal(s.camera.focus_distance, 1, 1e-7);
+    scene_free(&s);
+}
+
+static void test_variable_must_be_set_before_use(void **state)
+{
+    (void)state;
+    assert_parse_error("material m lambertian 1 1 1\nsphere 0 0 0 $r m\nset r 1\n", "s.txt:2:14: ",
+                       "undefined variable $r");
+    assert_parse_error("set angle 2*pi*$t", "s.txt:1:16: ", "undefined variable $t");
+    assert_parse_error("set x $x + 1", "s.txt:1:7: ", "undefined variable $x");
+}
+
+static void test_set_errors(void **state)
+{
+    (void)state;
+    assert_parse_error("set", "s.txt:1:4: ", "expected a variable name after set, found end of line");
+    assert_parse_error("set x", "s.txt:1:6: ", "expected an expression for $x, found end of line");
+    assert_parse_error("set x   # nothing", "s.txt:1:6: ", "expected an expression for $x");
+    assert_parse_error("set 1x 2", "s.txt:1:5: ", "expected a variable name after set");
+    assert_parse_error("set $x 2", "s.txt:1:5: ", "write it without '$'");
+    assert_parse_error("set a-b 2", "s.txt:1:5: ", "found 'a-b'");
+    assert_parse_error("set x 1 +", "s.txt:1:10: ", "expected a number, $variable, function or '('");
+    assert_parse_error("set x (1 + 2", "s.txt:1:7: ", "unbalanced parentheses");
+    assert_parse_error("set x 2 3", "s.txt:1:9: ", "unexpected character '3'");
+}
+
+/* ------------------------------------------------------------------ expression errors in scenes */
+
+static void test_expression_errors_have_scene_positions(void **state)
+{
+    (void)state;
+    assert_parse_error("camera fov (1/0)", "s.txt:1:14: ", "division by zero");
+    assert_parse_error("camera fov (foo(1))", "s.txt:1:13: ", "unknown function 'foo'");
+    assert_parse_error("camera fov (min(1))", "s.txt:1:13: ", "min takes 2 arguments, found 1");
+    assert_parse_error("camera fov (1 + 2", "s.txt:1:12: ", "unbalanced parentheses: this '(' is never closed");
+    assert_parse_error("camera fov (1 + 2  # comment", "s.txt:1:12: ", "never closed");
+    assert_parse_error("camera fov (10))", "s.txt:1:16: ", "unbalanced parentheses: ')' has no matching '('");
+    assert_parse_error("camera fov (1 @ 2)", "s.txt:1:15: ", "unexpected character '@'");
+    assert_parse_error("camera fov ()", "s.txt:1:12: ", "empty expression");
+    assert_parse_error("camera fov ($nope)", "s.txt:1:13: ", "undefined variable $nope");
+    assert_parse_error("camera fov $nope", "s.txt:1:12: ", "undefined variable $nope");
+    assert_parse_error("camera fov (sqrt(-4))", "s.txt:1:13: ", "sqrt of a negative number (-4)");
+    assert_parse_error("camera aperture (1e308*10)", "s.txt:1:23: ", "the result of '*' is infinite");
+    assert_parse_error("camera fov (0^-1)", "s.txt:1:14: ", "the result of '^' is infinite");
+    assert_parse_error("camera fov (1e999)", "s.txt:1:13: ", "out of range");
+    assert_parse_error("camera fov (nan)", "s.txt:1:13: ", "unknown name 'nan'");
+    assert_parse_error("camera fov (1 { 2)", "s.txt:1:15: ", "unexpected character '{'");
+}
+
+static void test_bad_number_tokens(void **state)
+{
+    (void)state;
+    assert_parse_error("material m lambertian 1 1 1\nsphere 0 0 0 abc m", "s.txt:2:14: ",
+                       "expected a number for the sphere's radius, found 'abc'");
+    assert_parse_error("sphere 1.2.3 0 0 1 m", "s.txt:1:8: ", "expected a number for the sphere's center x, found '1.2.3'");
+    assert_parse_error("camera fov 2*3", "s.txt:1:12: ", "write an expression in parentheses");
+    assert_parse_error("camera fov 2+", "s.txt:1:12: ", "found '2+'");
+    assert_parse_error("camera fov \"30\"", "s.txt:1:12: ", "expected a number for the camera's fov, found the string \"30\"");
+    assert_parse_error("camera fov $1x", "s.txt:1:12: ", "found '$1x'");
+    assert_parse_error("camera fov $a+1", "s.txt:1:12: ", "found '$a+1'");
+    assert_parse_error("camera fov (1+2)*3", "s.txt:1:12: ", "entirely inside one pair of parentheses");
+    assert_parse_error("camera fov 1e", "s.txt:1:12: ", "found '1e'");
+    assert_parse_error("camera fov 0x10", "s.txt:1:12: ", "found '0x10'");
+    assert_parse_error("camera fov sin(1)", "s.txt:1:12: ", "found 'sin(1)'");
+    assert_parse_error("camera fov -", "s.txt:1:12: ", "found '-'");
+}
+
+static void test_non_finite_numbers(void **state)
+{
+    (void)state;
+    assert_parse_error("camera fov nan", "s.txt:1:12: ", "found 'nan' (NaN and infinity are not allowed)");
+    assert_parse_error("camera fov -inf", "s.txt:1:12: ", "NaN and infinity are not allowed");
+    assert_parse_error("camera fov Infinity", "s.txt:1:12: ", "NaN and infinity are not allowed");
+    assert_parse_error("camera fov NAN", "s.txt:1:12: ", "NaN and infinity are not allowed");
+    assert_parse_error("camera fov 1e999", "s.txt:1:12: ",
+                       "expected a finite number for the camera's fov, found '1e999' (out of range)");
+    assert_parse_error("camera fov -1e999", "s.txt:1:12: ", "out of range");
+    /* Finite as a double but not as the renderer's float. */
+    assert_parse_error("material m lambertian 1 1 1\nsphere 0 0 0 1e300 m", "s.txt:2:14: ",
+                       "too large for the renderer's 32-bit floats");
+    assert_parse_error("material m emissive 1 1 1 strength 1e38\nmaterial n emissive 10 1 1 strength 1e38",
+                       "s.txt:2:37: ", "too large");
+}
+
+static void test_value_ranges(void **state)
+{
+    (void)state;
+    const char *m = "material m lambertian 1 1 1\n";
+    char text[256];
+    snprintf(text, sizeof text, "%ssphere 0 0 0 0 m", m);
+    assert_parse_error(text, "s.txt:2:14: ", "the sphere's radius must be > 0, found 0");
+    snprintf(text, sizeof text, "%ssphere 0 0 0 -1 m", m);
+    assert_parse_error(text, "s.txt:2:14: ", "the sphere's radius must be > 0, found -1");
+
+    assert_parse_error("camera fov 0", "s.txt:1:12: ", "the camera's fov must be between 0 and 180");
+    assert_parse_error("camera fov 180", "s.txt:1:12: ", "found 180");
+    assert_parse_error("camera fov -5", "s.txt:1:12: ", "between 0 and 180");
+    assert_parse_error("camera aperture -0.1", "s.txt:1:17: ", "the camera's aperture must be >= 0, found -0.1$");
+    assert_parse_error("camera focus -1", "s.txt:1:14: ", "the camera's focus distance must be >= 0");
+
+    assert_parse_error("material m lambertian 0.5 -0.1 0.5", "s.txt:1:27: ",
+                       "the green component of material 'm' must be >= 0, found -0.1$");
+    assert_parse_error("sky constant 1 1 -1", "s.txt:1:18: ", "the blue component of the sky colour must be >= 0");
+    assert_parse_error("sky gradient 1 1 1 -2 1 1", "s.txt:1:20: ", "the red component of the sky's top colour");
+    assert_parse_error("material m metal 1 1 1 fuzz 1.5", "s.txt:1:29: ",
+                       "the fuzz of material 'm' must be between 0 and 1, found 1.5$");
+    assert_parse_error("material m metal 1 1 1 fuzz -0.1", "s.txt:1:29: ", "between 0 and 1");
+    assert_parse_error("material g dielectric 0", "s.txt:1:23: ",
+                       "the index of refraction of material 'g' must be > 0, found 0");
+    assert_parse_error("material g dielectric -1.5", "s.txt:1:23: ", "must be > 0");
+    assert_parse_error("material l emissive 1 1 1 strength -1", "s.txt:1:36: ",
+                       "the strength of material 'l' must be >= 0, found -1");
+    assert_parse_error("material l emissive 1 -1 1", "s.txt:1:23: ", "the green component of material 'l'");
+    /* Positive in double but zero as a float is no better than zero. */
+    snprintf(text, sizeof text, "%ssphere 0 0 0 1e-50 m", m);
+    assert_parse_error(text, "s.txt:2:14: ", "the sphere's radius 1e-50 is too small");
+    assert_parse_error("material g dielectric 1e-60", "s.txt:1:23: ", "too small");
+}
+
+static void test_integer_ranges(void **state)
+{
+    (void)state;
+    assert_parse_error("render size 0 10", "s.txt:1:13: ",
+                       "the render width must be a whole number from 1 to 16384, found 0");
+    assert_parse_error("render size 10 16385", "s.txt:1:16: ", "the render height must be a whole number from 1 to 16384");
+    assert_parse_error("render size 10.5 10", "s.txt:1:13: ", "found 10.5");
+    assert_parse_error("render spp 0", "s.txt:1:12: ", "from 1 to 1073741824, found 0");
+    assert_parse_error("render spp 1073741825", "s.txt:1:12: ", "from 1 to 1073741824");
+    assert_parse_error("render depth 100001", "s.txt:1:14: ", "the render depth must be a whole number from 1 to 100000");
+    assert_parse_error("render seed -1", "s.txt:1:13: ", "the render seed must be a whole number from 0 to 4294967295");
+    assert_parse_error("render seed 4294967296", "s.txt:1:13: ", "found 4294967296");
+    assert_parse_error("render depth (1/3)", "s.txt:1:14: ", "found 0.333333333333333$");
+}
+
+/* ------------------------------------------------------------------ statement errors */
+
+static void test_unknown_statement(void **state)
+{
+    (void)state;
+    assert_parse_error("spere 0 0 0 1 m", "s.txt:1:1: ",
+                       "unknown statement 'spere' (expected include, set, camera, render, sky, material or sphere)");
+    assert_parse_error("\n\n   Camera fov 30", "s.txt:3:4: ", "unknown statement 'Camera'");
+    assert_parse_error("\"camera\"", "s.txt:1:1: ", "unknown statement the string \"camera\"");
+    assert_parse_error("42", "s.txt:1:1: ", "unknown statement '42'");
+}
+
+static void test_unknown_clause(void **state)
+{
+    (void)state;
+    assert_parse_error("camera from 0 0 1 zoom 2", "s.txt:1:19: ",
+                       "unknown camera clause 'zoom' (expected from, at, up, fov, aperture or focus)");
+    assert_parse_error("render size 10 10 quality 3", "s.txt:1:19: ",
+                       "unknown render clause 'quality' (expected size, spp, depth or seed)");
+    assert_parse_error("camera from 0 0 1 2", "s.txt:1:19: ", "unknown camera clause '2'");
+    assert_parse_error("material m metal 1 1 1 shine 2", "s.txt:1:24: ", "unknown metal material clause 'shine' (expected fuzz)");
+    assert_parse_error("material m emissive 1 1 1 fuzz 2", "s.txt:1:27: ",
+                       "unknown emissive material clause 'fuzz' (expected strength)");
+    assert_parse_error("sky rainbow 1 1 1", "s.txt:1:5: ", "expected a sky type (gradient or constant), found 'rainbow'");
+    assert_parse_error("material m plastic 1 1 1", "s.txt:1:12: ",
+                       "expected a material type (lambertian, metal, dielectric or emissive), found 'plastic'");
+}
+
+static void test_repeated_clause(void **state)
+{
+    (void)state;
+    assert_parse_error("camera fov 30 fov 40", "s.txt:1:15: ", "camera clause 'fov' given twice in one statement (first at column 8)");
+    assert_parse_error("render seed 1 size 2 2 seed 3", "s.txt:1:24: ", "render clause 'seed' given twice");
+    assert_parse_error("material m metal 1 1 1 fuzz 0.1 fuzz 0.2", "s.txt:1:33: ", "clause 'fuzz' given twice");
+    assert_parse_error("material m emissive 1 1 1 strength 1 strength 2", "s.txt:1:38: ", "clause 'strength' given twice");
+}
+
+static void test_missing_arguments(void **state)
+{
+    (void)state;
+    assert_parse_error("material m lambertian 1 1 1\nsphere 0 0 0", "s.txt:2:13: ",
+                       "expected a number for the sphere's radius, found end of line");
+    assert_parse_error("sphere 0 0 0   # radius forgotten", "s.txt:1:13: ", "the sphere's radius, found end of line");
+    assert_parse_error("sphere 1 2 3 1", "s.txt:1:15: ", "expected a material name for the sphere, found end of line");
+    assert_parse_error("sphere", "s.txt:1:7: ", "expected a number for the sphere's center x, found end of line");
+    assert_parse_error("camera from 1 2", "s.txt:1:16: ", "expected a number for the camera's from z, found end of line");
+    assert_parse_error("camera up 1 0", "s.txt:1:14: ", "the camera's up z");
+    assert_parse_error("camera at", "s.txt:1:10: ", "the camera's at x");
+    assert_parse_error("camera fov", "s.txt:1:11: ", "expected a number for the camera's fov, found end of line");
+    assert_parse_error("camera aperture", "s.txt:1:16: ", "the camera's aperture, found end of line");
+    assert_parse_error("camera focus", "s.txt:1:13: ", "the camera's focus distance, found end of line");
+    assert_parse_error("render size 10", "s.txt:1:15: ", "expected a number for the render height, found end of line");
+    assert_parse_error("render spp", "s.txt:1:11: ", "the samples per pixel (spp), found end of line");
+    assert_parse_error("render depth", "s.txt:1:13: ", "the render depth, found end of line");
+    assert_parse_error("render seed", "s.txt:1:12: ", "the render seed, found end of line");
+    assert_parse_error("sky gradient 1 1 1 0 0", "s.txt:1:23: ",
+                       "expected a number for the blue component of the sky's top colour, found end of line");
+    assert_parse_error("sky constant 1", "s.txt:1:15: ", "the green component of the sky colour");
+    assert_parse_error("sky", "s.txt:1:4: ", "expected a sky type (gradient or constant), found end of line");
+    assert_parse_error("material", "s.txt:1:9: ", "expected a material name after material, found end of line");
+    assert_parse_error("material m", "s.txt:1:11: ", "expected a material type");
+    assert_parse_error("material m lambertian 1 1", "s.txt:1:26: ", "the blue component of material 'm', found end of line");
+    assert_parse_error("material m metal 1 1 1 fuzz", "s.txt:1:28: ", "the fuzz of the metal material, found end of line");
+    assert_parse_error("material m dielectric", "s.txt:1:22: ",
+                       "expected a number for the index of refraction of material 'm', found end of line");
+    assert_parse_error("material l emissive 1 1 1 strength", "s.txt:1:35: ", "the strength of the emissive material");
+    assert_parse_error("include", "s.txt:1:8: ", "expected a quoted path after include");
+}
+
+static void test_extra_tokens(void **state)
+{
+    (void)state;
+    assert_parse_error("material m lambertian 1 1 1\nsphere 0 0 0 1 m extra", "s.txt:2:18: ",
+                       "unexpected 'extra' after the sphere (expected end of line)");
+    assert_parse_error("sky constant 1 1 1 2", "s.txt:1:20: ", "unexpected '2' after the sky");
+    assert_parse_error("sky gradient 1 1 1 0 0 0 \"x\"", "s.txt:1:26: ", "unexpected the string \"x\" after the sky");
+    assert_parse_error("material g dielectric 1.5 2", "s.txt:1:27: ", "unexpected '2' after a dielectric material");
+    assert_parse_error("material g lambertian 1 1 1 fuzz 0.5", "s.txt:1:29: ",
+                       "unexpected 'fuzz' after a lambertian material");
+    assert_parse_error("include \"a.txt\" more", "s.txt:1:17: ", "unexpected 'more' after the included path");
+}
+
+static void test_material_names(void **state)
+{
+    (void)state;
+    assert_parse_error("material m lambertian 1 1 1\n\nmaterial m metal 1 1 1", "s.txt:3:10: ",
+                       "material 'm' is already defined at s.txt:1:10");
+    assert_parse_error("material red lambertian 1 0 0\nsphere 0 0 0 1 blue", "s.txt:2:16: ",
+                       "the sphere's material 'blue' is not defined");
+    assert_parse_error("sphere 0 0 0 1 later\nmaterial later lambertian 1 1 1", "s.txt:1:16: ",
+                       "must be defined before the spheres that use it");
+    assert_parse_error("material $m lambertian 1 1 1", "s.txt:1:10: ", "expected a material name");
+    assert_parse_error("material \"m\" lambertian 1 1 1", "s.txt:1:10: ", "expected a material name");
+    assert_parse_error("sphere 0 0 0 1 \"m\"", "s.txt:1:16: ", "expected a material name for the sphere");
+
+    /* SCENE_NAME_MAX - 1 bytes is the longest name. */
+    char name[SCENE_NAME_MAX + 1];
+    memset(name, 'n', SCENE_NAME_MAX - 1);
+    name[SCENE_NAME_MAX - 1] = '\0';
+    char text[512];
+    snprintf(text, sizeof text, "material %s lambertian 1 1 1\nsphere 0 0 0 1 %s", name, name);
+    scene s;
+    parse_ok(text, NULL, &s);
+    assert_string_equal(s.materials[0].name, name);
+    assert_int_equal(s.spheres[0].material, 0);
+    scene_free(&s);
+
+    memset(name, 'n', SCENE_NAME_MAX);
+    name[SCENE_NAME_MAX] = '\0';
+    snprintf(text, sizeof text, "material %s lambertian 1 1 1", name);
+    assert_parse_error(text, "s.txt:1:10: ", "is 64 bytes long; the limit is 63");
+    snprintf(text, sizeof text, "sphere 0 0 0 1 %s", name);
+    assert_parse_error(text, "s.txt:1:16: ", "is not defined");
+}
+
+static void test_camera_frame_is_checked_after_the_file(void **state)
+{
+    (void)state;
+    assert_parse_error("camera from 1 2 3\ncamera fov 30 at 1 2 3", "s.txt:2:1: ",
+                       "the camera's from and at are the same point (1 2 3)");
+    assert_parse_error("camera from 0 0 0 at 0 -5 0\nrender spp 1\n  camera fov 20", "s.txt:3:3: ",
+                       "the camera's up (0 1 0) is parallel to its view direction (0 -5 0)");
+    assert_parse_error("camera up 0 0 0", "s.txt:1:1: ", "the camera's up (0 0 0) is parallel");
+
+    /* A frame that is only bad between two statements is fine: the final one counts. */
+    scene s;
+    parse_ok("camera from 0 0 0 at 0 -5 0\ncamera up 1 0 0\n", NULL, &s);
+    assert_vector_equal(s.camera.up, 1, 0, 0);
+    scene_free(&s);
+    parse_ok("camera at 0 0 1\ncamera from 0 0 5", NULL, &s);
+    assert_vector_equal(s.camera.look_at, 0, 0, 1);
+    scene_free(&s);
+}
+
+static void test_lexical_errors(void **state)
+{
+    (void)state;
+    assert_parse_error("include \"abc", "s.txt:1:9: ", "unterminated string");
+    assert_parse_error("camera {", "s.txt:1:8: ", "unexpected '{'");
+    assert_parse_error("camera fov 30\n}", "s.txt:2:1: ", "unexpected '}'");
+    assert_parse_error("sphere{", "s.txt:1:7: ", "unexpected '{'");
+}
+
+static void test_binary_bytes(void **state)
+{
+    (void)state;
+    assert_parse_error("camera fov 30\nsky \x01", "s.txt:2:5: ", "unexpected byte 0x01");
+    assert_parse_error("camera\x7f", "s.txt:1:7: ", "unexpected byte 0x7F");
+    assert_parse_error("# comment \xff\n", "s.txt:1:11: ", "unexpected byte 0xFF (not valid UTF-8");
+    assert_parse_error("camera \xC0\xAF", "s.txt:1:8: ", "unexpected byte 0xC0");     /* overlong */
+    assert_parse_error("# \xED\xA0\x80", "s.txt:1:3: ", "unexpected byte 0xED");         /* surrogate */
+    assert_parse_error("# \xF4\x90\x80\x80", "s.txt:1:3: ", "unexpected byte 0xF4");     /* > U+10FFFF */
+    assert_parse_error("#\n# \xE2\x82", "s.txt:2:3: ", "unexpected byte 0xE2");          /* truncated */
+    assert_parse_error("# \x80", "s.txt:1:3: ", "unexpected byte 0x80");                 /* lone continuation */
+    /* A bad byte on a later line does not hide an earlier error. */
+    assert_parse_error("camera fov 0\n\x01", "s.txt:1:12: ", "fov");
+}
+
+static void test_very_long_lines(void **state)
+{
+    (void)state;
+    size_t spaces = 1000000;
+    const char *head = "material m lambertian 1 1 1\nsphere";
+    const char *tail = "0 0 0 2 m\ncamera fov";
+    size_t length = strlen(head) + spaces + strlen(tail) + spaces + 16;
+    char *text = malloc(length);
+    assert_non_null(text);
+    char *end = text;
+    end += sprintf(end, "%s", head);
+    memset(end, ' ', spaces);
+    end += spaces;
+    end += sprintf(end, "%s", tail);
+    memset(end, '\t', spaces);
+    end += spaces;
+    sprintf(end, "abc");
+
+    /* The error is on line 3 at column 11 + spaces (after "camera fov" and the tabs). */
+    char prefix[64];
+    snprintf(prefix, sizeof prefix, "s.txt:3:%zu: ", strlen("camera fov") + spaces + 1);
+    assert_parse_error(text, prefix, "found 'abc'");
+
+    sprintf(end, "45");
+    scene s;
+    parse_ok(text, NULL, &s);
+    assert_int_equal(s.sphere_count, 1);
+    assert_double_equal(s.spheres[0].radius, 2, 0);
+    assert_double_equal(s.camera.vertical_fov_degrees, 45, 0);
+    scene_free(&s);
+    free(text);
+
+    /* A long quoted token is cut in the message, which stays well inside the buffer. */
+    char long_token[3000];
+    memset(long_token, 'x', sizeof long_token - 1);
+    long_token[sizeof long_token - 1] = '\0';
+    char long_text[3100];
+    snprintf(long_text, sizeof long_text, "camera fov %s", long_token);
+    assert_parse_error(long_text, "s.txt:1:12: ", "found 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...'");
+    /* ... and never in the middle of a UTF-8 character (é is 2 bytes at bytes 40 and 41). */
+    snprintf(long_text, sizeof long_text, "camera fov %.39s\xC3\xA9yyyy", long_token);
+    assert_parse_error(long_text, "s.txt:1:12: ", "found 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...'");
+}
+
+static void test_many_spheres(void **state)
+{
+    (void)state;
+    int count = 20000;
+    size_t size = (size_t)count * 40 + 64;
+    char *text = malloc(size);
+    assert_non_null(text);
+    size_t used = (size_t)snprintf(text, size, "material m lambertian 1 1 1\n");
+    for (int i = 0; i < count; i++)
+        used += (size_t)snprintf(text + used, size - used, "sphere %d 0 0 0.5 m\n", i);
+    scene s;
+    parse_ok(text, NULL, &s);
+    assert_int_equal(s.sphere_count, count);
+    assert_double_equal(s.spheres[count - 1].center[0], count - 1, 0);
+    scene_free(&s);
+    free(text);
+}
+
+/* ------------------------------------------------------------------ -D defines */
+
+static void test_define_overrides_set(void **state)
+{
+    (void)state;
+    scene_define defines[] = {{"t", "0.5"}, {"w", "2*pi"}};
+    scene_parse_options options = options_with_defines(defines, 2);
+    scene s;
+    /* The file's set of t is skipped (its expression is not even evaluated). */
+    parse_ok("set t 0.25\nset t )))\nset w 1\nset other $t * 2\n"
+             "material m lambertian 1 1 1\nsphere 0 0 0 $t m\nsphere $w $other 0 1 m\n", &options, &s);
+    assert_double_equal(s.spheres[0].radius, 0.5, 0);
+    assert_double_equal(s.spheres[1].center[0], 2 * 3.14159265358979, 1e-5);
+    assert_double_equal(s.spheres[1].center[1], 1, 0);
+    scene_free(&s);
+
+    /* Without the define the file's value is used. */
+    parse_ok("set t 0.25\nmaterial m lambertian 1 1 1\nsphere 0 0 0 $t m\n", NULL, &s);
+    assert_double_equal(s.spheres[0].radius, 0.25, 0);
+    scene_free(&s);
+}
+
+static void test_define_used_without_set(void **state)
+{
+    (void)state;
+    scene_define defines[] = {{"r", "3"}, {"r", "4"}};   /* the later of two defines wins */
+    scene_parse_options options = options_with_defines(defines, 2);
+    scene s;
+    parse_ok("material m lambertian 1 1 1\nsphere 0 0 0 $r m", &options, &s);
+    assert_double_equal(s.spheres[0].radius, 4, 0);
+    scene_free(&s);
+}
+
+static void test_define_unused_is_an_error(void **state)
+{
+    (void)state;
+    scene_define defines[] = {{"t", "1"}, {"foo", "2"}};
+    scene_parse_options options = options_with_defines(defines, 2);
+    scene s;
+    rt_error error = {{0}};
+    assert_int_equal(scene_load_string("set t 0\n", "s.txt", &options, &s, &error), RT_ERROR_INPUT);
+    assert_string_equal(error.message, "-D foo: the scene never sets or uses $foo");
+    assert_true(scene_is_default(&s));
+
+    /* Setting it counts as a mention even if nothing uses it afterwards. */
+    scene_define set_only[] = {{"foo", "2"}};
+    options = options_with_defines(set_only, 1);
+    parse_ok("set foo 1\n", &options, &s);
+    scene_free(&s);
+
+    /* A define named only in the skipped `set` of another define is still used. */
+    scene_define chained[] = {{"a", "1"}, {"b", "2"}, {"bc", "3"}};
+    options = options_with_defines(chained, 3);
+    parse_ok("set a $b + $bc*2\nmaterial m lambertian 1 1 1\nsphere 0 0 0 $a m\n", &options, &s);
+    assert_double_equal(s.spheres[0].radius, 1, 0);
+    scene_free(&s);
+    options = options_with_defines(chained, 3);
+    assert_parse_error_with("set a $b\n", &options, "-D bc: ", "the scene never sets or uses $bc");
+}
+
+static void test_define_bad_value(void **state)
+{
+    (void)state;
+    scene_define bad_value[] = {{"t", "abc"}};
+    scene_parse_options options = options_with_defines(bad_value, 1);
+    assert_parse_error_with("set t 1", &options, "-D t=abc: column 3: ", "unknown name 'abc'");
+
+    scene_define bad_expression[] = {{"t", "1/0"}};
+    options = options_with_defines(bad_expression, 1);
+    assert_parse_error_with("set t 1", &options, "-D t=1/0: column 4: ", "division by zero");
+
+    scene_define empty[] = {{"t", ""}};
+    options = options_with_defines(empty, 1);
+    assert_parse_error_with("set t 1", &options, "-D t=: ", "empty expression");
+
+    scene_define uses_variable[] = {{"t", "$u"}};
+    options = options_with_defines(uses_variable, 1);
+    assert_parse_error_with("set t 1", &options, "-D t=$u: column 3: ", "variables cannot be used here");
+
+    scene_define bad_name[] = {{"1x", "2"}};
+    options = options_with_defines(bad_name, 1);
+    assert_parse_error_with("set t 1", &options, "-D 1x=2: ", "'1x' is not a valid variable name");
+
+    scene_define missing_value[] = {{"t", NULL}};
+    options = options_with_defines(missing_value, 1);
+    assert_parse_error_with("set t 1", &options, "-D t: ", "missing value");
+}
+
+/* ------------------------------------------------------------------ files and includes */
+
+static void test_load_file(void **state)
+{
+    write_text(state, "scene.txt", "render spp 3\nmaterial m metal 1 1 1 fuzz 0.5\nsphere 0 0 0 1 m\n");
+    scene s;
+    load_file_ok(state, "scene.txt", NULL, &s);
+    assert_int_equal(s.render.samples_per_pixel, 3);
+    assert_int_equal(s.sphere_count, 1);
+    scene_free(&s);
+
+    write_text(state, "empty.txt", "");
+    load_file_ok(state, "empty.txt", NULL, &s);
+    assert_true(scene_is_default(&s));
+    scene_free(&s);
+
+    write_text(state, "bad.txt", "render spp 3\n\nsphere 0 0 0 1 m\n");
+    assert_file_error(state, "bad.txt", NULL, "%s/bad.txt:3:16: ", "the sphere's material 'm' is not defined");
+}
+
+static void test_unreadable_top_file(void **state)
+{
+    const char *directory = ((temporary_directory *)*state)->path;
+    char path[256], expected[512];
+    scene s;
+    rt_error error = {{0}};
+
+    path_in(state, "missing.txt", path, sizeof path);
+    assert_int_equal(scene_load_file(path, NULL, &s, &error), RT_ERROR_INPUT);
+    snprintf(expected, sizeof expected, "SCENE: cannot read '%s/missing.txt': No such file or directory", directory);
+    assert_string_equal(error.message, expected);
+    assert_true(scene_is_default(&s));
+
+    assert_int_equal(scene_load_file(directory, NULL, &s, &error), RT_ERROR_INPUT);
+    snprintf(expected, sizeof expected, "SCENE: cannot read '%s': Is a directory", directory);
+    assert_string_equal(error.message, expected);
+    assert_true(scene_is_default(&s));
+}
+
+static void test_binary_file(void **state)
+{
+    write_bytes(state, "nul.txt", "camera fov 30\ncamera\0fov", 24);
+    assert_file_error(state, "nul.txt", NULL, "%s/nul.txt:2:7: ", "unexpected byte 0x00");
+
+    static const char png_header[] = "\x89PNG\r\n\x1a\n\0\0\0\rIHDR";
+    write_bytes(state, "image.png", png_header, sizeof png_header - 1);
+    assert_file_error(state, "image.png", NULL, "%s/image.png:1:1: ", "unexpected byte 0x89");
+}
+
+static void test_include_relative_to_including_file(void **state)
+{
+    write_text(state, "top.txt", "set size 3\ninclude \"sub/materials.txt\"\nsphere 0 0 0 $radius ground\n");
+    write_text(state, "sub/materials.txt", "material ground lambertian 0.5 0.5 0.5\ninclude \"more.txt\"\n");
+    /* more.txt is found next to materials.txt (sub/), not next to top.txt */
+    write_text(state, "sub/more.txt", "set radius $size * 2   # variables are global across includes\n");
+    write_text(state, "more.txt", "this file must not be read\n");
+    scene s;
+    load_file_ok(state, "top.txt", NULL, &s);
+    assert_int_equal(s.material_count, 1);
+    assert_int_equal(s.sphere_count, 1);
+    assert_double_equal(s.spheres[0].radius, 6, 0);
+    scene_free(&s);
+
+    /* An error in an include is reported at its resolved path. */
+    write_text(state, "sub/broken.txt", "\n  sphere 0 0 0 -1 m\n");
+    write_text(state, "top2.txt", "material m lambertian 1 1 1\ninclude \"sub/broken.txt\"\n");
+    assert_file_error(state, "top2.txt", NULL, "%s/sub/broken.txt:2:16: ", "the sphere's radius must be > 0");
+
+    /* A duplicate material names the file of the first definition. */
+    write_text(state, "dup.txt", "set size 1\ninclude \"sub/materials.txt\"\nmaterial ground metal 1 1 1\n");
+    assert_file_error(state, "dup.txt", NULL, "%s/dup.txt:3:10: ",
+                      "material 'ground' is already defined at %s/sub/materials.txt:1:10");
+}
+
+static void test_include_from_string_and_absolute_path(void **state)
+{
+    const char *directory = ((temporary_directory *)*state)->path;
+    write_text(state, "m.txt", "material m lambertian 1 1 1\n");
+    char source_name[256], text[512];
+    snprintf(source_name, sizeof source_name, "%s/virtual.txt", directory);
+    scene s;
+    check_parse_ok("include \"m.txt\"\nsphere 0 0 0 1 m", source_name, NULL, &s, __FILE__, __LINE__);
+    assert_int_equal(s.sphere_count, 1);
+    scene_free(&s);
+
+    snprintf(text, sizeof text, "include \"%s/m.txt\"\nsphere 0 0 0 1 m", directory);
+    check_parse_ok(text, "elsewhere/x.txt", NULL, &s, __FILE__, __LINE__);
+    assert_int_equal(s.material_count, 1);
+    scene_free(&s);
+}
+
+static void test_include_camera_position(void **state)
+{
+    /* The camera frame error names the last camera statement, wherever it is. */
+    write_text(state, "cam.txt", "# camera\n    camera at 0 0 1\n");
+    write_text(state, "top.txt", "camera from 0 0 1\ninclude \"cam.txt\"\n");
+    assert_file_error(state, "top.txt", NULL, "%s/cam.txt:2:5: ", "the camera's from and at are the same point");
+}
+
+static void test_missing_include(void **state)
+{
+    write_text(state, "top.txt", "render spp 1\n  include \"nope/missing.txt\"\n");
+    assert_file_error(state, "top.txt", NULL, "%s/top.txt:2:3: ",
+                      "cannot read included file '%s/nope/missing.txt': No such file or directory");
+
+    mkdir(path_in(state, "folder", (char[256]){0}, 256), 0700);
+    write_text(state, "dir.txt", "include \"folder\"\n");
+    assert_file_error(state, "dir.txt", NULL, "%s/dir.txt:1:1: ", "cannot read included file '%s/folder': Is a directory");
+
+    write_text(state, "empty-path.txt", "include \"\"\n");
+    assert_file_error(state, "empty-path.txt", NULL, "%s/empty-path.txt:1:9: ", "found an empty string");
+
+    write_text(state, "unquoted.txt", "include other.txt\n");
+    assert_file_error(state, "unquoted.txt", NULL, "%s/unquoted.txt:1:9: ",
+                      "expected a quoted path after include (e.g. include \"common.txt\"), found 'other.txt'");
+}
+
+static void test_include_cycles(void **state)
+{
+    write_text(state, "a.txt", "include \"b.txt\"\n");
+    write_text(state, "b.txt", "# b\ninclude \"a.txt\"\n");
+    assert_file_error(state, "a.txt", NULL, "%s/b.txt:2:1: ", "include cycle: %s/a.txt -> %s/b.txt -> %s/a.txt");
+
+    write_text(state, "self.txt", "render spp 1\ninclude \"self.txt\"\n");
+    assert_file_error(state, "self.txt", NULL, "%s/self.txt:2:1: ", "include cycle: %s/self.txt -> %s/self.txt");
+
+    /* Files are compared by identity, not by spelling. */
+    write_text(state, "dot.txt", "include \"./dot.txt\"\n");
+    assert_file_error(state, "dot.txt", NULL, "%s/dot.txt:1:1: ", "include cycle: %s/dot.txt -> %s/./dot.txt");
+
+    /* Including the same file twice, one after the other, is not a cycle. */
+    write_text(state, "settings.txt", "render spp 5\n");
+    write_text(state, "twice.txt", "include \"settings.txt\"\ninclude \"settings.txt\"\n");
+    scene s;
+    load_file_ok(state, "twice.txt", NULL, &s);
+    assert_int_equal(s.render.samples_per_pixel, 5);
+    scene_free(&s);
+}
+
+/* Writes level0.txt .. level<count>.txt, each including the next; the last sets spp. */
+static void write_include_chain(void **state, int count)
+{
+    for (int i = 0; i < count; i++) {
+        char name[32], content[64];
+        snprintf(name, sizeof name, "level%d.txt", i);
+        snprintf(content, sizeof content, "include \"level%d.txt\"\n", i + 1);
+        write_text(state, name, content);
+    }
+    char name[32];
+    snprintf(name, sizeof name, "level%d.txt", count);
+    write_text(state, name, "render spp 9\n");
+}
+
+static void test_include_depth_limit(void **state)
+{
+    /* level0 -> ... -> level16: 16 levels of include, the default limit. */
+    write_include_chain(state, 16);
+    scene s;
+    load_file_ok(state, "level0.txt", NULL, &s);
+    assert_int_equal(s.render.samples_per_pixel, 9);
+    scene_free(&s);
+
+    write_include_chain(state, 17);
+    assert_file_error(state, "level0.txt", NULL, "%s/level16.txt:1:1: ",
+                      "includes nested too deeply: '%s/level17.txt' would be level 17, the limit is 16");
+
+    scene_parse_options options = scene_parse_options_defaults();
+    options.max_include_depth = 2;
+    assert_file_error(state, "level0.txt", &options, "%s/level2.txt:1:1: ", "would be level 3, the limit is 2");
+    options.max_include_depth = 30;
+    load_file_ok(state, "level0.txt", &options, &s);
+    assert_int_equal(s.render.samples_per_pixel, 9);
+    scene_free(&s);
+}
+
+static void test_define_applies_across_includes(void **state)
+{
+    write_text(state, "vars.txt", "set radius 1\n");
+    write_text(state, "top.txt", "include \"vars.txt\"\nmaterial m lambertian 1 1 1\nsphere 0 0 0 $radius m\n");
+    scene_define defines[] = {{"radius", "0.1 * 7"}};
+    scene_parse_options options = options_with_defines(defines, 1);
+    scene s;
+    load_file_ok(state, "top.txt", &options, &s);
+    assert_double_equal(s.spheres[0].radius, 0.7, 1e-7);
+    scene_free(&s);
+}
+
+/* ------------------------------------------------------------------ full example */
+
+static void test_documented_example(void **state)
+{
+    (void)state;
+    /* The complete example of docs/scene-format.md, kept in sync by hand. */
+    const char *text =
+        "# A glass ball, a diffuse ball and a metal ball on a huge ground sphere.\n"
+        "set t 0                                  # animation time, sweep with -D t=...\n"
+        "set angle 2*pi*$t\n"
+        "\n"
+        "render size 640 360 spp 64 depth 16 seed 7\n"
+        "camera from (4*cos($angle)) 1.5 (4*sin($angle)) at 0 0.5 0 up 0 1 0 fov 40\n"
+        "camera aperture 0.05 focus 4\n"
+        "sky gradient 1 1 1  0.5 0.7 1.0\n"
+        "\n"
+        "material ground lambertian 0.5 0.5 0.5\n"
+        "material red lambertian 0.8 0.2 0.1\n"
+        "material glass dielectric 1.5\n"
+        "material gold metal 0.9 0.7 0.3 fuzz 0.1\n"
+        "material lamp emissive 1 0.9 0.8 strength 10\n"
+        "\n"
+        "sphere 0 -1000 0 1000 ground\n"
+        "sphere -1.2 0.5 0 0.5 red\n"
+        "sphere 0 0.5 0 0.5 glass\n"
+        "sphere 1.2 0.5 0 0.5 gold\n"
+        "sphere 0 5 0 1 lamp\n";
+    scene_define defines[] = {{"t", "0.25"}};
+    scene_parse_options options = options_with_defines(defines, 1);
+    scene s;
+    parse_ok(text, &options, &s);
+    assert_int_equal(s.material_count, 5);
+    assert_int_equal(s.sphere_count, 5);
+    assert_vector_equal(s.camera.look_from, 0, 1.5, 4);
+    assert_double_equal(s.camera.aperture, 0.05, 1e-7);
+    assert_vector_equal(s.materials[4].emission, 10, 9, 8);
+    assert_int_equal(s.spheres[4].material, 4);
+    scene_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_empty_text_gives_defaults),
+        cmocka_unit_test(test_camera_clauses),
+        cmocka_unit_test(test_render_clauses),
+        cmocka_unit_test(test_sky),
+        cmocka_unit_test(test_materials),
+        cmocka_unit_test(test_spheres),
+        cmocka_unit_test(test_comments_spacing_and_line_endings),
+        cmocka_unit_test(test_number_forms),
+        cmocka_unit_test(test_set_and_variables),
+        cmocka_unit_test(test_variable_must_be_set_before_use),
+        cmocka_unit_test(test_set_errors),
+        cmocka_unit_test(test_expression_errors_have_scene_positions),
+        cmocka_unit_test(test_bad_number_tokens),
+        cmocka_unit_test(test_non_finite_numbers),
+        cmocka_unit_test(test_value_ranges),
+        cmocka_unit_test(test_integer_ranges),
+        cmocka_unit_test(test_unknown_statement),
+        cmocka_unit_test(test_unknown_clause),
+        cmocka_unit_test(test_repeated_clause),
+        cmocka_unit_test(test_missing_arguments),
+        cmocka_unit_test(test_extra_tokens),
+        cmocka_unit_test(test_material_names),
+        cmocka_unit_test(test_camera_frame_is_checked_after_the_file),
+        cmocka_unit_test(test_lexical_errors),
+        cmocka_unit_test(test_binary_bytes),
+        cmocka_unit_test(test_very_long_lines),
+        cmocka_unit_test(test_many_spheres),
+        cmocka_unit_test(test_define_overrides_set),
+        cmocka_unit_test(test_define_used_without_set),
+        cmocka_unit_test(test_define_unused_is_an_error),
+        cmocka_unit_test(test_define_bad_value),
+        cmocka_unit_test_setup_teardown(test_load_file, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_unreadable_top_file, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_binary_file, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_include_relative_to_including_file, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_include_from_string_and_absolute_path, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_include_camera_position, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_missing_include, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_include_cycles, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_include_depth_limit, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_define_applies_across_includes, create_directory, remove_directory),
+        cmocka_unit_test(test_documented_example),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
