@@ -333,28 +333,17 @@ static GLuint compile_stage(GLenum stage, const char *const *parts, int part_cou
         char log[800];
         glGetShaderInfoLog(shader, sizeof log, NULL, log);
         rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the %s shader does not compile: %s",
-                     stage == GL_VERTEX_SHADER ? "vertex" : "tracer", log);
+                     stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
         glDeleteShader(shader);
         return 0;
     }
     return shader;
 }
 
-/* Builds the tracer program: "#version 450 core" + packed_layout.h + tracer.frag. */
-static rt_status build_program(gpu_tracer *tracer, rt_error *error)
+/* Links a vertex and a fragment shader into a program. Returns the program, or 0 with
+ * the linker's log in error. The shaders are deleted either way. */
+static GLuint link_program(GLuint vertex, GLuint fragment, rt_error *error)
 {
-    const char *version = "#version 450 core\n";
-    const char *vertex_parts[] = {version, shader_source_fullscreen_vertex};
-    const char *fragment_parts[] = {version, shader_source_packed_layout, "#line 1 1\n",
-                                    shader_source_tracer_fragment};
-    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
-    if (vertex == 0)
-        return RT_ERROR_RUNTIME;
-    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 4, error);
-    if (fragment == 0) {
-        glDeleteShader(vertex);
-        return RT_ERROR_RUNTIME;
-    }
     GLuint program = glCreateProgram();
     glAttachShader(program, vertex);
     glAttachShader(program, fragment);
@@ -367,10 +356,29 @@ static rt_status build_program(gpu_tracer *tracer, rt_error *error)
         char log[800];
         glGetProgramInfoLog(program, sizeof log, NULL, log);
         glDeleteProgram(program);
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer does not link: %s", log);
+        rt_error_set(error, RT_ERROR_RUNTIME, "GPU: a shader program does not link: %s", log);
+        return 0;
     }
-    tracer->program = program;
-    return RT_OK;
+    return program;
+}
+
+/* Builds the tracer program: "#version 450 core" + packed_layout.h + random.glsl + tracer.frag. */
+static rt_status build_program(gpu_tracer *tracer, rt_error *error)
+{
+    const char *version = "#version 450 core\n";
+    const char *vertex_parts[] = {version, shader_source_fullscreen_vertex};
+    const char *fragment_parts[] = {version, shader_source_packed_layout, shader_source_random, "#line 1 1\n",
+                                    shader_source_tracer_fragment};
+    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
+    if (vertex == 0)
+        return RT_ERROR_RUNTIME;
+    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 5, error);
+    if (fragment == 0) {
+        glDeleteShader(vertex);
+        return RT_ERROR_RUNTIME;
+    }
+    tracer->program = link_program(vertex, fragment, error);
+    return tracer->program ? RT_OK : RT_ERROR_RUNTIME;
 }
 
 /* Uploads the packed scene into a square-ish RGBA32UI texture whose width is a power of
@@ -604,4 +612,59 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
     glDeleteVertexArrays(1, &tracer->vertex_array);
     glDeleteProgram(tracer->program);
     free(tracer);
+}
+
+rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32_t sample_index, uint32_t seed,
+                             uint32_t dimension, float *rgba, rt_error *error)
+{
+    (void)context;
+    const char *version = "#version 450 core\n";
+    const char *vertex_parts[] = {version, shader_source_fullscreen_vertex};
+    const char *fragment_parts[] = {version, shader_source_random, shader_source_random_test_fragment};
+    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
+    if (vertex == 0)
+        return RT_ERROR_RUNTIME;
+    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 3, error);
+    if (fragment == 0) {
+        glDeleteShader(vertex);
+        return RT_ERROR_RUNTIME;
+    }
+    GLuint program = link_program(vertex, fragment, error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    GLuint texture, framebuffer, vertex_array;
+    glGenTextures(1, &texture);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+    GLenum draw_buffer = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &draw_buffer);
+    glGenVertexArrays(1, &vertex_array);
+    glBindVertexArray(vertex_array);
+    glViewport(0, 0, width, height);
+    glUseProgram(program);
+    glUniform1ui(glGetUniformLocation(program, "sample_index"), sample_index);
+    glUniform1ui(glGetUniformLocation(program, "seed"), seed);
+    glUniform1ui(glGetUniformLocation(program, "dimension"), dimension);
+    glUniform1i(glGetUniformLocation(program, "image_height"), height);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    size_t row_floats = (size_t)width * 4;
+    float *bottom_up = malloc(row_floats * (size_t)height * sizeof(float));
+    if (bottom_up != NULL) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, bottom_up);
+        for (int row = 0; row < height; row++)
+            memcpy(rgba + (size_t)row * row_floats, bottom_up + (size_t)(height - 1 - row) * row_floats,
+                   row_floats * sizeof(float));
+        free(bottom_up);
+    }
+    glDeleteVertexArrays(1, &vertex_array);
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(1, &texture);
+    glDeleteProgram(program);
+    if (bottom_up == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading random numbers");
+    return check_gl("drawing random numbers", error);
 }

@@ -118,4 +118,13 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, gpu_tracer_totals *to
 /* Frees the tracer's GL objects. NULL is ignored. */
 void gpu_tracer_destroy(gpu_tracer *tracer);
 
+/* ---- tests ------------------------------------------------------------------------ */
+
+/* Draws the tracer's random numbers (glsl/random.glsl) for one (sample index, seed,
+ * dimension) on the device: rgba receives width*height*4 floats, rows top to bottom, and
+ * pixel (x, y) gets the four numbers the tracer draws for that pixel. For testing the
+ * generator where it runs. */
+rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32_t sample_index, uint32_t seed,
+                             uint32_t dimension, float *rgba, rt_error *error);
+
 #endif

@@ -13,6 +13,16 @@ shader_source_fullscreen_vertex:
     .incbin "glsl/fullscreen.vert"
     .byte 0
 
+    .global shader_source_random
+shader_source_random:
+    .incbin "glsl/random.glsl"
+    .byte 0
+
+    .global shader_source_random_test_fragment
+shader_source_random_test_fragment:
+    .incbin "glsl/random_test.frag"
+    .byte 0
+
     .global shader_source_tracer_fragment
 shader_source_tracer_fragment:
     .incbin "glsl/tracer.frag"

@@ -1,7 +1,7 @@
 // tracer.frag: the path tracer. One invocation per pixel per pass.
 //
-// Compiled as "#version 450 core" + core/packed_layout.h + this file, so every record
-// offset and type tag below comes from the one shared layout definition.
+// Compiled as "#version 450 core" + core/packed_layout.h + glsl/random.glsl + this file,
+// so every record offset and type tag below comes from the one shared layout definition.
 //
 // Why passes: llvmpipe silently ends all loops of one invocation after 65,535 iterations
 // in total, and GPU drivers kill long draws. So a pixel does at most pass_work_budget
@@ -70,19 +70,7 @@ uvec4 packed_texel(uint index)
 
 vec3 packed_xyz(uvec4 texel) { return uintBitsToFloat(texel.xyz); }
 
-// ---- random numbers --------------------------------------------------------------
-
-// A 4-in/4-out integer hash in the style of the pcg4d of Jarzynski and Olano
-// ("Hash Functions for GPU Rendering", JCGT 2020): good quality, no state.
-uvec4 hash4(uvec4 v)
-{
-    v = v * 1664525u + 1013904223u;
-    v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
-    v ^= v >> 16u;
-    v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
-    v ^= v >> 16u;
-    return v;
-}
+// ---- random numbers (glsl/random.glsl, prepended) ----------------------------------
 
 uvec2 rng_pixel;     // pixel in image coordinates (row 0 at the top)
 uint rng_sample;     // absolute sample index
@@ -91,8 +79,7 @@ uint rng_seed_hash;
 // Four uniform numbers in [0, 1) for one (bounce, stream) of the current sample.
 vec4 random4(uint bounce, uint stream)
 {
-    uvec4 h = hash4(uvec4(rng_pixel.x, rng_pixel.y, rng_sample, rng_seed_hash ^ (bounce * 8u + stream)));
-    return vec4(h >> 8u) * (1.0 / 16777216.0);
+    return random_numbers(rng_pixel, rng_sample, rng_seed_hash, bounce * 8u + stream);
 }
 
 // ---- geometry --------------------------------------------------------------------
@@ -300,7 +287,7 @@ void main()
     node_count = header_high.w;
 
     rng_pixel = uvec2(uint(frag_pixel.x), uint(image_size.y - 1 - frag_pixel.y));
-    rng_seed_hash = hash4(uvec4(seed, 0x9e3779b9u, 0x85ebca6bu, 0xc2b2ae35u)).x;
+    rng_seed_hash = random_seed_hash(seed);
     rng_sample = sample_start + samples_started - 1u;
 
     int work = 0;
