@@ -35,6 +35,11 @@ typedef struct rt_image {
     int width, height, channels;
     float *pixels;               /* owned; free with image_free() */
     char channel_names[IMAGE_MAX_CHANNELS][IMAGE_CHANNEL_NAME_MAX];  /* "" = default name */
+    /* Where these pixels sit in a larger image (a crop or tile): top-left pixel x, y (row 0
+     * at the top) and the full image's size. full_width 0 means "this is the full image".
+     * EXR keeps them as the data and display windows; reading fills them from the file. */
+    int x, y;
+    int full_width, full_height;
 } rt_image;
 
 typedef enum image_attribute_type {

@@ -16,6 +16,10 @@
 
 #include <stdarg.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum rt_status {
     RT_OK = 0,
     RT_ERROR_INPUT,
@@ -39,5 +43,9 @@ rt_status rt_error_set_va(rt_error *error, rt_status status, const char *format,
 
 /* Returns a short constant name for a status ("input error", ...); never NULL. */
 const char *rt_status_name(rt_status status);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

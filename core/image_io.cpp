@@ -1,0 +1,578 @@
+/* image_io.cpp: see image_io.h. The only C++ in rtspheres: a thin extern "C" shim over
+ * OpenImageIO. No C++ exception crosses the C boundary; every entry point catches them.
+ *
+ * Writing encodes the file into memory first (through an OIIO IOProxy) and then writes the
+ * bytes to the temporary file itself, so every disk error is seen here with its errno:
+ * libjpeg, for one, calls exit() on a write error when it owns the file. TIFF is the
+ * exception: OIIO 2.4's TIFF writer produces a corrupt file through an IOProxy as soon as
+ * it writes an EXIF block (which "oiio:ColorSpace" = "sRGB" does), so OIIO writes TIFF to
+ * the temporary file directly; libtiff reports write errors properly.
+ */
+#include "image_io.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace {
+
+enum class file_kind { unknown, exr, hdr, eight_bit };
+
+const char *const supported_extensions = ".exr .hdr .png .jpg .jpeg .tif .tiff";
+
+/* Returns the extension of path's last component including the dot ("" when none), so
+ * the temporary file can end the same way and OIIO picks the same format for it. */
+std::string extension_of(const std::string &path)
+{
+    size_t slash = path.find_last_of('/');
+    size_t dot = path.find_last_of('.');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+        return "";
+    return path.substr(dot);
+}
+
+/* Returns how a file with this extension is written. */
+file_kind kind_of_extension(const std::string &extension)
+{
+    const char *e = extension.c_str();
+    if (strcasecmp(e, ".exr") == 0)
+        return file_kind::exr;
+    if (strcasecmp(e, ".hdr") == 0)
+        return file_kind::hdr;
+    for (const char *eight_bit : {".png", ".jpg", ".jpeg", ".tif", ".tiff"})
+        if (strcasecmp(e, eight_bit) == 0)
+            return file_kind::eight_bit;
+    return file_kind::unknown;
+}
+
+/* Returns the name channel c of image goes by: its own, or the documented default. */
+std::string channel_name(const rt_image *image, int c)
+{
+    if (image->channel_names[c][0] != '\0')
+        return std::string(image->channel_names[c],
+                           strnlen(image->channel_names[c], IMAGE_CHANNEL_NAME_MAX));
+    static const char *const rgba[] = {"R", "G", "B", "A"};
+    if (c < 4)
+        return rgba[c];
+    return "channel" + std::to_string(c);
+}
+
+/* Whether a channel of this name holds alpha, which 8-bit outputs write linearly. */
+bool is_alpha_name(const std::string &name)
+{
+    return strcasecmp(name.c_str(), "A") == 0 || strcasecmp(name.c_str(), "Alpha") == 0;
+}
+
+/* OIIO sometimes ends its messages with a newline, and some failures (a truncated PPM)
+ * come with no message at all; ours are one line and never empty. */
+std::string one_line(std::string message, const char *if_empty = "unknown error")
+{
+    while (!message.empty() && (message.back() == '\n' || message.back() == ' '))
+        message.pop_back();
+    for (char &ch : message)
+        if (ch == '\n')
+            ch = ' ';
+    return message.empty() ? if_empty : message;
+}
+
+/* Returns the sRGB encoding of a linear value in [0,1] (IEC 61966-2-1). */
+float srgb_encode(float linear)
+{
+    if (linear <= 0.0031308f)
+        return 12.92f * linear;
+    return 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+/* Scales by 2^exposure (colour only), clamps to [0,1] (NaN becomes 0), sRGB-encodes
+ * colour and rounds to 8 bits. Alpha is coverage, so it is neither exposed nor encoded. */
+std::vector<unsigned char> to_eight_bit(const rt_image *image, float exposure)
+{
+    const float scale = std::exp2(exposure);
+    std::vector<bool> alpha(image->channels);
+    for (int c = 0; c < image->channels; c++)
+        alpha[c] = is_alpha_name(channel_name(image, c));
+    size_t count = (size_t)image->width * image->height * image->channels;
+    std::vector<unsigned char> bytes(count);
+    for (size_t i = 0; i < count; i++) {
+        bool is_alpha = alpha[i % image->channels];
+        float value = image->pixels[i];
+        if (!is_alpha)
+            value *= scale;
+        value = std::fmin(std::fmax(value, 0.0f), 1.0f);
+        if (!is_alpha)
+            value = srgb_encode(value);
+        bytes[i] = (unsigned char)std::lround(value * 255.0f);
+    }
+    return bytes;
+}
+
+/* Radiance HDR holds exactly RGB: the first three channels, or a grey channel repeated. */
+std::vector<float> to_rgb(const rt_image *image)
+{
+    size_t pixel_count = (size_t)image->width * image->height;
+    std::vector<float> rgb(pixel_count * 3);
+    for (size_t p = 0; p < pixel_count; p++)
+        for (int c = 0; c < 3; c++)
+            rgb[p * 3 + c] = image->pixels[p * image->channels + (image->channels >= 3 ? c : 0)];
+    return rgb;
+}
+
+/* Adds the caller's metadata to spec. OpenEXR has no 64-bit integer attribute (OIIO
+ * silently drops one), so integers beyond 32 bits are stored as their decimal text. */
+void add_attributes(OIIO::ImageSpec &spec, const image_write_options *options)
+{
+    for (int i = 0; i < options->attribute_count; i++) {
+        const image_attribute &attribute = options->attributes[i];
+        if (attribute.name == nullptr || attribute.name[0] == '\0')
+            continue;
+        switch (attribute.type) {
+        case IMAGE_ATTRIBUTE_STRING:
+            spec.attribute(attribute.name, attribute.string_value ? attribute.string_value : "");
+            break;
+        case IMAGE_ATTRIBUTE_INT:
+            if (attribute.int_value >= INT_MIN && attribute.int_value <= INT_MAX)
+                spec.attribute(attribute.name, (int)attribute.int_value);
+            else
+                spec.attribute(attribute.name, std::to_string(attribute.int_value));
+            break;
+        case IMAGE_ATTRIBUTE_FLOAT:
+            spec.attribute(attribute.name, OIIO::TypeDesc::DOUBLE, &attribute.float_value);
+            break;
+        }
+    }
+}
+
+/* Whether OIIO's writer for this format works through an in-memory IOProxy (see top). */
+bool encodes_in_memory(const std::string &extension)
+{
+    const char *e = extension.c_str();
+    return strcasecmp(e, ".tif") != 0 && strcasecmp(e, ".tiff") != 0;
+}
+
+/* Has OIIO write image as the format of format_path: into bytes when memory is not null,
+ * else into the file file_path (which is also the name OIIO's messages use). Returns ""
+ * on success, else OIIO's message. */
+std::string encode(const std::string &format_path, const char *file_path, file_kind kind,
+                   const rt_image *image, const image_write_options *options,
+                   OIIO::Filesystem::IOVecOutput *memory)
+{
+    auto output = OIIO::ImageOutput::create(format_path, memory);
+    if (!output)
+        return one_line(OIIO::geterror());
+    if (memory != nullptr && !output->supports("ioproxy"))
+        return "the OpenImageIO plugin for this format cannot write to memory";
+
+    std::vector<unsigned char> eight_bit;
+    std::vector<float> rgb;
+    OIIO::TypeDesc pixel_type = OIIO::TypeDesc::FLOAT;
+    const void *pixels = image->pixels;
+    int channels = image->channels;
+    if (kind == file_kind::eight_bit) {
+        eight_bit = to_eight_bit(image, options->exposure);
+        pixels = eight_bit.data();
+        pixel_type = OIIO::TypeDesc::UINT8;
+    } else if (kind == file_kind::hdr) {
+        rgb = to_rgb(image);
+        pixels = rgb.data();
+        channels = 3;
+    }
+
+    OIIO::ImageSpec spec(image->width, image->height, channels, pixel_type);
+    spec.alpha_channel = -1;
+    if (kind == file_kind::hdr) {
+        spec.channelnames = {"R", "G", "B"};
+    } else {
+        for (int c = 0; c < channels; c++) {
+            spec.channelnames[c] = channel_name(image, c);
+            if (spec.alpha_channel < 0 && is_alpha_name(spec.channelnames[c]))
+                spec.alpha_channel = c;
+        }
+    }
+    /* A crop or tile of a larger image keeps its place: EXR stores it as the data window
+     * inside the display window; other formats just get the pixels. */
+    if (kind == file_kind::exr && image->full_width > 0 && image->full_height > 0) {
+        spec.x = image->x;
+        spec.y = image->y;
+        spec.full_x = 0;
+        spec.full_y = 0;
+        spec.full_width = image->full_width;
+        spec.full_height = image->full_height;
+    }
+    spec.attribute("oiio:ColorSpace", kind == file_kind::eight_bit ? "sRGB" : "Linear");
+    /* OIIO takes pixels to be premultiplied and would divide the (already sRGB-encoded)
+     * colour by alpha for PNG; the header promises the values are stored as given. */
+    if (kind == file_kind::eight_bit)
+        spec.attribute("oiio:UnassociatedAlpha", 1);
+    add_attributes(spec, options);
+
+    if (!output->open(file_path, spec))
+        return one_line(output->geterror());
+    if (!output->write_image(pixel_type, pixels)) {
+        std::string message = one_line(output->geterror());
+        output->close();
+        return message;
+    }
+    if (!output->close())
+        return one_line(output->geterror());
+    if (memory != nullptr && memory->size() == 0)
+        return "OpenImageIO produced no data";
+    return "";
+}
+
+/* Writes all of bytes to fd. Returns 0, or an errno value. */
+int write_all(int fd, const std::vector<unsigned char> &bytes)
+{
+    size_t done = 0;
+    while (done < bytes.size()) {
+        ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0) {
+            if (errno == EINTR)
+                continue;
+            return errno;
+        }
+        done += (size_t)n;
+    }
+    return 0;
+}
+
+/* The mode a newly created file would get: mkstemps makes 0600 files, which would be a
+ * surprise after the rename. umask() can only be read by setting it; it is restored at
+ * once (the window only matters to another thread creating a file at the same moment). */
+mode_t new_file_mode()
+{
+    mode_t mask = umask(022);
+    umask(mask);
+    return 0666 & ~mask;
+}
+
+/* Flushes the directory entry of the rename too; failures are harmless and ignored. */
+void sync_directory(const std::string &directory)
+{
+    int fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        fsync(fd);
+        ::close(fd);
+    }
+}
+
+/* Sets the error for a write that failed for reason why; returns RT_ERROR_RUNTIME. */
+rt_status write_failed(rt_error *error, const char *path, const std::string &why)
+{
+    return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot write '%s': %s", path,
+                        why.c_str());
+}
+
+/* Writes image to a temporary file next to path and renames it over path. On failure the
+ * temporary file is removed and path is untouched. */
+rt_status image_write_impl(const char *path, const rt_image *image,
+                           const image_write_options *options, rt_error *error)
+{
+    const std::string destination = path;
+    const std::string extension = extension_of(destination);
+    file_kind kind = kind_of_extension(extension);
+    if (kind == file_kind::unknown) {
+        if (extension.empty())
+            return rt_error_set(error, RT_ERROR_INPUT,
+                                "IMAGE: cannot write '%s': no file extension to pick the format by "
+                                "(supported: %s)", path, supported_extensions);
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "IMAGE: cannot write '%s': unknown extension '%s' (supported: %s)",
+                            path, extension.c_str(), supported_extensions);
+    }
+    if (image == nullptr || image->pixels == nullptr || image->width <= 0 || image->height <= 0
+        || image->channels <= 0 || image->channels > IMAGE_MAX_CHANNELS)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "IMAGE: cannot write '%s': not a valid image (%dx%d, %d channels%s)",
+                            path, image ? image->width : 0, image ? image->height : 0,
+                            image ? image->channels : 0,
+                            image && image->pixels == nullptr ? ", no pixels" : "");
+    image_write_options defaults = image_write_options_defaults();
+    if (options == nullptr)
+        options = &defaults;
+
+    size_t slash = destination.find_last_of('/');
+    std::string prefix = slash == std::string::npos ? "" : destination.substr(0, slash + 1);
+    std::string base = destination.substr(prefix.size());
+    std::string directory = prefix.empty()       ? "."
+                            : prefix.size() == 1 ? "/"
+                                                 : prefix.substr(0, prefix.size() - 1);
+    std::string temporary = prefix + "." + base + ".tmp-XXXXXX" + extension;
+    std::vector<char> temporary_name(temporary.begin(), temporary.end());
+    temporary_name.push_back('\0');
+
+    int fd = mkstemps(temporary_name.data(), (int)extension.size());
+    if (fd < 0)
+        return write_failed(error, path, std::string("cannot create a temporary file in '")
+                                             + directory + "': " + strerror(errno));
+    const char *temporary_path = temporary_name.data();
+
+    std::string failure;
+    try {
+        std::vector<unsigned char> bytes;
+        OIIO::Filesystem::IOVecOutput memory(bytes);
+        bool in_memory = encodes_in_memory(extension);
+        failure = encode(destination, temporary_path, kind, image, options,
+                         in_memory ? &memory : nullptr);
+        if (failure.empty()) {
+            int err = in_memory ? write_all(fd, bytes) : 0;
+            if (err == 0 && fsync(fd) != 0 && errno != EINVAL)
+                err = errno;
+            if (err == 0 && fchmod(fd, new_file_mode()) != 0)
+                err = errno;
+            if (err != 0)
+                failure = strerror(err);
+        }
+    } catch (const std::bad_alloc &) {
+        failure = "out of memory";
+    } catch (const std::exception &e) {
+        failure = one_line(e.what());
+    } catch (...) {
+        failure = "unexpected C++ exception";
+    }
+    if (::close(fd) != 0 && failure.empty())
+        failure = strerror(errno);
+    if (failure.empty() && rename(temporary_path, path) != 0)
+        failure = std::string("cannot rename the temporary file over it: ") + strerror(errno);
+    if (!failure.empty()) {
+        unlink(temporary_path);
+        return write_failed(error, path, failure);
+    }
+    sync_directory(directory);
+    return RT_OK;
+}
+
+/* Sets the error for a read that failed for reason why; returns RT_ERROR_INPUT. */
+rt_status read_failed(rt_error *error, const char *path, const std::string &why)
+{
+    return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: cannot read '%s': %s", path,
+                        why.c_str());
+}
+
+/* Opens path for reading. Returns nullptr with the error set when that fails. OIIO's own
+ * message for a missing file is vague, so that case is reported from errno. */
+std::unique_ptr<OIIO::ImageInput> open_input(const char *path, rt_error *error)
+{
+    struct stat info;
+    if (stat(path, &info) != 0) {
+        read_failed(error, path, strerror(errno));
+        return nullptr;
+    }
+    if (S_ISDIR(info.st_mode)) {
+        read_failed(error, path, "it is a directory");
+        return nullptr;
+    }
+    if (info.st_size == 0) {
+        read_failed(error, path, "the file is empty");
+        return nullptr;
+    }
+    /* Without this OIIO multiplies PNG colour by alpha; we return what the file stores. */
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto input = OIIO::ImageInput::open(path, &config);
+    if (!input)
+        read_failed(error, path,
+                    one_line(OIIO::geterror(), "not an image file OpenImageIO reads"));
+    return input;
+}
+
+/* Reads path into *out, which the caller has zeroed and frees on an exception. */
+rt_status image_read_impl(const char *path, rt_image *out, rt_error *error)
+{
+    auto input = open_input(path, error);
+    if (!input)
+        return RT_ERROR_INPUT;
+    const OIIO::ImageSpec &spec = input->spec();
+    if (spec.deep)
+        return read_failed(error, path, "deep images are not supported");
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+        return read_failed(error, path, "the image has no pixels");
+    if (spec.nchannels > IMAGE_MAX_CHANNELS)
+        return read_failed(error, path,
+                           "it has " + std::to_string(spec.nchannels) + " channels; at most "
+                               + std::to_string(IMAGE_MAX_CHANNELS) + " are supported");
+
+    rt_status status = image_create(out, spec.width, spec.height, spec.nchannels, error);
+    if (status != RT_OK)
+        return status;
+    for (int c = 0; c < spec.nchannels && c < (int)spec.channelnames.size(); c++)
+        snprintf(out->channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s",
+                 spec.channelnames[c].c_str());
+    out->x = spec.x - spec.full_x;
+    out->y = spec.y - spec.full_y;
+    out->full_width = spec.full_width;
+    out->full_height = spec.full_height;
+    if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out->pixels)) {
+        image_free(out);
+        return read_failed(error, path,
+                           one_line(input->geterror(), "the file is truncated or corrupt"));
+    }
+    input->close();
+    return RT_OK;
+}
+
+/* Formats value with the fewest significant digits that read back as the same number. */
+std::string shortest_text(double value, bool single_precision)
+{
+    char text[64];
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(text, sizeof text, "%.*g", digits, value);
+        bool same = single_precision ? strtof(text, nullptr) == (float)value
+                                     : strtod(text, nullptr) == value;
+        if (same)
+            break;
+    }
+    return text;
+}
+
+/* Returns an attribute's value as text: numbers plainly, strings as they are. */
+std::string attribute_text(const OIIO::ParamValue &parameter)
+{
+    OIIO::TypeDesc type = parameter.type();
+    bool scalar = parameter.nvalues() == 1 && type.aggregate == OIIO::TypeDesc::SCALAR
+                  && type.arraylen == 0;
+    if (scalar) {
+        if (type == OIIO::TypeDesc::STRING)
+            return parameter.get_string();
+        if (type.basetype == OIIO::TypeDesc::DOUBLE)
+            return shortest_text(*(const double *)parameter.data(), false);
+        if (type.basetype == OIIO::TypeDesc::FLOAT || type.basetype == OIIO::TypeDesc::HALF)
+            return shortest_text(parameter.get_float(), true);
+        if (type.basetype == OIIO::TypeDesc::INT64)
+            return std::to_string(*(const long long *)parameter.data());
+        if (type.basetype == OIIO::TypeDesc::UINT64)
+            return std::to_string(*(const unsigned long long *)parameter.data());
+        if (type.basetype == OIIO::TypeDesc::UINT32)
+            return std::to_string(*(const unsigned int *)parameter.data());
+        if (!type.is_floating_point())
+            return std::to_string(parameter.get_int());
+    }
+    return parameter.get_string();
+}
+
+/* Reads attribute name of path as text into value; see image_read_attribute(). */
+rt_status image_read_attribute_impl(const char *path, const char *name, char *value,
+                                    int value_size, rt_error *error)
+{
+    if (name == nullptr || value == nullptr || value_size <= 0)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "IMAGE: reading an attribute of '%s' needs a name and a buffer", path);
+    value[0] = '\0';
+    auto input = open_input(path, error);
+    if (!input)
+        return RT_ERROR_INPUT;
+    const OIIO::ParamValue *parameter =
+        input->spec().find_attribute(name, OIIO::TypeDesc::UNKNOWN, true);
+    if (parameter == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: '%s' has no attribute '%s'", path,
+                            name);
+    snprintf(value, (size_t)value_size, "%s", attribute_text(*parameter).c_str());
+    return RT_OK;
+}
+
+}  // namespace
+
+extern "C" {
+
+image_write_options image_write_options_defaults(void)
+{
+    image_write_options options;
+    memset(&options, 0, sizeof options);
+    return options;
+}
+
+rt_status image_create(rt_image *image, int width, int height, int channels, rt_error *error)
+{
+    memset(image, 0, sizeof *image);
+    if (width <= 0 || height <= 0 || channels <= 0 || channels > IMAGE_MAX_CHANNELS)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "IMAGE: cannot create a %dx%d image with %d channels", width, height,
+                            channels);
+    size_t count = (size_t)width * (size_t)height;
+    if (count > SIZE_MAX / sizeof(float) / (size_t)channels)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: a %dx%d image is too large",
+                            width, height);
+    image->pixels = (float *)calloc(count * (size_t)channels, sizeof(float));
+    if (image->pixels == nullptr)
+        return rt_error_set(error, RT_ERROR_RUNTIME,
+                            "IMAGE: out of memory for a %dx%d image with %d channels", width,
+                            height, channels);
+    image->width = width;
+    image->height = height;
+    image->channels = channels;
+    return RT_OK;
+}
+
+void image_free(rt_image *image)
+{
+    if (image == nullptr)
+        return;
+    free(image->pixels);
+    memset(image, 0, sizeof *image);
+}
+
+rt_status image_write(const char *path, const rt_image *image, const image_write_options *options,
+                      rt_error *error)
+{
+    if (path == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to write the image to");
+    try {
+        return image_write_impl(path, image, options, error);
+    } catch (const std::exception &e) {
+        return write_failed(error, path, one_line(e.what()));
+    } catch (...) {
+        return write_failed(error, path, "unexpected C++ exception");
+    }
+}
+
+rt_status image_read(const char *path, rt_image *out, rt_error *error)
+{
+    memset(out, 0, sizeof *out);
+    if (path == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read an image from");
+    try {
+        return image_read_impl(path, out, error);
+    } catch (const std::bad_alloc &) {
+        image_free(out);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory",
+                            path);
+    } catch (const std::exception &e) {
+        image_free(out);
+        return read_failed(error, path, one_line(e.what()));
+    } catch (...) {
+        image_free(out);
+        return read_failed(error, path, "unexpected C++ exception");
+    }
+}
+
+rt_status image_read_attribute(const char *path, const char *name, char *value, int value_size,
+                               rt_error *error)
+{
+    if (path == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read an attribute from");
+    try {
+        return image_read_attribute_impl(path, name, value, value_size, error);
+    } catch (const std::exception &e) {
+        return read_failed(error, path, one_line(e.what()));
+    } catch (...) {
+        return read_failed(error, path, "unexpected C++ exception");
+    }
+}
+
+}  // extern "C"
