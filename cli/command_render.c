@@ -1,6 +1,7 @@
 /* command_render.c: `rtspheres render SCENE -o OUTPUT [options]`: parses options, loads
- * the scene, renders it on the GPU context and writes the image. Turns every failure
- * into a message on stderr and an exit code (0 ok, 1 runtime/interrupted, 2 bad input). */
+ * the scene (once per frame), renders it on one GPU context and writes the images.
+ * Turns every failure into a message on stderr and an exit code (0 ok, 1 runtime or
+ * interrupted, 2 bad input). */
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
@@ -9,10 +10,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "batch.h"
 #include "commands.h"
 #include "gpu.h"
 #include "image_io.h"
@@ -21,6 +24,7 @@
 #include "version.h"
 
 #define MAX_DEFINES 256
+#define DEFAULT_FRAMES_PER_SECOND 24.0
 
 static void print_help(FILE *stream)
 {
@@ -31,18 +35,29 @@ static void print_help(FILE *stream)
             ".exr (linear float, with metadata and a per-pixel 'samples' channel), .hdr,\n"
             ".png/.jpg/.tif (8-bit sRGB).\n"
             "\n"
-            "options (each overrides the scene file's `render` settings):\n"
-            "  -o, --output FILE      the image to write (required)\n"
+            "options (--spp, --size, --max-depth, --seed override the scene's `render` line):\n"
+            "  -o, --output FILE      the image to write (required); with --frames a pattern\n"
+            "                         such as frame-%%04d.png\n"
             "  -s, --spp N            samples per pixel\n"
             "      --size WxH         image size in pixels, e.g. 640x360\n"
             "      --max-depth N      path segments per sample at most\n"
             "      --seed N           random seed (same seed, same image)\n"
             "  -D NAME=VALUE          set scene variable $NAME (wins over the file's `set`)\n"
+            "      --frames LIST      render frames, e.g. 1-60 or 1-10,15,20-30:2; each frame\n"
+            "                         sets $frame and $time (= frame / --fps)\n"
+            "      --fps F            frames per second for $time (default 24)\n"
+            "      --samples S:C      render only sample indices S .. S+C-1 of each pixel\n"
+            "                         (parts merge exactly with `rtspheres merge`)\n"
+            "      --crop x0,y0,x1,y1 render only that region (row 0 at the top, x1/y1 exclusive)\n"
+            "      --tile I/N         render horizontal band I of N (0-based)\n"
+            "      --shard I/N        part I of N of the work (see --shard-by); for job arrays\n"
+            "      --shard-by KIND    frames, samples or tiles (default: frames when --frames\n"
+            "                         lists several, otherwise samples)\n"
             "      --exposure STOPS   brighten 8-bit outputs by 2^STOPS (default 0)\n"
-            "      --pass-budget N    fixed work units per pixel per GPU pass (default: adapted\n"
-            "                         so a pass takes about 0.25 s; the image is the same)\n"
             "      --roulette-depth N paths may end at random (Russian roulette, unbiased)\n"
             "                         after N segments (default 4)\n"
+            "      --pass-budget N    fixed work units per pixel per GPU pass (default: adapted\n"
+            "                         so a pass takes about 0.25 s; the image is the same)\n"
             "      --device N         use EGL device N (see `rtspheres info`)\n"
             "  -q, --quiet            no progress bar and no summary line\n"
             "  -v, --verbose          OpenGL debug messages and set-up details on stderr\n"
@@ -59,6 +74,28 @@ static void on_stop_signal(int signal_number)
     signal(signal_number, SIG_DFL);
 }
 
+/* Everything the command line asked for; zero/negative means "not given". */
+typedef struct render_request {
+    const char *scene_path;
+    const char *output;
+    long long spp, width, height, max_depth, seed;
+    long long pass_budget, device, roulette_depth;
+    double exposure;
+    double frames_per_second;
+    bool quiet, verbose;
+    scene_define defines[MAX_DEFINES + 2];
+    char *define_copies[MAX_DEFINES];
+    int define_count;
+    frame_list frames;           /* empty: one image, no $frame */
+    bool has_samples;
+    long long sample_start, sample_count;
+    bool has_crop;
+    int crop[4];
+    int tile_index, tile_count;  /* tile_count 0: no --tile */
+    int shard_index, shard_count;
+    const char *shard_by;
+} render_request;
+
 /* Parses a whole decimal integer in [minimum, maximum] into *value. Returns 0 or -1. */
 static int parse_integer(const char *text, long long minimum, long long maximum, long long *value)
 {
@@ -73,8 +110,8 @@ static int parse_integer(const char *text, long long minimum, long long maximum,
 
 typedef struct progress_state {
     bool tty;
-    int last_percent;
     double last_draw;
+    const char *label;
 } progress_state;
 
 static void draw_progress(void *context, const render_progress *progress)
@@ -92,8 +129,8 @@ static void draw_progress(void *context, const render_progress *progress)
         bar[i] = i < filled ? '#' : '.';
     bar[width] = '\0';
     double eta = fraction > 0 ? progress->elapsed_seconds * (1.0 - fraction) / fraction : 0;
-    fprintf(stderr, "\r[%s] %5.1f%%  %llu/%llu samples  %.1f s elapsed, ETA %.1f s ", bar, 100.0 * fraction,
-            (unsigned long long)progress->samples_done, (unsigned long long)progress->samples_total,
+    fprintf(stderr, "\r%s[%s] %5.1f%%  %llu/%llu samples  %.1f s elapsed, ETA %.1f s ", state->label, bar,
+            100.0 * fraction, (unsigned long long)progress->samples_done, (unsigned long long)progress->samples_total,
             progress->elapsed_seconds, eta);
     fflush(stderr);
 }
@@ -126,28 +163,35 @@ static bool output_directory_writable(const char *path)
     return stat(directory, &info) == 0 && S_ISDIR(info.st_mode) && access(directory, W_OK) == 0;
 }
 
-static bool is_float_output(const char *path)
+static const char *extension_of(const char *path)
 {
     const char *dot = strrchr(path, '.');
-    return dot != NULL && (strcasecmp(dot, ".exr") == 0 || strcasecmp(dot, ".hdr") == 0);
+    return dot != NULL && strchr(dot, '/') == NULL ? dot : "";
+}
+
+static bool keeps_sample_counts(const char *path)
+{
+    return strcasecmp(extension_of(path), ".exr") == 0;
 }
 
 static bool known_output(const char *path)
 {
     static const char *const extensions[] = {".exr", ".hdr", ".png", ".jpg", ".jpeg", ".tif", ".tiff"};
-    const char *dot = strrchr(path, '.');
-    if (dot == NULL || strchr(dot, '/') != NULL)
-        return false;
     for (size_t i = 0; i < sizeof extensions / sizeof extensions[0]; i++)
-        if (strcasecmp(dot, extensions[i]) == 0)
+        if (strcasecmp(extension_of(path), extensions[i]) == 0)
             return true;
     return false;
 }
 
-int command_render(int argc, char **argv)
+/* Parses the options into *request. Returns EXIT_OK, or an exit code after printing why;
+ * *help_shown is set when --help was handled. */
+static int parse_arguments(int argc, char **argv, render_request *request, bool *help_shown)
 {
-    enum { OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
-           OPTION_ROULETTE_DEPTH };
+    enum {
+        OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
+        OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
+        OPTION_SHARD_BY,
+    };
     static const struct option long_options[] = {
         {"output", required_argument, NULL, 'o'},
         {"spp", required_argument, NULL, 's'},
@@ -158,231 +202,318 @@ int command_render(int argc, char **argv)
         {"pass-budget", required_argument, NULL, OPTION_PASS_BUDGET},
         {"device", required_argument, NULL, OPTION_DEVICE},
         {"roulette-depth", required_argument, NULL, OPTION_ROULETTE_DEPTH},
+        {"frames", required_argument, NULL, OPTION_FRAMES},
+        {"fps", required_argument, NULL, OPTION_FPS},
+        {"samples", required_argument, NULL, OPTION_SAMPLES},
+        {"crop", required_argument, NULL, OPTION_CROP},
+        {"tile", required_argument, NULL, OPTION_TILE},
+        {"shard", required_argument, NULL, OPTION_SHARD},
+        {"shard-by", required_argument, NULL, OPTION_SHARD_BY},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
-    const char *output = NULL;
-    long long spp = 0, width = 0, height = 0, max_depth = 0, seed = -1, pass_budget = 0, device = -1;
-    long long roulette_depth = 0;
-    double exposure = 0;
-    bool quiet = false, verbose = false;
-    scene_define defines[MAX_DEFINES];
-    char *define_copies[MAX_DEFINES];
-    int define_count = 0;
-    int exit_code = EXIT_OK;
-
+    rt_error error = {{0}};
     optind = 1;
     int option;
     while ((option = getopt_long(argc, argv, "o:s:D:qvh", long_options, NULL)) != -1) {
+        const char *complaint = NULL;
         switch (option) {
         case 'o':
-            output = optarg;
+            request->output = optarg;
             break;
         case 's':
-            if (parse_integer(optarg, 1, 1 << 30, &spp)) {
-                fprintf(stderr, "rtspheres render: --spp wants a whole number from 1 to 1073741824, not '%s'\n", optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            if (parse_integer(optarg, 1, 1 << 30, &request->spp))
+                complaint = "--spp wants a whole number from 1 to 1073741824";
             break;
         case OPTION_SIZE: {
-            char *x = strchr(optarg, 'x');
             char copy[64];
             snprintf(copy, sizeof copy, "%s", optarg);
-            char *separator = x ? copy + (x - optarg) : NULL;
+            char *separator = strchr(copy, 'x');
             if (separator)
                 *separator = '\0';
-            if (!separator || parse_integer(copy, 1, 16384, &width) || parse_integer(separator + 1, 1, 16384, &height)) {
-                fprintf(stderr, "rtspheres render: --size wants WIDTHxHEIGHT, each 1 to 16384, e.g. 640x360, not '%s'\n",
-                        optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            if (!separator || parse_integer(copy, 1, 16384, &request->width)
+                || parse_integer(separator + 1, 1, 16384, &request->height))
+                complaint = "--size wants WIDTHxHEIGHT, each 1 to 16384, e.g. 640x360";
             break;
         }
         case OPTION_MAX_DEPTH:
-            if (parse_integer(optarg, 1, 100000, &max_depth)) {
-                fprintf(stderr, "rtspheres render: --max-depth wants a whole number from 1 to 100000, not '%s'\n", optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            if (parse_integer(optarg, 1, 100000, &request->max_depth))
+                complaint = "--max-depth wants a whole number from 1 to 100000";
             break;
         case OPTION_SEED:
-            if (parse_integer(optarg, 0, UINT32_MAX, &seed)) {
-                fprintf(stderr, "rtspheres render: --seed wants a whole number from 0 to 4294967295, not '%s'\n", optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            if (parse_integer(optarg, 0, UINT32_MAX, &request->seed))
+                complaint = "--seed wants a whole number from 0 to 4294967295";
             break;
         case OPTION_PASS_BUDGET:
-            if (parse_integer(optarg, 1, 50000, &pass_budget)) {
-                fprintf(stderr, "rtspheres render: --pass-budget wants a whole number from 1 to 50000, not '%s'\n", optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            if (parse_integer(optarg, 1, 50000, &request->pass_budget))
+                complaint = "--pass-budget wants a whole number from 1 to 50000";
             break;
         case OPTION_ROULETTE_DEPTH:
-            if (parse_integer(optarg, 1, 100000, &roulette_depth)) {
-                fprintf(stderr, "rtspheres render: --roulette-depth wants a whole number from 1 to 100000, not '%s'\n",
-                        optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            if (parse_integer(optarg, 1, 100000, &request->roulette_depth))
+                complaint = "--roulette-depth wants a whole number from 1 to 100000";
             break;
         case OPTION_DEVICE:
-            if (parse_integer(optarg, 0, 255, &device)) {
-                fprintf(stderr, "rtspheres render: --device wants a device number (0, 1, ...), not '%s'\n", optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            if (parse_integer(optarg, 0, 255, &request->device))
+                complaint = "--device wants a device number (0, 1, ...)";
             break;
         case OPTION_EXPOSURE: {
             char *end = NULL;
-            exposure = strtod(optarg, &end);
-            if (end == optarg || *end != '\0' || !isfinite(exposure) || fabs(exposure) > 64) {
-                fprintf(stderr, "rtspheres render: --exposure wants a number of stops (-64 to 64), not '%s'\n", optarg);
-                exit_code = EXIT_BAD_INPUT;
-            }
+            request->exposure = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !isfinite(request->exposure) || fabs(request->exposure) > 64)
+                complaint = "--exposure wants a number of stops (-64 to 64)";
             break;
         }
+        case OPTION_FPS: {
+            char *end = NULL;
+            request->frames_per_second = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !(request->frames_per_second > 0)
+                || request->frames_per_second > 1e6)
+                complaint = "--fps wants a positive number of frames per second";
+            break;
+        }
+        case OPTION_FRAMES:
+            frame_list_free(&request->frames);
+            if (frame_list_parse(optarg, &request->frames, &error) != RT_OK) {
+                fprintf(stderr, "rtspheres render: --%s\n", error.message);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case OPTION_SAMPLES: {
+            char copy[64];
+            snprintf(copy, sizeof copy, "%s", optarg);
+            char *separator = strchr(copy, ':');
+            if (separator)
+                *separator = '\0';
+            if (!separator || parse_integer(copy, 0, UINT32_MAX - 1, &request->sample_start)
+                || parse_integer(separator + 1, 1, 1 << 30, &request->sample_count)
+                || request->sample_start + request->sample_count > UINT32_MAX)
+                complaint = "--samples wants START:COUNT, e.g. 512:512 (COUNT at least 1)";
+            request->has_samples = true;
+            break;
+        }
+        case OPTION_CROP: {
+            char extra;
+            int *c = request->crop;
+            if (sscanf(optarg, "%d,%d,%d,%d%c", &c[0], &c[1], &c[2], &c[3], &extra) != 4 || c[0] < 0 || c[1] < 0
+                || c[2] <= c[0] || c[3] <= c[1])
+                complaint = "--crop wants x0,y0,x1,y1 with x0 < x1 and y0 < y1 (row 0 at the top)";
+            request->has_crop = true;
+            break;
+        }
+        case OPTION_TILE:
+            if (shard_parse(optarg, &request->tile_index, &request->tile_count, &error) != RT_OK) {
+                fprintf(stderr, "rtspheres render: --tile %s\n", error.message);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case OPTION_SHARD:
+            if (shard_parse(optarg, &request->shard_index, &request->shard_count, &error) != RT_OK) {
+                fprintf(stderr, "rtspheres render: --shard %s\n", error.message);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case OPTION_SHARD_BY:
+            if (strcmp(optarg, "frames") != 0 && strcmp(optarg, "samples") != 0 && strcmp(optarg, "tiles") != 0)
+                complaint = "--shard-by wants frames, samples or tiles";
+            request->shard_by = optarg;
+            break;
         case 'D': {
             const char *equals = strchr(optarg, '=');
             if (equals == NULL || equals == optarg || equals[1] == '\0') {
-                fprintf(stderr, "rtspheres render: -D wants NAME=VALUE, e.g. -D aperture=0.1, not '%s'\n", optarg);
-                exit_code = EXIT_BAD_INPUT;
+                complaint = "-D wants NAME=VALUE, e.g. -D aperture=0.1";
                 break;
             }
-            if (define_count == MAX_DEFINES) {
-                fprintf(stderr, "rtspheres render: more than %d -D options\n", MAX_DEFINES);
-                exit_code = EXIT_BAD_INPUT;
+            if (request->define_count == MAX_DEFINES) {
+                complaint = "too many -D options";
                 break;
             }
             char *copy = strdup(optarg);
             if (copy == NULL) {
                 fprintf(stderr, "rtspheres render: out of memory\n");
-                exit_code = EXIT_RUNTIME;
-                break;
+                return EXIT_RUNTIME;
             }
             copy[equals - optarg] = '\0';
-            define_copies[define_count] = copy;
-            defines[define_count] = (scene_define){.name = copy, .value = copy + (equals - optarg) + 1};
-            define_count++;
+            request->define_copies[request->define_count] = copy;
+            request->defines[request->define_count] =
+                (scene_define){.name = copy, .value = copy + (equals - optarg) + 1};
+            request->define_count++;
             break;
         }
         case 'q':
-            quiet = true;
+            request->quiet = true;
             break;
         case 'v':
-            verbose = true;
+            request->verbose = true;
             break;
         case 'h':
             print_help(stdout);
-            goto done;
+            *help_shown = true;
+            return EXIT_OK;
         default:
-            exit_code = EXIT_BAD_INPUT;
-            break;
+            return EXIT_BAD_INPUT;
+        }
+        if (complaint != NULL) {
+            fprintf(stderr, "rtspheres render: %s, not '%s'\n", complaint, optarg);
+            return EXIT_BAD_INPUT;
         }
     }
-    if (exit_code != EXIT_OK)
-        goto done;
     if (optind >= argc) {
         fprintf(stderr, "rtspheres render: which scene? usage: rtspheres render SCENE -o OUTPUT\n");
-        exit_code = EXIT_BAD_INPUT;
-        goto done;
+        return EXIT_BAD_INPUT;
     }
     if (optind + 1 < argc) {
         fprintf(stderr, "rtspheres render: one scene at a time; unexpected '%s'\n", argv[optind + 1]);
-        exit_code = EXIT_BAD_INPUT;
-        goto done;
+        return EXIT_BAD_INPUT;
     }
-    const char *scene_path = argv[optind];
+    request->scene_path = argv[optind];
+    const char *output = request->output;
     if (output == NULL) {
         fprintf(stderr, "rtspheres render: no output file; add -o OUTPUT (.exr, .png, .jpg, .hdr, .tif)\n");
-        exit_code = EXIT_BAD_INPUT;
-        goto done;
+        return EXIT_BAD_INPUT;
     }
     if (!known_output(output)) {
         fprintf(stderr, "rtspheres render: cannot tell the format of '%s'; use .exr, .hdr, .png, .jpg or .tif\n",
                 output);
-        exit_code = EXIT_BAD_INPUT;
-        goto done;
+        return EXIT_BAD_INPUT;
     }
     if (!output_directory_writable(output)) {
         fprintf(stderr, "rtspheres render: cannot write '%s': its directory does not exist or is not writable\n",
                 output);
-        exit_code = EXIT_BAD_INPUT;
-        goto done;
+        return EXIT_BAD_INPUT;
     }
-    if (same_file(output, scene_path)) {
+    if (same_file(output, request->scene_path)) {
         fprintf(stderr, "rtspheres render: the output '%s' is the scene file; refusing to overwrite it\n", output);
-        exit_code = EXIT_BAD_INPUT;
-        goto done;
+        return EXIT_BAD_INPUT;
     }
+    if (request->has_crop && request->tile_count) {
+        fprintf(stderr, "rtspheres render: --crop and --tile both choose the region; give one\n");
+        return EXIT_BAD_INPUT;
+    }
+    if (request->frames.count > 1 && !output_pattern_has_frame(output)) {
+        fprintf(stderr, "rtspheres render: %d frames would all write '%s'; put a frame number pattern in the "
+                        "output, e.g. frame-%%04d.png\n", request->frames.count, output);
+        return EXIT_BAD_INPUT;
+    }
+    if (request->frames.count > 0 && output_pattern_format(output, 0, (char[4096]){0}, 4096, &error) != RT_OK) {
+        fprintf(stderr, "rtspheres render: %s\n", error.message);
+        return EXIT_BAD_INPUT;
+    }
+    if (request->shard_count) {
+        const char *by = request->shard_by ? request->shard_by : request->frames.count > 1 ? "frames" : "samples";
+        request->shard_by = by;
+        if (strcmp(by, "frames") == 0 && request->frames.count == 0) {
+            fprintf(stderr, "rtspheres render: --shard-by frames needs --frames\n");
+            return EXIT_BAD_INPUT;
+        }
+        if (strcmp(by, "samples") == 0 && request->has_samples) {
+            fprintf(stderr, "rtspheres render: --shard by samples and --samples both choose the samples; give one\n");
+            return EXIT_BAD_INPUT;
+        }
+        if (strcmp(by, "tiles") == 0 && (request->has_crop || request->tile_count)) {
+            fprintf(stderr, "rtspheres render: --shard by tiles and --crop/--tile both choose the region; give one\n");
+            return EXIT_BAD_INPUT;
+        }
+        if (strcmp(by, "tiles") == 0) {
+            request->tile_index = request->shard_index;
+            request->tile_count = request->shard_count;
+        }
+    }
+    return EXIT_OK;
+}
 
+/* Renders one image (one frame, or the only image) on context and writes it to output.
+ * frame < 0: no --frames. Returns an exit code, after printing why on failure. */
+static int render_frame(gpu_context *context, const render_request *request, int frame, const char *output)
+{
+    scene_define defines[MAX_DEFINES + 2];
+    memcpy(defines, request->defines, (size_t)request->define_count * sizeof defines[0]);
+    int define_count = request->define_count;
+    char frame_text[32], time_text[64];
+    if (frame >= 0) {
+        double fps = request->frames_per_second > 0 ? request->frames_per_second : DEFAULT_FRAMES_PER_SECOND;
+        snprintf(frame_text, sizeof frame_text, "%d", frame);
+        snprintf(time_text, sizeof time_text, "%.17g", frame / fps);
+        defines[define_count++] = (scene_define){.name = "frame", .value = frame_text, .optional = true};
+        defines[define_count++] = (scene_define){.name = "time", .value = time_text, .optional = true};
+    }
     scene_parse_options parse_options = scene_parse_options_defaults();
     parse_options.defines = defines;
     parse_options.define_count = define_count;
     scene s;
     rt_error error = {{0}};
-    rt_status status = scene_load_file(scene_path, &parse_options, &s, &error);
+    rt_status status = scene_load_file(request->scene_path, &parse_options, &s, &error);
     if (status != RT_OK) {
         fprintf(stderr, "%s\n", error.message);
-        exit_code = exit_code_for_status(status);
-        goto done;
+        return exit_code_for_status(status);
     }
-    if (spp) s.render.samples_per_pixel = (int)spp;
-    if (width) { s.render.width = (int)width; s.render.height = (int)height; }
-    if (max_depth) s.render.max_depth = (int)max_depth;
-    if (seed >= 0) s.render.seed = (uint32_t)seed;
+    if (request->spp) s.render.samples_per_pixel = (int)request->spp;
+    if (request->width) { s.render.width = (int)request->width; s.render.height = (int)request->height; }
+    if (request->max_depth) s.render.max_depth = (int)request->max_depth;
+    if (request->seed >= 0) s.render.seed = (uint32_t)request->seed;
 
-    gpu_options gpu = gpu_options_defaults();
-    gpu.device = device >= 0 ? (int)device + 1 : 0;
-    gpu.debug_output = verbose;
-    gpu.log = log_to_stderr;
-    gpu_context *context = NULL;
-    status = gpu_create(&gpu, &context, &error);
-    if (status != RT_OK) {
-        fprintf(stderr, "rtspheres render: %s\n", error.message);
-        scene_free(&s);
-        exit_code = exit_code_for_status(status);
-        goto done;
-    }
-    if (verbose) {
-        gpu_info info;
-        gpu_get_info(context, &info);
-        fprintf(stderr, "rtspheres: rendering on %s (%s, %s)\n", info.gl_renderer, info.platform, info.gl_version);
-    }
-
-    progress_state progress = {.tty = !quiet && isatty(STDERR_FILENO), .last_draw = -1};
     render_options options = render_options_defaults();
-    options.pass_work_budget = (uint32_t)pass_budget;
-    options.russian_roulette_depth = (uint32_t)roulette_depth;
+    long long sample_start = 0, sample_count = s.render.samples_per_pixel;
+    if (request->has_samples) {
+        sample_start = request->sample_start;
+        sample_count = request->sample_count;
+    } else if (request->shard_count && strcmp(request->shard_by, "samples") == 0) {
+        shard_range(request->shard_index, request->shard_count, s.render.samples_per_pixel, &sample_start,
+                    &sample_count);
+        if (sample_count == 0) {
+            fprintf(stderr, "rtspheres render: shard %d/%d of %d samples per pixel is empty; use fewer shards\n",
+                    request->shard_index, request->shard_count, s.render.samples_per_pixel);
+            scene_free(&s);
+            return EXIT_BAD_INPUT;
+        }
+    }
+    options.sample_start = (uint32_t)sample_start;
+    s.render.samples_per_pixel = (int)sample_count;
+    if (request->has_crop) {
+        memcpy(options.region, request->crop, sizeof options.region);
+    } else if (request->tile_count) {
+        long long row, rows;
+        shard_range(request->tile_index, request->tile_count, s.render.height, &row, &rows);
+        if (rows == 0) {
+            fprintf(stderr, "rtspheres render: tile %d/%d of a %d-row image is empty; use fewer tiles\n",
+                    request->tile_index, request->tile_count, s.render.height);
+            scene_free(&s);
+            return EXIT_BAD_INPUT;
+        }
+        int band[4] = {0, (int)row, s.render.width, (int)(row + rows)};
+        memcpy(options.region, band, sizeof band);
+    }
+    options.pass_work_budget = (uint32_t)request->pass_budget;
+    options.russian_roulette_depth = (uint32_t)request->roulette_depth;
+
+    char label[64] = "";
+    if (frame >= 0)
+        snprintf(label, sizeof label, "frame %d ", frame);
+    progress_state progress = {.tty = !request->quiet && isatty(STDERR_FILENO), .last_draw = -1, .label = label};
     options.progress = draw_progress;
     options.progress_context = &progress;
     options.stop_requested = &stop_requested;
-    stop_requested = 0;
-    signal(SIGINT, on_stop_signal);
-    signal(SIGTERM, on_stop_signal);
     render_result result;
     status = render_scene(context, &s, &options, &result, &error);
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
-    gpu_destroy(context);
     if (progress.tty)
         fprintf(stderr, "\n");
     if (status != RT_OK && status != RT_ERROR_INTERRUPTED) {
         fprintf(stderr, "rtspheres render: %s\n", error.message);
         scene_free(&s);
-        exit_code = exit_code_for_status(status);
-        goto done;
+        return exit_code_for_status(status);
     }
     rt_status render_status = status;
 
-    /* 8-bit formats get the colour channels only; float formats keep the sample counts. */
+    /* Only EXR keeps the per-pixel sample counts; other formats get colour only. */
     rt_image colour = result.image;
     rt_image rgb = {0};
-    if (!is_float_output(output) || strcasecmp(strrchr(output, '.'), ".hdr") == 0) {
+    if (!keeps_sample_counts(output)) {
         if (image_create(&rgb, result.image.width, result.image.height, 3, &error) != RT_OK) {
             fprintf(stderr, "rtspheres render: %s\n", error.message);
             image_free(&result.image);
             scene_free(&s);
-            exit_code = EXIT_RUNTIME;
-            goto done;
+            return EXIT_RUNTIME;
         }
         size_t pixel_count = (size_t)rgb.width * rgb.height;
         for (size_t i = 0; i < pixel_count; i++)
@@ -390,50 +521,115 @@ int command_render(int argc, char **argv)
                 rgb.pixels[3 * i + c] = result.image.pixels[4 * i + c];
         colour = rgb;
     }
+    colour.x = result.region[0];
+    colour.y = result.region[1];
+    colour.full_width = s.render.width;
+    colour.full_height = s.render.height;
+
     /* Counters beyond 2^31 would not fit an EXR int attribute: they are written as text. */
-    char samples_text[32], segments_text[32], seed_text[16];
+    char samples_text[32], segments_text[32], seed_text[16], sample_start_text[16], hash_text[24];
     snprintf(seed_text, sizeof seed_text, "%u", s.render.seed);
     snprintf(samples_text, sizeof samples_text, "%llu", (unsigned long long)result.samples);
     snprintf(segments_text, sizeof segments_text, "%.0f", result.path_segments);
+    snprintf(sample_start_text, sizeof sample_start_text, "%llu", (unsigned long long)sample_start);
+    snprintf(hash_text, sizeof hash_text, "%016llx", (unsigned long long)result.scene_hash);
     image_attribute attributes[] = {
         {.name = "rtspheres:version", .type = IMAGE_ATTRIBUTE_STRING, .string_value = RTSPHERES_VERSION},
-        {.name = "rtspheres:scene", .type = IMAGE_ATTRIBUTE_STRING, .string_value = scene_path},
+        {.name = "rtspheres:scene", .type = IMAGE_ATTRIBUTE_STRING, .string_value = request->scene_path},
+        {.name = "rtspheres:scene_hash", .type = IMAGE_ATTRIBUTE_STRING, .string_value = hash_text},
         {.name = "rtspheres:spp", .type = IMAGE_ATTRIBUTE_INT, .int_value = s.render.samples_per_pixel},
+        {.name = "rtspheres:sample_start", .type = IMAGE_ATTRIBUTE_STRING, .string_value = sample_start_text},
         {.name = "rtspheres:seed", .type = IMAGE_ATTRIBUTE_STRING, .string_value = seed_text},
         {.name = "rtspheres:max_depth", .type = IMAGE_ATTRIBUTE_INT, .int_value = s.render.max_depth},
-        {.name = "rtspheres:sample_start", .type = IMAGE_ATTRIBUTE_INT, .int_value = 0},
+        {.name = "rtspheres:frame", .type = IMAGE_ATTRIBUTE_INT, .int_value = frame},
         {.name = "rtspheres:samples_finished", .type = IMAGE_ATTRIBUTE_STRING, .string_value = samples_text},
         {.name = "rtspheres:path_segments", .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
         {.name = "rtspheres:complete", .type = IMAGE_ATTRIBUTE_INT, .int_value = render_status == RT_OK},
         {.name = "rtspheres:render_seconds", .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = result.seconds},
     };
     image_write_options write_options = image_write_options_defaults();
-    write_options.exposure = (float)exposure;
+    write_options.exposure = (float)request->exposure;
     write_options.attributes = attributes;
     write_options.attribute_count = (int)(sizeof attributes / sizeof attributes[0]);
     status = image_write(output, &colour, &write_options, &error);
     image_free(&rgb);
     image_free(&result.image);
+    int exit_code = EXIT_OK;
     if (status != RT_OK) {
         fprintf(stderr, "rtspheres render: %s\n", error.message);
-        scene_free(&s);
         exit_code = exit_code_for_status(status);
-        goto done;
-    }
-    if (render_status == RT_ERROR_INTERRUPTED) {
+    } else if (render_status == RT_ERROR_INTERRUPTED) {
         fprintf(stderr, "rtspheres render: interrupted: wrote the %llu samples finished so far to %s\n",
                 (unsigned long long)result.samples, output);
         exit_code = EXIT_RUNTIME;
-    } else if (!quiet) {
+    } else if (!request->quiet) {
         fprintf(stderr, "rtspheres: %s -> %s: %dx%d, %d spp in %.2f s (%.3g samples/s, %.3g path segments/s, %d pass%s)\n",
-                scene_path, output, s.render.width, s.render.height, s.render.samples_per_pixel, result.seconds,
-                result.samples / result.seconds, result.path_segments / result.seconds, result.passes,
-                result.passes == 1 ? "" : "es");
+                request->scene_path, output, result.image.width ? result.image.width : colour.width, colour.height,
+                s.render.samples_per_pixel, result.seconds, result.samples / result.seconds,
+                result.path_segments / result.seconds, result.passes, result.passes == 1 ? "" : "es");
     }
     scene_free(&s);
+    return exit_code;
+}
+
+int command_render(int argc, char **argv)
+{
+    render_request request = {.seed = -1, .device = -1};
+    bool help_shown = false;
+    int exit_code = parse_arguments(argc, argv, &request, &help_shown);
+    if (exit_code != EXIT_OK || help_shown)
+        goto done;
+
+    gpu_options gpu = gpu_options_defaults();
+    gpu.device = request.device >= 0 ? (int)request.device + 1 : 0;
+    gpu.debug_output = request.verbose;
+    gpu.log = log_to_stderr;
+    gpu_context *context = NULL;
+    rt_error error = {{0}};
+    rt_status status = gpu_create(&gpu, &context, &error);
+    if (status != RT_OK) {
+        fprintf(stderr, "rtspheres render: %s\n", error.message);
+        exit_code = exit_code_for_status(status);
+        goto done;
+    }
+    if (request.verbose) {
+        gpu_info info;
+        gpu_get_info(context, &info);
+        fprintf(stderr, "rtspheres: rendering on %s (%s, %s)\n", info.gl_renderer, info.platform, info.gl_version);
+    }
+
+    stop_requested = 0;
+    signal(SIGINT, on_stop_signal);
+    signal(SIGTERM, on_stop_signal);
+    if (request.frames.count == 0) {
+        exit_code = render_frame(context, &request, -1, request.output);
+    } else {
+        struct timespec start, end;
+        clock_gettime(CLOCK_MONOTONIC, &start);
+        int rendered = 0;
+        for (int i = 0; i < request.frames.count && exit_code == EXIT_OK && !stop_requested; i++) {
+            if (request.shard_count && strcmp(request.shard_by, "frames") == 0 && i % request.shard_count != request.shard_index)
+                continue;
+            char name[4096];
+            output_pattern_format(request.output, request.frames.frames[i], name, sizeof name, NULL);
+            exit_code = render_frame(context, &request, request.frames.frames[i], name);
+            rendered++;
+        }
+        clock_gettime(CLOCK_MONOTONIC, &end);
+        double seconds = (double)(end.tv_sec - start.tv_sec) + (end.tv_nsec - start.tv_nsec) * 1e-9;
+        if (stop_requested && exit_code == EXIT_OK)
+            exit_code = EXIT_RUNTIME;
+        if (!request.quiet && rendered > 0)
+            fprintf(stderr, "rtspheres: %d frame%s in %.2f s (%.3g frames/s)\n", rendered, rendered == 1 ? "" : "s",
+                    seconds, rendered / seconds);
+    }
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    gpu_destroy(context);
 
 done:
-    for (int i = 0; i < define_count; i++)
-        free(define_copies[i]);
+    for (int i = 0; i < request.define_count; i++)
+        free(request.define_copies[i]);
+    frame_list_free(&request.frames);
     return exit_code;
 }

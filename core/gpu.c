@@ -474,6 +474,9 @@ static void set_parameters(gpu_tracer *tracer, const gpu_tracer_parameters *p)
     GLuint program = tracer->program;
     glUseProgram(program);
     glUniform2i(glGetUniformLocation(program, "image_size"), p->width, p->height);
+    glUniform2i(glGetUniformLocation(program, "region_origin"), p->region_x, p->region_y);
+    glUniform2i(glGetUniformLocation(program, "full_size"), p->full_width ? p->full_width : p->width,
+                p->full_height ? p->full_height : p->height);
     set_vec3(program, "camera_origin", p->camera_origin);
     set_vec3(program, "camera_lower_left", p->camera_lower_left);
     set_vec3(program, "camera_horizontal", p->camera_horizontal);

@@ -63,7 +63,9 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 
 /* Per-render parameters of the tracer shader. Vectors are world space. */
 typedef struct gpu_tracer_parameters {
-    int width, height;                    /* the image; passes cover all of it */
+    int width, height;                    /* the region rendered; passes cover all of it */
+    int region_x, region_y;               /* its top-left pixel in the full image (row 0 at top) */
+    int full_width, full_height;          /* the full image (0: the same as width, height) */
     float camera_origin[3];
     float camera_lower_left[3];           /* point on the focus plane at the image's bottom left */
     float camera_horizontal[3];           /* focus-plane vector across the image width */

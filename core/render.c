@@ -19,6 +19,17 @@ render_options render_options_defaults(void)
     return (render_options){0};
 }
 
+/* FNV-1a, 64-bit, continued from hash over size bytes. */
+static uint64_t hash_bytes(uint64_t hash, const void *data, size_t size)
+{
+    const unsigned char *bytes = data;
+    for (size_t i = 0; i < size; i++) {
+        hash ^= bytes[i];
+        hash *= 0x100000001b3ull;
+    }
+    return hash;
+}
+
 static double seconds_now(void)
 {
     struct timespec now;
@@ -28,11 +39,15 @@ static double seconds_now(void)
 
 /* Fills the tracer's parameters from the scene, its camera frame and the options. */
 static void tracer_parameters(const scene *s, const camera_frame *frame, const render_options *options,
-                              gpu_tracer_parameters *p)
+                              const int region[4], gpu_tracer_parameters *p)
 {
     memset(p, 0, sizeof *p);
-    p->width = s->render.width;
-    p->height = s->render.height;
+    p->region_x = region[0];
+    p->region_y = region[1];
+    p->width = region[2] - region[0];
+    p->height = region[3] - region[1];
+    p->full_width = s->render.width;
+    p->full_height = s->render.height;
     memcpy(p->camera_origin, frame->origin, sizeof p->camera_origin);
     memcpy(p->camera_lower_left, frame->lower_left, sizeof p->camera_lower_left);
     memcpy(p->camera_horizontal, frame->horizontal, sizeof p->camera_horizontal);
@@ -61,6 +76,18 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (options == NULL)
         options = &defaults;
 
+    int region[4] = {0, 0, s->render.width, s->render.height};
+    if (options->region[0] || options->region[1] || options->region[2] || options->region[3]) {
+        const int *r = options->region;
+        if (r[0] < 0 || r[1] < 0 || r[2] > s->render.width || r[3] > s->render.height || r[0] >= r[2] || r[1] >= r[3])
+            return rt_error_set(error, RT_ERROR_INPUT,
+                                "RENDER: region %d,%d,%d,%d is not a non-empty part of the %dx%d image", r[0], r[1],
+                                r[2], r[3], s->render.width, s->render.height);
+        memcpy(region, r, sizeof region);
+    }
+    memcpy(result->region, region, sizeof region);
+    int width = region[2] - region[0], height = region[3] - region[1];
+
     camera_frame frame;
     rt_status status = camera_frame_compute(&s->camera, s->render.width, s->render.height, &frame, error);
     if (status != RT_OK)
@@ -72,9 +99,16 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     result->bvh_depth = packed.bvh_depth;
     result->bvh_build_seconds = packed.bvh_build_seconds;
     result->packed_bytes = packed.texel_count * 16u;
+    uint64_t hash = 0xcbf29ce484222325ull;
+    hash = hash_bytes(hash, packed.texels, (size_t)packed.texel_count * 16u);
+    hash = hash_bytes(hash, &frame, sizeof frame);
+    hash = hash_bytes(hash, &s->sky, sizeof s->sky);
+    int shape[3] = {s->render.width, s->render.height, s->render.max_depth};
+    hash = hash_bytes(hash, shape, sizeof shape);
+    result->scene_hash = hash;
 
     gpu_tracer_parameters parameters;
-    tracer_parameters(s, &frame, options, &parameters);
+    tracer_parameters(s, &frame, options, region, &parameters);
     gpu_tracer *tracer = NULL;
     status = gpu_tracer_create(context, packed.texels, packed.texel_count, &parameters, &tracer, error);
     packed_scene_free(&packed);
@@ -82,7 +116,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         return status;
 
     render_progress progress = {
-        .samples_total = (uint64_t)s->render.width * s->render.height * s->render.samples_per_pixel,
+        .samples_total = (uint64_t)width * height * s->render.samples_per_pixel,
     };
     bool interrupted = false;
     bool adaptive = options->pass_work_budget == 0;
@@ -122,7 +156,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     }
 
     if (status == RT_OK)
-        status = image_create(&result->image, s->render.width, s->render.height, 4, error);
+        status = image_create(&result->image, width, height, 4, error);
     gpu_tracer_totals totals = {0};
     if (status == RT_OK)
         status = gpu_tracer_read(tracer, result->image.pixels, &totals, error);
@@ -141,7 +175,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
 
     /* Sums to means; the count stays in the fourth channel. */
     float *pixels = result->image.pixels;
-    size_t pixel_count = (size_t)s->render.width * s->render.height;
+    size_t pixel_count = (size_t)width * height;
     for (size_t i = 0; i < pixel_count; i++) {
         float count = pixels[4 * i + 3];
         result->samples += (uint64_t)count;

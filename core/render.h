@@ -17,7 +17,10 @@
  *     used for every pass. The image does not depend on it, only the time per pass.
  *   target_pass_seconds 0.25 (short passes keep progress, Ctrl-C and GPU watchdogs happy),
  *   russian_roulette_depth 4 (paths may end at random from the 5th segment on),
- *   sample_start 0, no progress callback, no stop flag.
+ *   sample_start 0, the whole image, no progress callback, no stop flag.
+ *
+ * With a region, result->image covers only the region (its pixels are exactly those of
+ * the full render: camera and random numbers use full-image pixel coordinates).
  */
 #ifndef RT_RENDER_H
 #define RT_RENDER_H
@@ -41,7 +44,9 @@ typedef struct render_options {
     uint32_t pass_work_budget;
     double target_pass_seconds;
     uint32_t russian_roulette_depth;
-    uint32_t sample_start;
+    uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */
+    int region[4];               /* x0, y0, x1, y1 (row 0 at the top, x1/y1 exclusive) of the
+                                  * full image to render; all zero: the whole image */
     void (*progress)(void *progress_context, const render_progress *progress);
     void *progress_context;
     const volatile sig_atomic_t *stop_requested;
@@ -49,6 +54,7 @@ typedef struct render_options {
 
 typedef struct render_result {
     rt_image image;              /* R, G, B, samples; free with image_free() */
+    int region[4];               /* the region image covers (x0, y0, x1, y1) */
     uint64_t samples;            /* samples finished over all pixels */
     double seconds;              /* whole render, including set-up */
     double first_pass_seconds;   /* from the start until the first pass finished */
@@ -57,6 +63,9 @@ typedef struct render_result {
     int bvh_depth;
     double bvh_build_seconds;
     uint32_t packed_bytes;
+    uint64_t scene_hash;         /* FNV-1a of what decides the image apart from the samples:
+                                  * packed scene, camera, sky, full size, max depth. Parts of
+                                  * one render share it; `merge` refuses mixed hashes. */
 } render_result;
 
 /* Returns options with every field at its default (all zero). */

@@ -1258,6 +1258,8 @@ static bool check_finished_scene(parser *p)
     for (int i = 0; i < p->options->define_count; i++) {
         const char *name = p->options->defines[i].name;
         variable *defined = find_variable(p, name, strlen(name));
+        if (p->options->defines[i].optional)
+            continue;
         if (defined == NULL || !defined->mentioned)
             return fail_without_position(p, "-D %s: the scene never sets or uses $%s", name, name);
     }

@@ -17,12 +17,16 @@
 #ifndef RT_SCENE_PARSE_H
 #define RT_SCENE_PARSE_H
 
+#include <stdbool.h>
+
 #include "scene.h"
 #include "status.h"
 
 typedef struct scene_define {
     const char *name;            /* variable name without '$' */
     const char *value;           /* text of a number or expression, e.g. "0.5" or "2*pi" */
+    bool optional;               /* true: no error when the scene does not use it
+                                  * (the renderer's own $frame and $time) */
 } scene_define;
 
 typedef struct scene_parse_options {

@@ -33,7 +33,9 @@ uniform sampler2D state_statistics;
 uniform usampler2D packed_scene;
 uniform int packed_width_log2;
 
-uniform ivec2 image_size;
+uniform ivec2 image_size;       // the region this render covers (the whole image or a crop)
+uniform ivec2 region_origin;    // its top-left pixel in the full image (row 0 at the top)
+uniform ivec2 full_size;        // the full image: camera and random numbers use its pixels
 uniform vec3 camera_origin;
 uniform vec3 camera_lower_left;
 uniform vec3 camera_horizontal;
@@ -286,7 +288,11 @@ void main()
     node_offset = header_high.z;
     node_count = header_high.w;
 
-    rng_pixel = uvec2(uint(frag_pixel.x), uint(image_size.y - 1 - frag_pixel.y));
+    // Full-image pixel, row 0 at the top: a crop or tile renders exactly the pixels
+    // (and random numbers) of the full render.
+    ivec2 image_pixel = ivec2(region_origin.x + frag_pixel.x, region_origin.y + (image_size.y - 1 - frag_pixel.y));
+    vec2 film_pixel = vec2(float(image_pixel.x), float(full_size.y - 1 - image_pixel.y));
+    rng_pixel = uvec2(image_pixel);
     rng_seed_hash = random_seed_hash(seed);
     rng_sample = sample_start + samples_started - 1u;
 
@@ -302,7 +308,7 @@ void main()
             rng_sample = sample_start + samples_started;
             samples_started++;
             vec4 u = random4(0u, 0u);
-            vec2 film = (vec2(frag_pixel) + u.xy) / vec2(image_size);
+            vec2 film = (film_pixel + u.xy) / vec2(full_size);
             vec2 lens = lens_radius * random_in_unit_disk(u.zw);
             origin = camera_origin + lens.x * camera_u + lens.y * camera_v;
             direction = normalize(camera_lower_left + film.x * camera_horizontal

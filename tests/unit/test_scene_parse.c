@@ -803,7 +803,7 @@ static void test_many_spheres(void **state)
 static void test_define_overrides_set(void **state)
 {
     (void)state;
-    scene_define defines[] = {{"t", "0.5"}, {"w", "2*pi"}};
+    scene_define defines[] = {{"t", "0.5", false}, {"w", "2*pi", false}};
     scene_parse_options options = options_with_defines(defines, 2);
     scene s;
     /* The file's set of t is skipped (its expression is not even evaluated). */
@@ -823,7 +823,7 @@ static void test_define_overrides_set(void **state)
 static void test_define_used_without_set(void **state)
 {
     (void)state;
-    scene_define defines[] = {{"r", "3"}, {"r", "4"}};   /* the later of two defines wins */
+    scene_define defines[] = {{"r", "3", false}, {"r", "4", false}};   /* the later of two defines wins */
     scene_parse_options options = options_with_defines(defines, 2);
     scene s;
     parse_ok("material m lambertian 1 1 1\nsphere 0 0 0 $r m", &options, &s);
@@ -834,7 +834,7 @@ static void test_define_used_without_set(void **state)
 static void test_define_unused_is_an_error(void **state)
 {
     (void)state;
-    scene_define defines[] = {{"t", "1"}, {"foo", "2"}};
+    scene_define defines[] = {{"t", "1", false}, {"foo", "2", false}};
     scene_parse_options options = options_with_defines(defines, 2);
     scene s;
     rt_error error = {{0}};
@@ -843,13 +843,13 @@ static void test_define_unused_is_an_error(void **state)
     assert_true(scene_is_default(&s));
 
     /* Setting it counts as a mention even if nothing uses it afterwards. */
-    scene_define set_only[] = {{"foo", "2"}};
+    scene_define set_only[] = {{"foo", "2", false}};
     options = options_with_defines(set_only, 1);
     parse_ok("set foo 1\n", &options, &s);
     scene_free(&s);
 
     /* A define named only in the skipped `set` of another define is still used. */
-    scene_define chained[] = {{"a", "1"}, {"b", "2"}, {"bc", "3"}};
+    scene_define chained[] = {{"a", "1", false}, {"b", "2", false}, {"bc", "3", false}};
     options = options_with_defines(chained, 3);
     parse_ok("set a $b + $bc*2\nmaterial m lambertian 1 1 1\nsphere 0 0 0 $a m\n", &options, &s);
     assert_double_equal(s.spheres[0].radius, 1, 0);
@@ -861,27 +861,27 @@ static void test_define_unused_is_an_error(void **state)
 static void test_define_bad_value(void **state)
 {
     (void)state;
-    scene_define bad_value[] = {{"t", "abc"}};
+    scene_define bad_value[] = {{"t", "abc", false}};
     scene_parse_options options = options_with_defines(bad_value, 1);
     assert_parse_error_with("set t 1", &options, "-D t=abc: column 3: ", "unknown name 'abc'");
 
-    scene_define bad_expression[] = {{"t", "1/0"}};
+    scene_define bad_expression[] = {{"t", "1/0", false}};
     options = options_with_defines(bad_expression, 1);
     assert_parse_error_with("set t 1", &options, "-D t=1/0: column 4: ", "division by zero");
 
-    scene_define empty[] = {{"t", ""}};
+    scene_define empty[] = {{"t", "", false}};
     options = options_with_defines(empty, 1);
     assert_parse_error_with("set t 1", &options, "-D t=: ", "empty expression");
 
-    scene_define uses_variable[] = {{"t", "$u"}};
+    scene_define uses_variable[] = {{"t", "$u", false}};
     options = options_with_defines(uses_variable, 1);
     assert_parse_error_with("set t 1", &options, "-D t=$u: column 3: ", "variables cannot be used here");
 
-    scene_define bad_name[] = {{"1x", "2"}};
+    scene_define bad_name[] = {{"1x", "2", false}};
     options = options_with_defines(bad_name, 1);
     assert_parse_error_with("set t 1", &options, "-D 1x=2: ", "'1x' is not a valid variable name");
 
-    scene_define missing_value[] = {{"t", NULL}};
+    scene_define missing_value[] = {{"t", NULL, false}};
     options = options_with_defines(missing_value, 1);
     assert_parse_error_with("set t 1", &options, "-D t: ", "missing value");
 }
@@ -1065,7 +1065,7 @@ static void test_define_applies_across_includes(void **state)
 {
     write_text(state, "vars.txt", "set radius 1\n");
     write_text(state, "top.txt", "include \"vars.txt\"\nmaterial m lambertian 1 1 1\nsphere 0 0 0 $radius m\n");
-    scene_define defines[] = {{"radius", "0.1 * 7"}};
+    scene_define defines[] = {{"radius", "0.1 * 7", false}};
     scene_parse_options options = options_with_defines(defines, 1);
     scene s;
     load_file_ok(state, "top.txt", &options, &s);
@@ -1100,7 +1100,7 @@ static void test_documented_example(void **state)
         "sphere 0 0.5 0 0.5 glass\n"
         "sphere 1.2 0.5 0 0.5 gold\n"
         "sphere 0 5 0 1 lamp\n";
-    scene_define defines[] = {{"t", "0.25"}};
+    scene_define defines[] = {{"t", "0.25", false}};
     scene_parse_options options = options_with_defines(defines, 1);
     scene s;
     parse_ok(text, &options, &s);
