@@ -53,6 +53,10 @@ static void print_help(FILE *stream)
             "      --shard I/N        part I of N of the work (see --shard-by); for job arrays\n"
             "      --shard-by KIND    frames, samples or tiles (default: frames when --frames\n"
             "                         lists several, otherwise samples)\n"
+            "      --checkpoint SECS  every SECS seconds, write the image so far to\n"
+            "                         OUTPUT-without-extension.partial.exr\n"
+            "      --resume PARTIAL   continue a partial render (a checkpoint, or what Ctrl-C\n"
+            "                         wrote); the result equals an uninterrupted render\n"
             "      --exposure STOPS   brighten 8-bit outputs by 2^STOPS (default 0)\n"
             "      --roulette-depth N paths may end at random (Russian roulette, unbiased)\n"
             "                         after N segments (default 4)\n"
@@ -94,6 +98,8 @@ typedef struct render_request {
     int tile_index, tile_count;  /* tile_count 0: no --tile */
     int shard_index, shard_count;
     const char *shard_by;
+    double checkpoint_seconds;   /* 0: no checkpoints */
+    const char *resume_path;     /* NULL: start afresh */
 } render_request;
 
 /* Parses a whole decimal integer in [minimum, maximum] into *value. Returns 0 or -1. */
@@ -190,7 +196,7 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
     enum {
         OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
         OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
-        OPTION_SHARD_BY,
+        OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME,
     };
     static const struct option long_options[] = {
         {"output", required_argument, NULL, 'o'},
@@ -209,6 +215,8 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         {"tile", required_argument, NULL, OPTION_TILE},
         {"shard", required_argument, NULL, OPTION_SHARD},
         {"shard-by", required_argument, NULL, OPTION_SHARD_BY},
+        {"checkpoint", required_argument, NULL, OPTION_CHECKPOINT},
+        {"resume", required_argument, NULL, OPTION_RESUME},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -273,6 +281,16 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
                 complaint = "--fps wants a positive number of frames per second";
             break;
         }
+        case OPTION_CHECKPOINT: {
+            char *end = NULL;
+            request->checkpoint_seconds = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !(request->checkpoint_seconds > 0) || request->checkpoint_seconds > 1e7)
+                complaint = "--checkpoint wants a positive number of seconds";
+            break;
+        }
+        case OPTION_RESUME:
+            request->resume_path = optarg;
+            break;
         case OPTION_FRAMES:
             frame_list_free(&request->frames);
             if (frame_list_parse(optarg, &request->frames, &error) != RT_OK) {
@@ -400,6 +418,10 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         fprintf(stderr, "rtspheres render: %s\n", error.message);
         return EXIT_BAD_INPUT;
     }
+    if (request->resume_path != NULL && request->frames.count > 1) {
+        fprintf(stderr, "rtspheres render: --resume continues one image; render the frames one at a time\n");
+        return EXIT_BAD_INPUT;
+    }
     if (request->shard_count) {
         const char *by = request->shard_by ? request->shard_by : request->frames.count > 1 ? "frames" : "samples";
         request->shard_by = by;
@@ -420,6 +442,133 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
             request->tile_count = request->shard_count;
         }
     }
+    return EXIT_OK;
+}
+
+/* What an output file records about the render that made it. */
+typedef struct render_job {
+    const render_request *request;
+    const scene *scene;
+    int frame;
+    long long sample_start;
+} render_job;
+
+/* The partial file of an output: the name without its extension + ".partial.exr". */
+static void partial_path_for(const char *output, char *path, size_t size)
+{
+    const char *extension = extension_of(output);
+    snprintf(path, size, "%.*s.partial.exr", (int)(strlen(output) - strlen(extension)), output);
+}
+
+/* Writes image (R, G, B means, samples) to path with the rtspheres metadata; 8-bit and
+ * HDR formats get the colour channels only. complete says whether every sample ran. */
+static rt_status write_render(const render_job *job, const rt_image *image, const char *path, uint64_t samples,
+                              bool complete, const render_result *result, rt_error *error)
+{
+    const scene *s = job->scene;
+    rt_image colour = *image;
+    rt_image rgb = {0};
+    if (!keeps_sample_counts(path)) {
+        rt_status status = image_create(&rgb, image->width, image->height, 3, error);
+        if (status != RT_OK)
+            return status;
+        size_t pixel_count = (size_t)rgb.width * rgb.height;
+        for (size_t i = 0; i < pixel_count; i++)
+            for (int c = 0; c < 3; c++)
+                rgb.pixels[3 * i + c] = image->pixels[4 * i + c];
+        colour = rgb;
+    }
+    colour.x = result->region[0];
+    colour.y = result->region[1];
+    colour.full_width = s->render.width;
+    colour.full_height = s->render.height;
+
+    /* Counters beyond 2^31 would not fit an EXR int attribute: they are written as text. */
+    char samples_text[32], segments_text[32], seed_text[16], sample_start_text[16], hash_text[24];
+    snprintf(seed_text, sizeof seed_text, "%u", s->render.seed);
+    snprintf(samples_text, sizeof samples_text, "%llu", (unsigned long long)samples);
+    snprintf(segments_text, sizeof segments_text, "%.0f", result->path_segments);
+    snprintf(sample_start_text, sizeof sample_start_text, "%llu", (unsigned long long)job->sample_start);
+    snprintf(hash_text, sizeof hash_text, "%016llx", (unsigned long long)result->scene_hash);
+    image_attribute attributes[] = {
+        {.name = "rtspheres:version", .type = IMAGE_ATTRIBUTE_STRING, .string_value = RTSPHERES_VERSION},
+        {.name = "rtspheres:scene", .type = IMAGE_ATTRIBUTE_STRING, .string_value = job->request->scene_path},
+        {.name = "rtspheres:scene_hash", .type = IMAGE_ATTRIBUTE_STRING, .string_value = hash_text},
+        {.name = "rtspheres:spp", .type = IMAGE_ATTRIBUTE_INT, .int_value = s->render.samples_per_pixel},
+        {.name = "rtspheres:sample_start", .type = IMAGE_ATTRIBUTE_STRING, .string_value = sample_start_text},
+        {.name = "rtspheres:seed", .type = IMAGE_ATTRIBUTE_STRING, .string_value = seed_text},
+        {.name = "rtspheres:max_depth", .type = IMAGE_ATTRIBUTE_INT, .int_value = s->render.max_depth},
+        {.name = "rtspheres:frame", .type = IMAGE_ATTRIBUTE_INT, .int_value = job->frame},
+        {.name = "rtspheres:samples_finished", .type = IMAGE_ATTRIBUTE_STRING, .string_value = samples_text},
+        {.name = "rtspheres:path_segments", .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
+        {.name = "rtspheres:complete", .type = IMAGE_ATTRIBUTE_INT, .int_value = complete},
+        {.name = "rtspheres:render_seconds", .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = result->seconds},
+    };
+    image_write_options write_options = image_write_options_defaults();
+    write_options.exposure = (float)job->request->exposure;
+    write_options.attributes = attributes;
+    write_options.attribute_count = (int)(sizeof attributes / sizeof attributes[0]);
+    rt_status status = image_write(path, &colour, &write_options, error);
+    image_free(&rgb);
+    return status;
+}
+
+typedef struct checkpoint_state {
+    const render_job *job;
+    const char *path;
+    int region[4];
+    bool quiet;
+} checkpoint_state;
+
+/* render_options.checkpoint: writes the image so far to the partial file. */
+static rt_status write_checkpoint(void *context, const rt_image *partial, uint64_t samples, uint64_t scene_hash,
+                                  rt_error *error)
+{
+    checkpoint_state *state = context;
+    render_result result = {.scene_hash = scene_hash};
+    memcpy(result.region, state->region, sizeof result.region);
+    rt_status status = write_render(state->job, partial, state->path, samples, false, &result, error);
+    if (status == RT_OK && !state->quiet && !isatty(STDERR_FILENO))
+        fprintf(stderr, "rtspheres: checkpoint: %llu samples in %s\n", (unsigned long long)samples, state->path);
+    return status;
+}
+
+/* Reads a partial render for --resume and checks it belongs to this render (seed, first
+ * sample, samples per pixel, region). Returns an exit code after printing why. */
+static int load_resume(const char *path, const scene *s, long long sample_start, const int region[4],
+                       rt_image *image, uint64_t *scene_hash)
+{
+    rt_error error = {{0}};
+    if (image_read(path, image, &error) != RT_OK) {
+        fprintf(stderr, "rtspheres render: --resume: %s\n", error.message);
+        return EXIT_BAD_INPUT;
+    }
+    char seed[32] = "", start[32] = "", spp[32] = "", hash[32] = "";
+    image_read_attribute(path, "rtspheres:seed", seed, sizeof seed, NULL);
+    image_read_attribute(path, "rtspheres:sample_start", start, sizeof start, NULL);
+    image_read_attribute(path, "rtspheres:spp", spp, sizeof spp, NULL);
+    image_read_attribute(path, "rtspheres:scene_hash", hash, sizeof hash, NULL);
+    const char *problem = NULL;
+    char expected[64];
+    if (hash[0] == '\0')
+        problem = "it has no rtspheres metadata (was it written by rtspheres render to .exr?)";
+    else if (strtoull(seed, NULL, 10) != s->render.seed)
+        snprintf(expected, sizeof expected, "seed %s, this render %u", seed, s->render.seed), problem = expected;
+    else if (strtoll(start, NULL, 10) != sample_start)
+        snprintf(expected, sizeof expected, "first sample %s, this render %lld", start, sample_start),
+            problem = expected;
+    else if (strtoll(spp, NULL, 10) != s->render.samples_per_pixel)
+        snprintf(expected, sizeof expected, "%s spp, this render %d", spp, s->render.samples_per_pixel),
+            problem = expected;
+    else if (image->x != region[0] || image->y != region[1] || image->width != region[2] - region[0]
+             || image->height != region[3] - region[1])
+        problem = "it covers another region of the image (size or crop differ)";
+    if (problem != NULL) {
+        fprintf(stderr, "rtspheres render: --resume %s does not belong to this render: %s\n", path, problem);
+        image_free(image);
+        return EXIT_BAD_INPUT;
+    }
+    *scene_hash = strtoull(hash, NULL, 16);
     return EXIT_OK;
 }
 
@@ -487,6 +636,30 @@ static int render_frame(gpu_context *context, const render_request *request, int
     options.pass_work_budget = (uint32_t)request->pass_budget;
     options.russian_roulette_depth = (uint32_t)request->roulette_depth;
 
+    int region[4] = {0, 0, s.render.width, s.render.height};
+    if (options.region[2] > 0)
+        memcpy(region, options.region, sizeof region);
+    render_job job = {.request = request, .scene = &s, .frame = frame, .sample_start = sample_start};
+    char partial_path[4096];
+    partial_path_for(output, partial_path, sizeof partial_path);
+    rt_image resume_image = {0};
+    if (request->resume_path != NULL) {
+        int code = load_resume(request->resume_path, &s, sample_start, region, &resume_image,
+                               &options.resume_scene_hash);
+        if (code != EXIT_OK) {
+            scene_free(&s);
+            return code;
+        }
+        options.resume = &resume_image;
+    }
+    checkpoint_state checkpoint = {.job = &job, .path = partial_path, .quiet = request->quiet};
+    memcpy(checkpoint.region, region, sizeof region);
+    if (request->checkpoint_seconds > 0) {
+        options.checkpoint_seconds = request->checkpoint_seconds;
+        options.checkpoint = write_checkpoint;
+        options.checkpoint_context = &checkpoint;
+    }
+
     char label[64] = "";
     if (frame >= 0)
         snprintf(label, sizeof label, "frame %d ", frame);
@@ -500,74 +673,41 @@ static int render_frame(gpu_context *context, const render_request *request, int
         fprintf(stderr, "\n");
     if (status != RT_OK && status != RT_ERROR_INTERRUPTED) {
         fprintf(stderr, "rtspheres render: %s\n", error.message);
+        image_free(&resume_image);
         scene_free(&s);
         return exit_code_for_status(status);
     }
     rt_status render_status = status;
 
-    /* Only EXR keeps the per-pixel sample counts; other formats get colour only. */
-    rt_image colour = result.image;
-    rt_image rgb = {0};
-    if (!keeps_sample_counts(output)) {
-        if (image_create(&rgb, result.image.width, result.image.height, 3, &error) != RT_OK) {
-            fprintf(stderr, "rtspheres render: %s\n", error.message);
-            image_free(&result.image);
-            scene_free(&s);
-            return EXIT_RUNTIME;
-        }
-        size_t pixel_count = (size_t)rgb.width * rgb.height;
-        for (size_t i = 0; i < pixel_count; i++)
-            for (int c = 0; c < 3; c++)
-                rgb.pixels[3 * i + c] = result.image.pixels[4 * i + c];
-        colour = rgb;
-    }
-    colour.x = result.region[0];
-    colour.y = result.region[1];
-    colour.full_width = s.render.width;
-    colour.full_height = s.render.height;
-
-    /* Counters beyond 2^31 would not fit an EXR int attribute: they are written as text. */
-    char samples_text[32], segments_text[32], seed_text[16], sample_start_text[16], hash_text[24];
-    snprintf(seed_text, sizeof seed_text, "%u", s.render.seed);
-    snprintf(samples_text, sizeof samples_text, "%llu", (unsigned long long)result.samples);
-    snprintf(segments_text, sizeof segments_text, "%.0f", result.path_segments);
-    snprintf(sample_start_text, sizeof sample_start_text, "%llu", (unsigned long long)sample_start);
-    snprintf(hash_text, sizeof hash_text, "%016llx", (unsigned long long)result.scene_hash);
-    image_attribute attributes[] = {
-        {.name = "rtspheres:version", .type = IMAGE_ATTRIBUTE_STRING, .string_value = RTSPHERES_VERSION},
-        {.name = "rtspheres:scene", .type = IMAGE_ATTRIBUTE_STRING, .string_value = request->scene_path},
-        {.name = "rtspheres:scene_hash", .type = IMAGE_ATTRIBUTE_STRING, .string_value = hash_text},
-        {.name = "rtspheres:spp", .type = IMAGE_ATTRIBUTE_INT, .int_value = s.render.samples_per_pixel},
-        {.name = "rtspheres:sample_start", .type = IMAGE_ATTRIBUTE_STRING, .string_value = sample_start_text},
-        {.name = "rtspheres:seed", .type = IMAGE_ATTRIBUTE_STRING, .string_value = seed_text},
-        {.name = "rtspheres:max_depth", .type = IMAGE_ATTRIBUTE_INT, .int_value = s.render.max_depth},
-        {.name = "rtspheres:frame", .type = IMAGE_ATTRIBUTE_INT, .int_value = frame},
-        {.name = "rtspheres:samples_finished", .type = IMAGE_ATTRIBUTE_STRING, .string_value = samples_text},
-        {.name = "rtspheres:path_segments", .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
-        {.name = "rtspheres:complete", .type = IMAGE_ATTRIBUTE_INT, .int_value = render_status == RT_OK},
-        {.name = "rtspheres:render_seconds", .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = result.seconds},
-    };
-    image_write_options write_options = image_write_options_defaults();
-    write_options.exposure = (float)request->exposure;
-    write_options.attributes = attributes;
-    write_options.attribute_count = (int)(sizeof attributes / sizeof attributes[0]);
-    status = image_write(output, &colour, &write_options, &error);
-    image_free(&rgb);
-    image_free(&result.image);
     int exit_code = EXIT_OK;
-    if (status != RT_OK) {
-        fprintf(stderr, "rtspheres render: %s\n", error.message);
-        exit_code = exit_code_for_status(status);
-    } else if (render_status == RT_ERROR_INTERRUPTED) {
-        fprintf(stderr, "rtspheres render: interrupted: wrote the %llu samples finished so far to %s\n",
-                (unsigned long long)result.samples, output);
+    if (render_status == RT_ERROR_INTERRUPTED) {
+        /* The partial goes next to the output, never over it: the user's last good image
+         * stays, and --resume continues from the partial. */
+        status = write_render(&job, &result.image, partial_path, result.samples, false, &result, &error);
+        if (status == RT_OK)
+            fprintf(stderr, "rtspheres render: interrupted: wrote the %llu samples finished so far to %s; "
+                            "continue with --resume %s\n", (unsigned long long)result.samples, partial_path, partial_path);
+        else
+            fprintf(stderr, "rtspheres render: interrupted, and the partial could not be written: %s\n", error.message);
         exit_code = EXIT_RUNTIME;
-    } else if (!request->quiet) {
-        fprintf(stderr, "rtspheres: %s -> %s: %dx%d, %d spp in %.2f s (%.3g samples/s, %.3g path segments/s, %d pass%s)\n",
-                request->scene_path, output, result.image.width ? result.image.width : colour.width, colour.height,
-                s.render.samples_per_pixel, result.seconds, result.samples / result.seconds,
-                result.path_segments / result.seconds, result.passes, result.passes == 1 ? "" : "es");
+    } else {
+        status = write_render(&job, &result.image, output, result.samples, true, &result, &error);
+        if (status != RT_OK) {
+            fprintf(stderr, "rtspheres render: %s\n", error.message);
+            exit_code = exit_code_for_status(status);
+        } else {
+            /* The checkpoint is ours and now superseded by the complete image. */
+            unlink(partial_path);
+            if (!request->quiet)
+                fprintf(stderr,
+                        "rtspheres: %s -> %s: %dx%d, %d spp in %.2f s (%.3g samples/s, %.3g path segments/s, %d pass%s)\n",
+                        request->scene_path, output, result.image.width, result.image.height,
+                        s.render.samples_per_pixel, result.seconds, result.samples / result.seconds,
+                        result.path_segments / result.seconds, result.passes, result.passes == 1 ? "" : "es");
+        }
     }
+    image_free(&result.image);
+    image_free(&resume_image);
     scene_free(&s);
     return exit_code;
 }

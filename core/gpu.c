@@ -463,6 +463,36 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     return status;
 }
 
+/* Loads a partial result into the state the first pass reads: the accumulated sums
+ * and, as "samples started", the finished counts (a path that was in flight is simply
+ * traced again: its random numbers are the same). */
+static rt_status load_resume_state(gpu_tracer *tracer, const float *resume, rt_error *error)
+{
+    size_t pixel_count = (size_t)tracer->width * tracer->height;
+    float *sums = malloc(pixel_count * 4 * sizeof(float));
+    uint32_t *counters = calloc(pixel_count * 4, sizeof(uint32_t));
+    if (sums == NULL || counters == NULL) {
+        free(sums);
+        free(counters);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory loading the partial render");
+    }
+    size_t row_floats = (size_t)tracer->width * 4;
+    for (int row = 0; row < tracer->height; row++) {
+        /* Rows top to bottom in memory; GL's row 0 is the bottom. */
+        const float *source = resume + (size_t)(tracer->height - 1 - row) * row_floats;
+        memcpy(sums + (size_t)row * row_floats, source, row_floats * sizeof(float));
+        for (int x = 0; x < tracer->width; x++)
+            counters[((size_t)row * tracer->width + x) * 4] = (uint32_t)source[x * 4 + 3];
+    }
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][STATE_ACCUMULATED]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA, GL_FLOAT, sums);
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][STATE_COUNTERS]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA_INTEGER, GL_UNSIGNED_INT, counters);
+    free(sums);
+    free(counters);
+    return check_gl("loading the partial render", error);
+}
+
 static void set_vec3(GLuint program, const char *name, const float value[3])
 {
     glUniform3f(glGetUniformLocation(program, name), value[0], value[1], value[2]);
@@ -514,6 +544,8 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
         status = upload_packed_scene(tracer, packed_texels, texel_count, error);
     if (status == RT_OK)
         status = create_state(tracer, error);
+    if (status == RT_OK && parameters->resume != NULL)
+        status = load_resume_state(tracer, parameters->resume, error);
     if (status != RT_OK) {
         gpu_tracer_destroy(tracer);
         return status;

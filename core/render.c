@@ -1,7 +1,9 @@
 /* render.c: see render.h. Plain C: the GL work is gpu.c's. */
 #include "render.h"
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -67,6 +69,70 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     p->pass_work_budget = options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET;
 }
 
+/* Reads the tracer's accumulation into a new width x height image of means (R, G, B) and
+ * per-pixel finished samples; *samples receives their total. The caller frees image. */
+static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, gpu_tracer_totals *totals,
+                            uint64_t *samples, rt_error *error)
+{
+    rt_status status = image_create(image, width, height, 4, error);
+    if (status == RT_OK)
+        status = gpu_tracer_read(tracer, image->pixels, totals, error);
+    if (status != RT_OK) {
+        image_free(image);
+        return status;
+    }
+    /* Sums to means; the count stays in the fourth channel. */
+    float *pixels = image->pixels;
+    size_t pixel_count = (size_t)width * height;
+    *samples = 0;
+    for (size_t i = 0; i < pixel_count; i++) {
+        float count = pixels[4 * i + 3];
+        *samples += (uint64_t)count;
+        for (int c = 0; c < 3; c++)
+            pixels[4 * i + c] = count > 0 ? pixels[4 * i + c] / count : 0.0f;
+    }
+    snprintf(image->channel_names[3], IMAGE_CHANNEL_NAME_MAX, "samples");
+    return RT_OK;
+}
+
+/* Turns a partial result (R, G, B means and a samples channel, region-sized) back into the
+ * tracer's sums. Returns an allocated width*height*4 array or NULL with error set. */
+static float *resume_sums(const rt_image *partial, int width, int height, uint32_t samples_per_pixel,
+                          uint64_t *samples_done, rt_error *error)
+{
+    int samples_channel = -1;
+    for (int c = 0; c < partial->channels; c++)
+        if (strcmp(partial->channel_names[c], "samples") == 0)
+            samples_channel = c;
+    if (partial->width != width || partial->height != height || partial->channels < 4 || samples_channel < 0) {
+        rt_error_set(error, RT_ERROR_INPUT,
+                     "RENDER: the partial render is %dx%d with %d channels; resuming needs %dx%d with R, G, B and "
+                     "samples", partial->width, partial->height, partial->channels, width, height);
+        return NULL;
+    }
+    float *sums = malloc((size_t)width * height * 4 * sizeof(float));
+    if (sums == NULL) {
+        rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
+        return NULL;
+    }
+    *samples_done = 0;
+    for (size_t i = 0; i < (size_t)width * height; i++) {
+        const float *pixel = partial->pixels + i * partial->channels;
+        float count = pixel[samples_channel];
+        if (!(count >= 0) || count > (float)samples_per_pixel || count != floorf(count)) {
+            free(sums);
+            rt_error_set(error, RT_ERROR_INPUT, "RENDER: the partial render has %g samples at pixel %zu, outside 0..%u",
+                         count, i, samples_per_pixel);
+            return NULL;
+        }
+        for (int c = 0; c < 3; c++)
+            sums[i * 4 + c] = pixel[c] * count;
+        sums[i * 4 + 3] = count;
+        *samples_done += (uint64_t)count;
+    }
+    return sums;
+}
+
 rt_status render_scene(gpu_context *context, const scene *s, const render_options *options,
                        render_result *result, rt_error *error)
 {
@@ -106,18 +172,39 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     int shape[3] = {s->render.width, s->render.height, s->render.max_depth};
     hash = hash_bytes(hash, shape, sizeof shape);
     result->scene_hash = hash;
+    if (options->resume != NULL && options->resume_scene_hash != 0 && options->resume_scene_hash != hash) {
+        packed_scene_free(&packed);
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "RENDER: the partial render was made from another scene, camera, size or depth "
+                            "(scene hash %016llx, this render %016llx)",
+                            (unsigned long long)options->resume_scene_hash, (unsigned long long)hash);
+    }
 
     gpu_tracer_parameters parameters;
     tracer_parameters(s, &frame, options, region, &parameters);
+    uint64_t samples_resumed = 0;
+    float *sums = NULL;
+    if (options->resume != NULL) {
+        sums = resume_sums(options->resume, width, height, (uint32_t)s->render.samples_per_pixel, &samples_resumed,
+                           error);
+        if (sums == NULL) {
+            packed_scene_free(&packed);
+            return RT_ERROR_INPUT;
+        }
+        parameters.resume = sums;
+    }
     gpu_tracer *tracer = NULL;
     status = gpu_tracer_create(context, packed.texels, packed.texel_count, &parameters, &tracer, error);
     packed_scene_free(&packed);
+    free(sums);
     if (status != RT_OK)
         return status;
 
     render_progress progress = {
         .samples_total = (uint64_t)width * height * s->render.samples_per_pixel,
+        .samples_done = samples_resumed,
     };
+    double last_checkpoint = seconds_now();
     bool interrupted = false;
     bool adaptive = options->pass_work_budget == 0;
     double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
@@ -153,18 +240,28 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
             interrupted = true;
             break;
         }
+        if (options->checkpoint != NULL && options->checkpoint_seconds > 0
+            && seconds_now() - last_checkpoint >= options->checkpoint_seconds) {
+            rt_image partial;
+            uint64_t partial_samples;
+            status = read_image(tracer, width, height, &partial, NULL, &partial_samples, error);
+            if (status != RT_OK)
+                break;
+            status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, result->scene_hash,
+                                         error);
+            image_free(&partial);
+            if (status != RT_OK)
+                break;
+            last_checkpoint = seconds_now();
+        }
     }
 
-    if (status == RT_OK)
-        status = image_create(&result->image, width, height, 4, error);
     gpu_tracer_totals totals = {0};
     if (status == RT_OK)
-        status = gpu_tracer_read(tracer, result->image.pixels, &totals, error);
+        status = read_image(tracer, width, height, &result->image, &totals, &result->samples, error);
     gpu_tracer_destroy(tracer);
-    if (status != RT_OK) {
-        image_free(&result->image);
+    if (status != RT_OK)
         return status;
-    }
     if (totals.traversal_overflows > 0) {
         image_free(&result->image);
         return rt_error_set(error, RT_ERROR_RUNTIME,
@@ -173,16 +270,6 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
                             totals.traversal_overflows);
     }
 
-    /* Sums to means; the count stays in the fourth channel. */
-    float *pixels = result->image.pixels;
-    size_t pixel_count = (size_t)width * height;
-    for (size_t i = 0; i < pixel_count; i++) {
-        float count = pixels[4 * i + 3];
-        result->samples += (uint64_t)count;
-        for (int c = 0; c < 3; c++)
-            pixels[4 * i + c] = count > 0 ? pixels[4 * i + c] / count : 0.0f;
-    }
-    snprintf(result->image.channel_names[3], IMAGE_CHANNEL_NAME_MAX, "samples");
     result->passes = progress.passes;
     result->path_segments = totals.path_segments;
     result->seconds = seconds_now() - start;

@@ -50,6 +50,19 @@ typedef struct render_options {
     void (*progress)(void *progress_context, const render_progress *progress);
     void *progress_context;
     const volatile sig_atomic_t *stop_requested;
+    /* Continue a partial render: an image of the region with R, G, B means and a
+     * "samples" channel (as render_scene returns and an EXR keeps). A pixel with n
+     * samples goes on from sample index sample_start + n, so the result equals an
+     * uninterrupted render up to float rounding of mean * n. NULL: start afresh. */
+    const rt_image *resume;
+    uint64_t resume_scene_hash;  /* with resume: must equal this render's scene_hash (0: unchecked) */
+    /* Every checkpoint_seconds (0: never), checkpoint() receives the image so far (the
+     * same layout as the result), the samples it holds and the render's scene_hash; a non-OK status stops the
+     * render with that status. */
+    double checkpoint_seconds;
+    rt_status (*checkpoint)(void *checkpoint_context, const rt_image *partial, uint64_t samples, uint64_t scene_hash,
+                            rt_error *error);
+    void *checkpoint_context;
 } render_options;
 
 typedef struct render_result {

@@ -1,0 +1,106 @@
+#!/bin/sh
+# test-interrupt.sh: nothing is lost when a render is interrupted. SIGINT/SIGTERM finish
+# the pass in flight and write the samples so far to OUTPUT-base.partial.exr (never over
+# the output), --checkpoint writes that file periodically, and --resume continues it to
+# the same image as an uninterrupted render.
+#   usage: sh tests/render/test-interrupt.sh PROGRAM SCRATCH_DIR
+set -u
+program=$1
+scratch=$2
+. "$(dirname "$0")/lib.sh"
+scene=scenes/materials/lambertian.txt
+# About 9 million samples: several seconds on llvmpipe, so the signals land mid-render.
+options="--size 64x36 --spp 4096 --seed 3"
+
+# interrupt_after SECONDS SIGNAL OUTPUT [OPTIONS...]: starts a render, signals it, waits;
+# prints the exit code.
+interrupt_after() {
+    delay=$1 signal=$2 output=$3
+    shift 3
+    # shellcheck disable=SC2086
+    "$program" render $scene -o "$output" $options "$@" 2>"$scratch/interrupt.err" &
+    pid=$!
+    sleep "$delay"
+    kill -s "$signal" "$pid" 2>/dev/null
+    wait "$pid"
+    echo $?
+}
+
+# SIGINT: exit 1, the partial holds fewer samples than asked, the existing output stays.
+printf 'previous image' >"$scratch/out.png"
+code=$(interrupt_after 1 INT "$scratch/out.png")
+partial="$scratch/out.partial.exr"
+if [ "$code" = 1 ] && [ -f "$partial" ] && [ "$(metadata "$partial" complete)" = 0 ]; then
+    pass "SIGINT writes the partial render and exits 1"
+else
+    fail "SIGINT writes the partial render and exits 1" "exit $code; $(cat "$scratch/interrupt.err")"
+fi
+if [ "$(cat "$scratch/out.png")" = "previous image" ]; then pass "SIGINT leaves the existing output as it was"
+else fail "SIGINT leaves the existing output as it was" "out.png changed"; fi
+range=$(channel_range "$partial" samples)
+if awk -v r="$range" 'BEGIN { split(r, v, " "); exit !(v[1] >= 0 && v[2] <= 4096 && v[1] < 4096) }'; then
+    pass "partial records real per-pixel sample counts ($range)"
+else fail "partial sample counts" "samples channel range '$range'"; fi
+
+# SIGTERM behaves the same.
+code=$(interrupt_after 1 TERM "$scratch/term.exr")
+if [ "$code" = 1 ] && [ -f "$scratch/term.partial.exr" ] && [ ! -f "$scratch/term.exr" ]; then
+    pass "SIGTERM writes the partial render, not the output"
+else fail "SIGTERM" "exit $code, files: $(ls "$scratch" | tr '\n' ' ')"; fi
+
+# --resume gives the image of an uninterrupted render (to float rounding of mean * n),
+# and removes the partial once the output is complete.
+"$program" render $scene -o "$scratch/reference.exr" $options --quiet
+# shellcheck disable=SC2086
+if "$program" render $scene -o "$scratch/out.exr" $options --resume "$partial" --quiet; then
+    if "$program" diff "$scratch/out.exr" "$scratch/reference.exr" --fail 1e-5 --failpercent 0 >"$scratch/diff.txt"; then
+        pass "resumed render equals the uninterrupted one"
+    else fail "resumed render equals the uninterrupted one" "$(tr '\n' ' ' <"$scratch/diff.txt")"; fi
+    samples=$(channel_range "$scratch/out.exr" samples)
+    if [ "$samples" = "4096 4096" ]; then pass "resumed render has every sample"
+    else fail "resumed render has every sample" "samples $samples"; fi
+else
+    fail "resume" "the resumed render failed"
+fi
+if [ ! -f "$scratch/out.partial.exr" ]; then pass "the partial is removed when the render completes"
+else fail "the partial is removed when the render completes" "it is still there"; fi
+
+# A partial of another render is refused: different seed, different size.
+code=$(interrupt_after 1 INT "$scratch/other.exr")
+# shellcheck disable=SC2086
+"$program" render $scene -o "$scratch/x.exr" --size 64x36 --spp 4096 --seed 4 --resume "$scratch/other.partial.exr" \
+    2>"$scratch/err" >/dev/null
+code=$?
+if [ "$code" = 2 ] && grep -q "seed" "$scratch/err"; then pass "resume refuses another seed"
+else fail "resume refuses another seed" "exit $code: $(cat "$scratch/err")"; fi
+"$program" render $scene -o "$scratch/x.exr" --size 32x18 --spp 4096 --seed 3 --resume "$scratch/other.partial.exr" \
+    2>"$scratch/err" >/dev/null
+code=$?
+if [ "$code" = 2 ]; then pass "resume refuses another size"
+else fail "resume refuses another size" "exit $code: $(cat "$scratch/err")"; fi
+
+# --checkpoint writes the partial while the render runs.
+# shellcheck disable=SC2086
+"$program" render $scene -o "$scratch/cp.exr" $options --checkpoint 0.3 --quiet &
+pid=$!
+sleep 1.5
+if [ -f "$scratch/cp.partial.exr" ] && [ "$(metadata "$scratch/cp.partial.exr" complete)" = 0 ]; then
+    pass "--checkpoint writes the partial during the render"
+else fail "--checkpoint writes the partial during the render" "no cp.partial.exr after 1.5 s"; fi
+kill -s KILL "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+
+# A second signal ends the render at once (the default action): death by SIGINT.
+# shellcheck disable=SC2086
+"$program" render $scene -o "$scratch/twice.exr" --size 64x36 --spp 100000 --quiet &
+pid=$!
+sleep 1
+kill -s INT "$pid"
+sleep 0.2
+kill -s INT "$pid"
+wait "$pid"
+code=$?
+# 130 = 128 + SIGINT: the process died of the signal instead of finishing its pass.
+if [ "$code" = 130 ]; then pass "a second SIGINT stops at once (exit $code)"
+else fail "a second SIGINT stops at once" "exit $code, expected 130 (killed by SIGINT)"; fi
+finish
