@@ -720,6 +720,13 @@ int command_render(int argc, char **argv)
     if (exit_code != EXIT_OK || help_shown)
         goto done;
 
+    /* Handlers go in before the (possibly slow, cold) GPU set-up: a signal then must not
+     * kill the process without a word, and one that arrives before the first pass simply
+     * ends the render early (nothing is written when no sample finished). */
+    stop_requested = 0;
+    signal(SIGINT, on_stop_signal);
+    signal(SIGTERM, on_stop_signal);
+
     gpu_options gpu = gpu_options_defaults();
     gpu.device = request.device >= 0 ? (int)request.device + 1 : 0;
     gpu.debug_output = request.verbose;
@@ -732,15 +739,18 @@ int command_render(int argc, char **argv)
         exit_code = exit_code_for_status(status);
         goto done;
     }
+    if (stop_requested) {
+        fprintf(stderr, "rtspheres render: interrupted before the render started; nothing written\n");
+        gpu_destroy(context);
+        exit_code = EXIT_RUNTIME;
+        goto done;
+    }
     if (request.verbose) {
         gpu_info info;
         gpu_get_info(context, &info);
         fprintf(stderr, "rtspheres: rendering on %s (%s, %s)\n", info.gl_renderer, info.platform, info.gl_version);
     }
 
-    stop_requested = 0;
-    signal(SIGINT, on_stop_signal);
-    signal(SIGTERM, on_stop_signal);
     if (request.frames.count == 0) {
         exit_code = render_frame(context, &request, -1, request.output);
     } else {
@@ -768,6 +778,8 @@ int command_render(int argc, char **argv)
     gpu_destroy(context);
 
 done:
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
     for (int i = 0; i < request.define_count; i++)
         free(request.define_copies[i]);
     frame_list_free(&request.frames);

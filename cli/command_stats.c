@@ -20,9 +20,9 @@ static void print_help(FILE *stream)
 }
 
 static const char *const metadata_names[] = {
-    "rtspheres:version", "rtspheres:scene", "rtspheres:spp", "rtspheres:seed", "rtspheres:max_depth",
+    "rtspheres:version", "rtspheres:scene", "rtspheres:scene_hash", "rtspheres:frame", "rtspheres:spp", "rtspheres:seed", "rtspheres:max_depth",
     "rtspheres:sample_start", "rtspheres:samples_finished", "rtspheres:path_segments", "rtspheres:complete",
-    "rtspheres:render_seconds",
+    "rtspheres:render_seconds", "rtspheres:merged_parts",
 };
 
 int command_stats(int argc, char **argv)

@@ -12,7 +12,7 @@
  * config.max_depth: a node at that depth becomes a leaf whatever its size.
  *
  * Defaults of bvh_build_config (zero means default):
- *   max_leaf_size 4, bin_count 16, max_depth BVH_MAX_DEPTH (48),
+ *   max_leaf_size 4, bin_count 16, max_depth BVH_MAX_DEPTH (24),
  *   traversal_cost 1.0, intersection_cost 1.0
  */
 #ifndef RT_BVH_H

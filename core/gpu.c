@@ -514,6 +514,13 @@ static void set_parameters(gpu_tracer *tracer, const gpu_tracer_parameters *p)
     set_vec3(program, "camera_u", p->camera_u);
     set_vec3(program, "camera_v", p->camera_v);
     glUniform1f(glGetUniformLocation(program, "lens_radius"), p->lens_radius);
+    glUniform1f(glGetUniformLocation(program, "shutter_open"), p->shutter_open);
+    glUniform1f(glGetUniformLocation(program, "shutter_close"), p->shutter_close);
+    glUniform1ui(glGetUniformLocation(program, "camera_media"), p->camera_media);
+    glUniform1f(glGetUniformLocation(program, "sky_intensity"), p->sky_intensity);
+    glUniform1f(glGetUniformLocation(program, "sky_rotation"), p->sky_rotation_radians);
+    glUniform1uiv(glGetUniformLocation(program, "sky_faces"), 6, p->sky_faces);
+    glUniform1ui(glGetUniformLocation(program, "sky_environment"), p->sky_environment);
     glUniform1i(glGetUniformLocation(program, "sky_type"), p->sky_type);
     set_vec3(program, "sky_bottom", p->sky_bottom);
     set_vec3(program, "sky_top", p->sky_top);

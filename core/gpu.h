@@ -72,8 +72,14 @@ typedef struct gpu_tracer_parameters {
     float camera_vertical[3];             /* focus-plane vector up the image height */
     float camera_u[3], camera_v[3];       /* lens axes (right, up), unit length */
     float lens_radius;
+    float shutter_open, shutter_close;    /* ray times are uniform in [open, close] */
+    uint32_t camera_media;                /* volumes the camera is in (pack.h: packed_media_at) */
     int sky_type;                         /* SKY_* of scene.h */
     float sky_bottom[3], sky_top[3];
+    float sky_intensity;
+    float sky_rotation_radians;           /* about +Y */
+    uint32_t sky_faces[6];                /* image indices of the sky box faces */
+    uint32_t sky_environment;             /* image index of the environment map */
     uint32_t seed;
     uint32_t sample_start;                /* first sample index (sample ranges) */
     uint32_t samples_per_pixel;

@@ -25,19 +25,338 @@ static float bits_float(uint32_t bits)
     return value;
 }
 
-static void put_texel(uint32_t *texels, uint32_t index, uint32_t x, uint32_t y, uint32_t z, uint32_t w)
-{
-    texels[4 * (size_t)index + 0] = x;
-    texels[4 * (size_t)index + 1] = y;
-    texels[4 * (size_t)index + 2] = z;
-    texels[4 * (size_t)index + 3] = w;
-}
-
 static double seconds_now(void)
 {
     struct timespec now;
     clock_gettime(CLOCK_MONOTONIC, &now);
     return now.tv_sec + now.tv_nsec * 1e-9;
+}
+
+/* ---- primitives before packing ------------------------------------------------------- */
+
+/* One primitive on its way into a BVH: what to write and its bounding box. */
+typedef struct pending_primitive {
+    uint32_t type;
+    uint32_t material;           /* PACKED_NONE: the instance's */
+    uint32_t instance;           /* PRIMITIVE_INSTANCE */
+    int32_t mesh, triangle;      /* mesh triangles: where to read attributes; else -1 */
+    float data[3][4];
+    bvh_box box;
+} pending_primitive;
+
+typedef struct primitive_list {
+    pending_primitive *items;
+    uint32_t count, capacity;
+} primitive_list;
+
+/* Appends an item; returns a pointer to it, or NULL when memory runs out. */
+static pending_primitive *list_push(primitive_list *list)
+{
+    if (list->count == list->capacity) {
+        uint32_t capacity = list->capacity ? list->capacity * 2 : 64;
+        pending_primitive *grown = realloc(list->items, (size_t)capacity * sizeof *grown);
+        if (grown == NULL)
+            return NULL;
+        list->items = grown;
+        list->capacity = capacity;
+    }
+    pending_primitive *item = &list->items[list->count++];
+    memset(item, 0, sizeof *item);
+    item->mesh = item->triangle = -1;
+    item->material = PACKED_NONE;
+    item->instance = PACKED_NONE;
+    return item;
+}
+
+static void box_empty(bvh_box *box)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        box->min[axis] = INFINITY;
+        box->max[axis] = -INFINITY;
+    }
+}
+
+static void box_add_point(bvh_box *box, const float p[3])
+{
+    for (int axis = 0; axis < 3; axis++) {
+        box->min[axis] = fminf(box->min[axis], p[axis]);
+        box->max[axis] = fmaxf(box->max[axis], p[axis]);
+    }
+}
+
+/* Pads a box by a few float steps: corners computed in float round, and a box that cuts
+ * off a sliver of its primitive would make grazing rays miss it. */
+static void box_pad(bvh_box *box)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        float pad = 1e-6f * (fabsf(box->min[axis]) + fabsf(box->max[axis])) + 1e-7f;
+        box->min[axis] -= pad;
+        box->max[axis] += pad;
+    }
+}
+
+static void sphere_box(bvh_box *box, const float center[3], float radius)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        box->min[axis] = fminf(box->min[axis], center[axis] - radius);
+        box->max[axis] = fmaxf(box->max[axis], center[axis] + radius);
+    }
+}
+
+/* Fills item from a scene shape (material already resolved) and computes its box. */
+static void pending_from_shape(pending_primitive *item, const scene_shape *shape, uint32_t material)
+{
+    item->material = material;
+    box_empty(&item->box);
+    const float (*p)[3] = shape->points;
+    switch (shape->type) {
+    case SHAPE_SPHERE:
+        item->type = PRIMITIVE_SPHERE;
+        memcpy(item->data[0], p[0], 3 * sizeof(float));
+        item->data[0][3] = shape->radius;
+        sphere_box(&item->box, p[0], shape->radius);
+        break;
+    case SHAPE_MOVING_SPHERE:
+        item->type = PRIMITIVE_MOVING_SPHERE;
+        memcpy(item->data[0], p[0], 3 * sizeof(float));
+        item->data[0][3] = shape->radius;
+        memcpy(item->data[1], p[1], 3 * sizeof(float));
+        sphere_box(&item->box, p[0], shape->radius);
+        sphere_box(&item->box, p[1], shape->radius);
+        break;
+    case SHAPE_TRIANGLE:
+        item->type = PRIMITIVE_TRIANGLE;
+        memcpy(item->data[0], p[0], 3 * sizeof(float));
+        for (int axis = 0; axis < 3; axis++) {
+            item->data[1][axis] = p[1][axis] - p[0][axis];
+            item->data[2][axis] = p[2][axis] - p[0][axis];
+        }
+        for (int k = 0; k < 3; k++)
+            box_add_point(&item->box, p[k]);
+        break;
+    case SHAPE_QUAD:
+        item->type = PRIMITIVE_QUAD;
+        for (int k = 0; k < 3; k++)
+            memcpy(item->data[k], p[k], 3 * sizeof(float));
+        for (int corner = 0; corner < 4; corner++) {
+            float q[3];
+            for (int axis = 0; axis < 3; axis++)
+                q[axis] = p[0][axis] + ((corner & 1) ? p[1][axis] : 0) + ((corner & 2) ? p[2][axis] : 0);
+            box_add_point(&item->box, q);
+        }
+        break;
+    }
+    box_pad(&item->box);
+}
+
+/* Fills item from triangle t of a loaded mesh. */
+static void pending_from_triangle(pending_primitive *item, const scene_mesh *mesh, int mesh_index, int t)
+{
+    scene_shape shape = {.type = SHAPE_TRIANGLE};
+    for (int k = 0; k < 3; k++)
+        memcpy(shape.points[k], mesh->positions + 3 * (size_t)mesh->indices[3 * (size_t)t + k], 3 * sizeof(float));
+    int material = mesh->triangle_materials ? mesh->triangle_materials[t] : -1;
+    pending_from_shape(item, &shape, material >= 0 ? (uint32_t)material : PACKED_NONE);
+    if (mesh->normals != NULL || mesh->uvs != NULL) {
+        item->mesh = mesh_index;
+        item->triangle = t;
+    }
+}
+
+/* ---- transforms ---------------------------------------------------------------------- */
+
+/* Inverts the affine 3x4 matrix m into inverse. Returns false when it is singular. */
+static bool invert_affine(const float m[3][4], float inverse[3][4])
+{
+    double a[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            a[r][c] = m[r][c];
+    double cofactor[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            cofactor[r][c] = a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1];
+        }
+    double determinant = a[0][0] * cofactor[0][0] + a[0][1] * cofactor[0][1] + a[0][2] * cofactor[0][2];
+    if (!(fabs(determinant) > 1e-30))
+        return false;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            inverse[r][c] = (float)(cofactor[c][r] / determinant);
+    for (int r = 0; r < 3; r++)
+        inverse[r][3] = -(inverse[r][0] * m[0][3] + inverse[r][1] * m[1][3] + inverse[r][2] * m[2][3]);
+    return true;
+}
+
+static bool is_identity(const float m[3][4])
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++)
+            if (m[r][c] != (r == c ? 1.0f : 0.0f))
+                return false;
+    return true;
+}
+
+/* The world box of an object box under object_to_world (its 8 corners transformed). */
+static bvh_box transform_box(const bvh_box *box, const float m[3][4])
+{
+    bvh_box world;
+    box_empty(&world);
+    for (int corner = 0; corner < 8; corner++) {
+        float p[3] = {(corner & 1) ? box->max[0] : box->min[0], (corner & 2) ? box->max[1] : box->min[1],
+                      (corner & 4) ? box->max[2] : box->min[2]};
+        float q[3];
+        for (int r = 0; r < 3; r++)
+            q[r] = m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3];
+        box_add_point(&world, q);
+    }
+    box_pad(&world);
+    return world;
+}
+
+/* ---- BVHs ---------------------------------------------------------------------------- */
+
+/* A built BVH over a primitive list, kept until everything is placed. */
+typedef struct built_tree {
+    primitive_list primitives;
+    bvh tree;
+    uint32_t node_base, primitive_base;   /* where it lands in the packed arrays */
+} built_tree;
+
+/* Builds the BVH of list (the list stays in caller order; tree.primitive_indices orders it). */
+static rt_status build_tree(built_tree *built, const pack_options *options, double *seconds, rt_error *error)
+{
+    uint32_t count = built->primitives.count;
+    bvh_box *boxes = malloc((count ? count : 1) * sizeof *boxes);
+    if (boxes == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+    for (uint32_t i = 0; i < count; i++)
+        boxes[i] = built->primitives.items[i].box;
+    double start = seconds_now();
+    rt_status status = bvh_build(boxes, count, options->bvh_config, &built->tree, error);
+    *seconds += seconds_now() - start;
+    free(boxes);
+    return status;
+}
+
+static void put_texel(uint32_t *texels, uint64_t index, uint32_t x, uint32_t y, uint32_t z, uint32_t w)
+{
+    texels[4 * index + 0] = x;
+    texels[4 * index + 1] = y;
+    texels[4 * index + 2] = z;
+    texels[4 * index + 3] = w;
+}
+
+/* The attribute record of a mesh triangle: vertex normals and uvs (zero where absent). */
+static void write_attributes(uint32_t *texels, uint64_t base, const scene_mesh *mesh, int t)
+{
+    float n[3][3] = {{0}}, uv[3][2] = {{0}};
+    uint32_t flags = 0;
+    for (int k = 0; k < 3; k++) {
+        uint32_t v = mesh->indices[3 * (size_t)t + k];
+        if (mesh->normals) {
+            memcpy(n[k], mesh->normals + 3 * (size_t)v, 3 * sizeof(float));
+            flags |= ATTRIBUTE_HAS_NORMALS;
+        }
+        if (mesh->uvs) {
+            memcpy(uv[k], mesh->uvs + 2 * (size_t)v, 2 * sizeof(float));
+            flags |= ATTRIBUTE_HAS_UVS;
+        }
+    }
+    put_texel(texels, base + 0, float_bits(n[0][0]), float_bits(n[0][1]), float_bits(n[0][2]), float_bits(uv[0][0]));
+    put_texel(texels, base + 1, float_bits(n[1][0]), float_bits(n[1][1]), float_bits(n[1][2]), float_bits(uv[0][1]));
+    put_texel(texels, base + 2, float_bits(n[2][0]), float_bits(n[2][1]), float_bits(n[2][2]), float_bits(uv[1][0]));
+    put_texel(texels, base + 3, float_bits(uv[1][1]), float_bits(uv[2][0]), float_bits(uv[2][1]), flags);
+}
+
+/* ---- the whole scene ----------------------------------------------------------------- */
+
+typedef struct packer {
+    const scene *scene;
+    const pack_options *options;
+    built_tree top;
+    built_tree *objects;         /* per scene object: its BVH when an instance needs one */
+    bool *object_needed;
+    uint32_t *instance_of_scene; /* scene instance -> packed instance index or PACKED_NONE */
+    uint32_t packed_instances;
+    packed_scene *out;
+} packer;
+
+/* Resolves a shape's material against an instance override: the shape's own, else the
+ * override, else PACKED_NONE (the shader then uses the instance's or the default). */
+static uint32_t resolve_material(int own, int override)
+{
+    if (own >= 0)
+        return (uint32_t)own;
+    if (override >= 0)
+        return (uint32_t)override;
+    return PACKED_NONE;
+}
+
+/* Adds the primitives of scene object index to list; materials resolved with override
+ * (for objects copied into the top level) or left to the instance (override = -2). */
+static rt_status add_object_primitives(packer *p, int index, int override, primitive_list *list, rt_error *error)
+{
+    const scene *s = p->scene;
+    const scene_object *object = &s->objects[index];
+    if (object->mesh >= 0) {
+        const scene_mesh *mesh = &s->meshes[object->mesh];
+        if (mesh->positions == NULL && mesh->triangle_count > 0)
+            return rt_error_set(error, RT_ERROR_INPUT, "PACK: mesh '%s' was not loaded", mesh->path);
+        for (int t = 0; t < mesh->triangle_count; t++) {
+            pending_primitive *item = list_push(list);
+            if (item == NULL)
+                return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+            pending_from_triangle(item, mesh, object->mesh, t);
+            if (item->material == PACKED_NONE && override >= 0)
+                item->material = (uint32_t)override;
+        }
+        return RT_OK;
+    }
+    for (int k = 0; k < object->shape_count; k++) {
+        const scene_shape *shape = &s->shapes[object->first_shape + k];
+        pending_primitive *item = list_push(list);
+        if (item == NULL)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+        pending_from_shape(item, shape, resolve_material(shape->material, override));
+    }
+    return RT_OK;
+}
+
+/* Collects the top level: world spheres, identity placements copied in, instances. */
+static rt_status collect(packer *p, rt_error *error)
+{
+    const scene *s = p->scene;
+    for (int i = 0; i < s->sphere_count; i++) {
+        pending_primitive *item = list_push(&p->top.primitives);
+        if (item == NULL)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+        scene_shape shape = {.type = SHAPE_SPHERE, .radius = s->spheres[i].radius};
+        memcpy(shape.points[0], s->spheres[i].center, sizeof shape.points[0]);
+        pending_from_shape(item, &shape, (uint32_t)s->spheres[i].material);
+    }
+    for (int i = 0; i < s->instance_count; i++) {
+        const scene_instance *instance = &s->instances[i];
+        if (instance->object < 0 || instance->object >= s->object_count)
+            return rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d names object %d of %d", i, instance->object,
+                                s->object_count);
+        const scene_object *object = &s->objects[instance->object];
+        bool copy_in = !instance->volume && object->mesh < 0 && is_identity(instance->object_to_world);
+        p->instance_of_scene[i] = PACKED_NONE;
+        if (copy_in) {
+            rt_status status = add_object_primitives(p, instance->object, instance->material, &p->top.primitives, error);
+            if (status != RT_OK)
+                return status;
+            continue;
+        }
+        p->object_needed[instance->object] = true;
+        /* The shader keeps a path's media as 16-bit instance numbers. */
+        if (instance->volume && p->packed_instances >= 65534)
+            return rt_error_set(error, RT_ERROR_INPUT, "PACK: more than 65533 instances come before volume %d", i);
+        p->instance_of_scene[i] = p->packed_instances++;
+    }
+    return RT_OK;
 }
 
 rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *out, rt_error *error)
@@ -46,87 +365,235 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     pack_options defaults = pack_options_defaults();
     if (options == NULL)
         options = &defaults;
+    packer p = {.scene = s, .options = options, .out = out};
+    rt_status status = RT_OK;
+    uint32_t *texels = NULL;
+    p.objects = calloc((size_t)s->object_count + 1, sizeof *p.objects);
+    p.object_needed = calloc((size_t)s->object_count + 1, sizeof *p.object_needed);
+    p.instance_of_scene = calloc((size_t)s->instance_count + 1, sizeof *p.instance_of_scene);
+    if (p.objects == NULL || p.object_needed == NULL || p.instance_of_scene == NULL) {
+        status = rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+        goto done;
+    }
+    status = collect(&p, error);
 
-    uint32_t primitive_count = (uint32_t)s->sphere_count;
-    bvh_box *boxes = malloc((primitive_count ? primitive_count : 1) * sizeof *boxes);
-    if (boxes == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
-    for (uint32_t i = 0; i < primitive_count; i++) {
-        const scene_sphere *sphere = &s->spheres[i];
-        for (int axis = 0; axis < 3; axis++) {
-            /* Padded by a few float steps: centre +- radius rounds, and a box that
-             * cuts off a sliver of its sphere would make grazing rays miss it. */
-            float pad = 1e-6f * (fabsf(sphere->center[axis]) + sphere->radius);
-            boxes[i].min[axis] = sphere->center[axis] - sphere->radius - pad;
-            boxes[i].max[axis] = sphere->center[axis] + sphere->radius + pad;
+    /* Bottom-level BVHs, one per object an instance needs. */
+    for (int o = 0; o < s->object_count && status == RT_OK; o++) {
+        if (!p.object_needed[o])
+            continue;
+        status = add_object_primitives(&p, o, -2, &p.objects[o].primitives, error);
+        if (status == RT_OK && p.objects[o].primitives.count == 0)
+            status = rt_error_set(error, RT_ERROR_INPUT, "PACK: object %d placed by an instance is empty", o);
+        if (status == RT_OK)
+            status = build_tree(&p.objects[o], options, &out->bvh_build_seconds, error);
+        if (status == RT_OK && p.objects[o].tree.depth > out->bvh_depth)
+            out->bvh_depth = p.objects[o].tree.depth;
+    }
+    /* One top-level item per instance, boxed by its object's root box in the world. */
+    for (int i = 0; i < s->instance_count && status == RT_OK; i++) {
+        if (p.instance_of_scene[i] == PACKED_NONE)
+            continue;
+        const scene_instance *instance = &s->instances[i];
+        pending_primitive *item = list_push(&p.top.primitives);
+        if (item == NULL) {
+            status = rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+            break;
+        }
+        item->type = PRIMITIVE_INSTANCE;
+        item->instance = p.instance_of_scene[i];
+        item->box = transform_box(&p.objects[instance->object].tree.nodes[0].box, instance->object_to_world);
+    }
+    if (status == RT_OK)
+        status = build_tree(&p.top, options, &out->bvh_build_seconds, error);
+    if (status != RT_OK)
+        goto done;
+    if (p.top.tree.depth > out->bvh_depth)
+        out->bvh_depth = p.top.tree.depth;
+
+    /* Where everything goes: top level first (root node 0), then each object's BVH. */
+    uint64_t node_count = p.top.primitives.count ? p.top.tree.node_count : 0;
+    uint64_t primitive_count = p.top.primitives.count;
+    uint64_t attribute_count = 0;
+    for (uint32_t k = 0; k < p.top.primitives.count; k++)
+        attribute_count += p.top.primitives.items[k].mesh >= 0;
+    for (int o = 0; o < s->object_count; o++) {
+        if (!p.object_needed[o])
+            continue;
+        p.objects[o].node_base = (uint32_t)node_count;
+        p.objects[o].primitive_base = (uint32_t)primitive_count;
+        node_count += p.objects[o].tree.node_count;
+        primitive_count += p.objects[o].primitives.count;
+        for (uint32_t k = 0; k < p.objects[o].primitives.count; k++)
+            attribute_count += p.objects[o].primitives.items[k].mesh >= 0;
+    }
+    uint64_t image_pixels = 0;
+    for (int i = 0; i < s->image_count; i++)
+        image_pixels += (uint64_t)s->images[i].width * s->images[i].height;
+
+    uint64_t material_count = (uint64_t)s->material_count + 1;
+    uint64_t material_offset = PACKED_HEADER_TEXELS;
+    uint64_t primitive_offset = material_offset + material_count * PACKED_MATERIAL_STRIDE;
+    uint64_t attribute_offset = primitive_offset + primitive_count * PACKED_PRIMITIVE_STRIDE;
+    uint64_t node_offset = attribute_offset + attribute_count * PACKED_ATTRIBUTE_STRIDE;
+    uint64_t instance_offset = node_offset + node_count * PACKED_NODE_STRIDE;
+    uint64_t texture_offset = instance_offset + (uint64_t)p.packed_instances * PACKED_INSTANCE_STRIDE;
+    uint64_t image_offset = texture_offset + (uint64_t)s->texture_count * PACKED_TEXTURE_STRIDE;
+    uint64_t pixel_offset = image_offset + (uint64_t)s->image_count * PACKED_IMAGE_STRIDE;
+    uint64_t texel_count = pixel_offset + image_pixels;
+    if (texel_count > UINT32_MAX / 4) {
+        status = rt_error_set(error, RT_ERROR_INPUT, "PACK: the scene needs %llu texels, more than 32-bit indices reach",
+                              (unsigned long long)texel_count);
+        goto done;
+    }
+    texels = calloc(texel_count, 4 * sizeof(uint32_t));
+    if (texels == NULL) {
+        status = rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory for %llu texels",
+                              (unsigned long long)texel_count);
+        goto done;
+    }
+    uint32_t default_material = (uint32_t)s->material_count;
+    put_texel(texels, 0, PACKED_MAGIC, PACKED_LAYOUT_VERSION, (uint32_t)material_offset, (uint32_t)material_count);
+    put_texel(texels, 1, (uint32_t)primitive_offset, (uint32_t)primitive_count, (uint32_t)node_offset,
+              (uint32_t)node_count);
+    put_texel(texels, 2, (uint32_t)instance_offset, p.packed_instances, (uint32_t)attribute_offset, default_material);
+    put_texel(texels, 3, (uint32_t)texture_offset, (uint32_t)s->texture_count, (uint32_t)image_offset,
+              (uint32_t)s->image_count);
+
+    /* Materials, and the default grey one last. */
+    for (uint64_t i = 0; i < material_count; i++) {
+        scene_material m = scene_material_defaults();
+        if (i < (uint64_t)s->material_count)
+            m = s->materials[i];
+        else {
+            m.type = MATERIAL_LAMBERTIAN;
+            m.albedo[0] = m.albedo[1] = m.albedo[2] = 0.5f;
+        }
+        uint64_t base = material_offset + i * PACKED_MATERIAL_STRIDE;
+        put_texel(texels, base + 0, (uint32_t)m.type, float_bits(m.albedo[0]), float_bits(m.albedo[1]),
+                  float_bits(m.albedo[2]));
+        put_texel(texels, base + 1, float_bits(m.emission[0]), float_bits(m.emission[1]), float_bits(m.emission[2]),
+                  float_bits(m.fuzz));
+        put_texel(texels, base + 2, float_bits(m.index_of_refraction),
+                  m.albedo_texture >= 0 ? (uint32_t)m.albedo_texture : PACKED_NONE,
+                  m.emission_texture >= 0 ? (uint32_t)m.emission_texture : PACKED_NONE,
+                  m.normal_map >= 0 ? (uint32_t)m.normal_map : PACKED_NONE);
+    }
+
+    /* Primitives, attributes and nodes of every BVH. */
+    uint64_t next_attribute = 0;
+    built_tree *trees[1] = {&p.top};
+    for (int o = -1; o < s->object_count; o++) {
+        built_tree *built = o < 0 ? trees[0] : &p.objects[o];
+        if (o >= 0 && !p.object_needed[o])
+            continue;
+        if (built->primitives.count == 0)
+            continue;
+        for (uint32_t slot = 0; slot < built->primitives.count; slot++) {
+            const pending_primitive *item = &built->primitives.items[built->tree.primitive_indices[slot]];
+            uint64_t base = primitive_offset + ((uint64_t)built->primitive_base + slot) * PACKED_PRIMITIVE_STRIDE;
+            uint32_t attribute = PACKED_NONE;
+            if (item->mesh >= 0) {
+                attribute = (uint32_t)next_attribute;
+                write_attributes(texels, attribute_offset + next_attribute * PACKED_ATTRIBUTE_STRIDE,
+                                 &s->meshes[item->mesh], item->triangle);
+                next_attribute++;
+            }
+            put_texel(texels, base, item->type, item->material, attribute, item->instance);
+            for (int k = 0; k < 3; k++)
+                put_texel(texels, base + 1 + k, float_bits(item->data[k][0]), float_bits(item->data[k][1]),
+                          float_bits(item->data[k][2]), float_bits(item->data[k][3]));
+            out->triangle_count += item->type == PRIMITIVE_TRIANGLE;
+        }
+        for (uint32_t n = 0; n < built->tree.node_count; n++) {
+            const bvh_node *node = &built->tree.nodes[n];
+            uint64_t base = node_offset + ((uint64_t)built->node_base + n) * PACKED_NODE_STRIDE;
+            uint32_t first = node->count ? node->first + built->primitive_base : node->first + built->node_base;
+            put_texel(texels, base + 0, float_bits(node->box.min[0]), float_bits(node->box.min[1]),
+                      float_bits(node->box.min[2]), first);
+            put_texel(texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
+                      float_bits(node->box.max[2]), node->count);
         }
     }
-    bvh tree;
-    double build_start = seconds_now();
-    rt_status status = bvh_build(boxes, primitive_count, options->bvh_config, &tree, error);
-    free(boxes);
-    if (status != RT_OK)
-        return status;
-    out->bvh_build_seconds = seconds_now() - build_start;
-    out->bvh_depth = tree.depth;
 
-    uint64_t node_count = primitive_count ? tree.node_count : 0;
-    uint64_t material_offset = PACKED_HEADER_TEXELS;
-    uint64_t primitive_offset = material_offset + (uint64_t)s->material_count * PACKED_MATERIAL_STRIDE;
-    uint64_t node_offset = primitive_offset + (uint64_t)primitive_count * PACKED_PRIMITIVE_STRIDE;
-    uint64_t texel_count = node_offset + node_count * PACKED_NODE_STRIDE;
-    if (texel_count > UINT32_MAX / 4) {
-        bvh_free(&tree);
-        return rt_error_set(error, RT_ERROR_INPUT, "PACK: the scene needs %llu texels, more than 32-bit indices reach",
-                            (unsigned long long)texel_count);
-    }
-    uint32_t *texels = calloc(texel_count, 4 * sizeof(uint32_t));
-    if (texels == NULL) {
-        bvh_free(&tree);
-        return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory for %llu texels",
-                            (unsigned long long)texel_count);
+    /* Instances: the object's root, material, world-to-object matrix, volume. */
+    for (int i = 0; i < s->instance_count; i++) {
+        uint32_t packed_index = p.instance_of_scene[i];
+        if (packed_index == PACKED_NONE)
+            continue;
+        const scene_instance *instance = &s->instances[i];
+        float world_to_object[3][4];
+        if (!invert_affine(instance->object_to_world, world_to_object)) {
+            status = rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d has a transform that cannot be inverted", i);
+            goto done;
+        }
+        uint64_t base = instance_offset + (uint64_t)packed_index * PACKED_INSTANCE_STRIDE;
+        put_texel(texels, base, p.objects[instance->object].node_base,
+                  instance->material >= 0 ? (uint32_t)instance->material : PACKED_NONE,
+                  instance->volume ? INSTANCE_VOLUME : 0, 0);
+        for (int r = 0; r < 3; r++)
+            put_texel(texels, base + 1 + r, float_bits(world_to_object[r][0]), float_bits(world_to_object[r][1]),
+                      float_bits(world_to_object[r][2]), float_bits(world_to_object[r][3]));
+        put_texel(texels, base + 4, float_bits(instance->density), float_bits(instance->volume_albedo[0]),
+                  float_bits(instance->volume_albedo[1]), float_bits(instance->volume_albedo[2]));
     }
 
-    put_texel(texels, 0, PACKED_MAGIC, PACKED_LAYOUT_VERSION, (uint32_t)material_offset, (uint32_t)s->material_count);
-    put_texel(texels, 1, (uint32_t)primitive_offset, primitive_count, (uint32_t)node_offset, (uint32_t)node_count);
-
-    for (int i = 0; i < s->material_count; i++) {
-        const scene_material *m = &s->materials[i];
-        uint32_t base = (uint32_t)material_offset + (uint32_t)i * PACKED_MATERIAL_STRIDE;
-        put_texel(texels, base + 0, (uint32_t)m->type, float_bits(m->albedo[0]), float_bits(m->albedo[1]),
-                  float_bits(m->albedo[2]));
-        put_texel(texels, base + 1, float_bits(m->emission[0]), float_bits(m->emission[1]),
-                  float_bits(m->emission[2]), float_bits(m->fuzz));
-        put_texel(texels, base + 2, float_bits(m->index_of_refraction), 0, 0, 0);
+    /* Textures and images. */
+    for (int i = 0; i < s->texture_count; i++) {
+        const scene_texture *t = &s->textures[i];
+        uint64_t base = texture_offset + (uint64_t)i * PACKED_TEXTURE_STRIDE;
+        put_texel(texels, base, (uint32_t)t->type, (uint32_t)t->even, (uint32_t)t->odd, (uint32_t)t->image);
+        put_texel(texels, base + 1, float_bits(t->color[0]), float_bits(t->color[1]), float_bits(t->color[2]),
+                  float_bits(t->scale));
     }
-
-    for (uint32_t slot = 0; slot < primitive_count; slot++) {
-        const scene_sphere *sphere = &s->spheres[tree.primitive_indices[slot]];
-        uint32_t base = (uint32_t)primitive_offset + slot * PACKED_PRIMITIVE_STRIDE;
-        put_texel(texels, base + 0, PRIMITIVE_SPHERE, (uint32_t)sphere->material, 0, 0);
-        put_texel(texels, base + 1, float_bits(sphere->center[0]), float_bits(sphere->center[1]),
-                  float_bits(sphere->center[2]), float_bits(sphere->radius));
+    uint64_t next_pixel = pixel_offset;
+    for (int i = 0; i < s->image_count; i++) {
+        const scene_image *image = &s->images[i];
+        put_texel(texels, image_offset + (uint64_t)i * PACKED_IMAGE_STRIDE, (uint32_t)next_pixel, (uint32_t)image->width,
+                  (uint32_t)image->height, 0);
+        uint64_t pixels = (uint64_t)image->width * image->height;
+        if (image->pixels != NULL)
+            for (uint64_t k = 0; k < 4 * pixels; k++)
+                texels[4 * next_pixel + k] = float_bits(image->pixels[k]);
+        next_pixel += pixels;
     }
-
-    for (uint32_t n = 0; n < node_count; n++) {
-        const bvh_node *node = &tree.nodes[n];
-        uint32_t base = (uint32_t)node_offset + n * PACKED_NODE_STRIDE;
-        put_texel(texels, base + 0, float_bits(node->box.min[0]), float_bits(node->box.min[1]),
-                  float_bits(node->box.min[2]), node->first);
-        put_texel(texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
-                  float_bits(node->box.max[2]), node->count);
-    }
-    bvh_free(&tree);
 
     out->texels = texels;
+    texels = NULL;
     out->texel_count = (uint32_t)texel_count;
     out->material_offset = (uint32_t)material_offset;
-    out->material_count = (uint32_t)s->material_count;
+    out->material_count = (uint32_t)material_count;
+    out->default_material = default_material;
     out->primitive_offset = (uint32_t)primitive_offset;
-    out->primitive_count = primitive_count;
+    out->primitive_count = (uint32_t)primitive_count;
+    out->attribute_offset = (uint32_t)attribute_offset;
+    out->attribute_count = (uint32_t)attribute_count;
     out->node_offset = (uint32_t)node_offset;
     out->node_count = (uint32_t)node_count;
-    return RT_OK;
+    out->instance_offset = (uint32_t)instance_offset;
+    out->instance_count = p.packed_instances;
+    out->texture_offset = (uint32_t)texture_offset;
+    out->texture_count = (uint32_t)s->texture_count;
+    out->image_offset = (uint32_t)image_offset;
+    out->image_count = (uint32_t)s->image_count;
+
+done:
+    free(texels);
+    free(p.top.primitives.items);
+    bvh_free(&p.top.tree);
+    if (p.objects != NULL)
+        for (int o = 0; o < s->object_count; o++) {
+            free(p.objects[o].primitives.items);
+            bvh_free(&p.objects[o].tree);
+        }
+    free(p.objects);
+    free(p.object_needed);
+    free(p.instance_of_scene);
+    if (status != RT_OK) {
+        double seconds = out->bvh_build_seconds;
+        memset(out, 0, sizeof *out);
+        out->bvh_build_seconds = seconds;
+    }
+    return status;
 }
 
 void packed_scene_free(packed_scene *packed)
@@ -151,27 +618,47 @@ packed_primitive packed_primitive_at(const packed_scene *packed, uint32_t slot)
     packed_primitive primitive = {
         .type = packed_uint(packed, base, 0),
         .material = packed_uint(packed, base, 1),
+        .attribute = packed_uint(packed, base, 2),
+        .instance = packed_uint(packed, base, 3),
     };
-    for (int i = 0; i < 4; i++)
-        primitive.sphere[i] = packed_float(packed, base + 1, i);
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 4; i++)
+            primitive.data[k][i] = packed_float(packed, base + 1 + k, i);
     return primitive;
 }
 
-/* The shader's sphere test (tracer.frag, intersect_sphere), in C. */
-static float intersect_sphere(const float sphere[4], const float origin[3], const float direction[3], float t_max)
+/* ---- the shader's traversal, in C ---------------------------------------------------- */
+
+static float dot3(const float a[3], const float b[3])
 {
-    float to_origin[3], closest[3];
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* tracer.frag intersect_sphere: nearest root in (0, t_max) for any direction length. */
+static float intersect_sphere(const float center[3], float radius, const float origin[3], const float direction[3],
+                              float t_max)
+{
+    float length = sqrtf(dot3(direction, direction));
+    float unit[3], to_origin[3], closest[3];
+    for (int i = 0; i < 3; i++) {
+        unit[i] = direction[i] / length;
+        to_origin[i] = origin[i] - center[i];
+    }
+    float b = dot3(to_origin, unit);
     for (int i = 0; i < 3; i++)
-        to_origin[i] = origin[i] - sphere[i];
-    float b = to_origin[0] * direction[0] + to_origin[1] * direction[1] + to_origin[2] * direction[2];
-    for (int i = 0; i < 3; i++)
-        closest[i] = to_origin[i] - b * direction[i];
-    float radius_squared = sphere[3] * sphere[3];
-    float discriminant = radius_squared - (closest[0] * closest[0] + closest[1] * closest[1] + closest[2] * closest[2]);
+        closest[i] = to_origin[i] - b * unit[i];
+    float discriminant = radius * radius - dot3(closest, closest);
     if (discriminant < 0)
         return INFINITY;
     float root = sqrtf(discriminant);
-    float c = to_origin[0] * to_origin[0] + to_origin[1] * to_origin[1] + to_origin[2] * to_origin[2] - radius_squared;
+    float c = dot3(to_origin, to_origin) - radius * radius;
     float q = -b - (b >= 0 ? root : -root);
     float t_near = c / q, t_far = q;
     if (t_near > t_far) {
@@ -179,6 +666,8 @@ static float intersect_sphere(const float sphere[4], const float origin[3], cons
         t_near = t_far;
         t_far = swap;
     }
+    t_near /= length;
+    t_far /= length;
     if (t_near > 0 && t_near < t_max)
         return t_near;
     if (t_far > 0 && t_far < t_max)
@@ -186,7 +675,30 @@ static float intersect_sphere(const float sphere[4], const float origin[3], cons
     return INFINITY;
 }
 
-/* The shader's slab test (tracer.frag, intersect_box), in C. */
+/* tracer.frag intersect_triangle (Moller-Trumbore), and quads by their plane. */
+static float intersect_flat(const packed_primitive *primitive, const float origin[3], const float direction[3],
+                            float t_max)
+{
+    const float *corner = primitive->data[0], *edge1 = primitive->data[1], *edge2 = primitive->data[2];
+    float p[3], s[3], q[3];
+    cross3(direction, edge2, p);
+    float determinant = dot3(edge1, p);
+    if (fabsf(determinant) < 1e-20f)
+        return INFINITY;
+    float inverse = 1.0f / determinant;
+    for (int i = 0; i < 3; i++)
+        s[i] = origin[i] - corner[i];
+    float u = dot3(s, p) * inverse;
+    cross3(s, edge1, q);
+    float v = dot3(direction, q) * inverse;
+    bool inside = primitive->type == PRIMITIVE_QUAD ? (u >= 0 && u <= 1 && v >= 0 && v <= 1)
+                                                     : (u >= 0 && v >= 0 && u + v <= 1);
+    if (!inside)
+        return INFINITY;
+    float t = dot3(edge2, q) * inverse;
+    return t > 0 && t < t_max ? t : INFINITY;
+}
+
 static float intersect_box(const packed_scene *packed, uint32_t node, const float origin[3],
                            const float inverse_direction[3], float t_max)
 {
@@ -201,44 +713,77 @@ static float intersect_box(const packed_scene *packed, uint32_t node, const floa
     return enter <= leave ? enter : INFINITY;
 }
 
-uint32_t packed_intersect_nearest(const packed_scene *packed, const float origin[3], const float direction[3],
-                                  float t_max, float *t_hit)
+bool packed_intersect_nearest(const packed_scene *packed, const float origin[3], const float direction[3], float time,
+                              float t_max, packed_hit *hit)
 {
-    float nearest = t_max;
-    uint32_t nearest_slot = UINT32_MAX;
-    *t_hit = INFINITY;
+    hit->t = t_max;
+    hit->primitive = PACKED_NONE;
+    hit->instance = PACKED_NONE;
     if (packed->node_count == 0)
-        return UINT32_MAX;
-    float inverse_direction[3];
+        return false;
+    float ray_origin[3], ray_direction[3], inverse_direction[3];
+    memcpy(ray_origin, origin, sizeof ray_origin);
+    memcpy(ray_direction, direction, sizeof ray_direction);
     for (int i = 0; i < 3; i++)
-        inverse_direction[i] = 1.0f / direction[i];
-    if (intersect_box(packed, 0, origin, inverse_direction, INFINITY) == INFINITY)
-        return UINT32_MAX;
-    uint32_t stack_node[BVH_MAX_DEPTH + 1];
-    float stack_entry[BVH_MAX_DEPTH + 1];
+        inverse_direction[i] = 1.0f / ray_direction[i];
+    if (intersect_box(packed, 0, ray_origin, inverse_direction, INFINITY) == INFINITY)
+        return false;
+    enum { STACK = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE };
+    uint32_t stack_node[STACK];
+    float stack_entry[STACK];
     int stack_size = 0;
-    uint32_t node = 0;
+    uint32_t node = 0, current_instance = PACKED_NONE;
     float node_entry = 0;
     for (;;) {
-        if (node_entry < nearest) {
+        if (node == PACKED_NONE) {
+            /* Leaving an instance: back to the world ray. */
+            memcpy(ray_origin, origin, sizeof ray_origin);
+            memcpy(ray_direction, direction, sizeof ray_direction);
+            for (int i = 0; i < 3; i++)
+                inverse_direction[i] = 1.0f / ray_direction[i];
+            current_instance = PACKED_NONE;
+        } else if (node_entry < hit->t) {
             uint32_t base = packed->node_offset + node * PACKED_NODE_STRIDE;
             uint32_t first = packed_uint(packed, base, 3), count = packed_uint(packed, base + 1, 3);
             if (count > 0) {
                 for (uint32_t slot = first; slot < first + count; slot++) {
                     packed_primitive primitive = packed_primitive_at(packed, slot);
-                    float t = intersect_sphere(primitive.sphere, origin, direction, nearest);
-                    if (t < nearest) {
-                        nearest = t;
-                        nearest_slot = slot;
+                    float t = INFINITY;
+                    if (primitive.type == PRIMITIVE_INSTANCE) {
+                        /* Visited after this leaf: a marker that restores the world ray,
+                         * under an entry that moves the ray into the instance. */
+                        if (stack_size + 2 > STACK)
+                            continue;
+                        stack_node[stack_size] = PACKED_NONE;
+                        stack_entry[stack_size] = -INFINITY;
+                        stack_size++;
+                        stack_node[stack_size] = primitive.instance | 0x80000000u;
+                        stack_entry[stack_size] = -INFINITY;
+                        stack_size++;
+                        continue;
+                    }
+                    if (primitive.type == PRIMITIVE_SPHERE)
+                        t = intersect_sphere(primitive.data[0], primitive.data[0][3], ray_origin, ray_direction, hit->t);
+                    else if (primitive.type == PRIMITIVE_MOVING_SPHERE) {
+                        float center[3];
+                        for (int i = 0; i < 3; i++)
+                            center[i] = primitive.data[0][i] + time * (primitive.data[1][i] - primitive.data[0][i]);
+                        t = intersect_sphere(center, primitive.data[0][3], ray_origin, ray_direction, hit->t);
+                    } else
+                        t = intersect_flat(&primitive, ray_origin, ray_direction, hit->t);
+                    if (t < hit->t) {
+                        hit->t = t;
+                        hit->primitive = slot;
+                        hit->instance = current_instance;
                     }
                 }
             } else {
-                float left = intersect_box(packed, first, origin, inverse_direction, nearest);
-                float right = intersect_box(packed, first + 1, origin, inverse_direction, nearest);
+                float left = intersect_box(packed, first, ray_origin, inverse_direction, hit->t);
+                float right = intersect_box(packed, first + 1, ray_origin, inverse_direction, hit->t);
                 uint32_t near_node = right < left ? first + 1 : first;
                 float near_entry = fminf(left, right), far_entry = fmaxf(left, right);
                 if (near_entry < INFINITY) {
-                    if (far_entry < INFINITY && stack_size <= BVH_MAX_DEPTH) {
+                    if (far_entry < INFINITY && stack_size < STACK) {
                         stack_node[stack_size] = near_node == first ? first + 1 : first;
                         stack_entry[stack_size] = far_entry;
                         stack_size++;
@@ -254,8 +799,80 @@ uint32_t packed_intersect_nearest(const packed_scene *packed, const float origin
         stack_size--;
         node = stack_node[stack_size];
         node_entry = stack_entry[stack_size];
+        if (node != PACKED_NONE && (node & 0x80000000u)) {
+            /* Entering an instance: move the ray into its object's coordinates. The
+             * direction is not renormalised, so t stays the world ray's parameter. */
+            uint32_t instance = node & 0x7fffffffu;
+            uint32_t instance_base = packed->instance_offset + instance * PACKED_INSTANCE_STRIDE;
+            node = packed_uint(packed, instance_base, 0);
+            for (int r = 0; r < 3; r++) {
+                float m[4];
+                for (int c = 0; c < 4; c++)
+                    m[c] = packed_float(packed, instance_base + 1 + r, c);
+                ray_origin[r] = m[0] * origin[0] + m[1] * origin[1] + m[2] * origin[2] + m[3];
+                ray_direction[r] = m[0] * direction[0] + m[1] * direction[1] + m[2] * direction[2];
+            }
+            for (int i = 0; i < 3; i++)
+                inverse_direction[i] = 1.0f / ray_direction[i];
+            current_instance = instance;
+            node_entry = intersect_box(packed, node, ray_origin, inverse_direction, hit->t);
+        }
     }
-    if (nearest_slot != UINT32_MAX)
-        *t_hit = nearest;
-    return nearest_slot;
+    return hit->primitive != PACKED_NONE;
+}
+
+uint32_t packed_media_at(const packed_scene *packed, const float point[3])
+{
+    /* Parity along one ray: a closed boundary that the ray from the point crosses an odd
+     * number of times contains the point. Of those, the one crossed first is innermost.
+     * The direction is skewed so the walk does not run along edges of axis-aligned boxes. */
+    const float direction[3] = {0.5773503f, 0.5896503f, 0.5452503f};
+    enum { TRACKED = 256 };
+    uint32_t volume[TRACKED];
+    int crossings[TRACKED];
+    float first_crossing[TRACKED];
+    int tracked = 0;
+    float origin[3];
+    memcpy(origin, point, sizeof origin);
+    float travelled = 0;
+    for (int step = 0; step < 100000; step++) {
+        packed_hit hit;
+        if (!packed_intersect_nearest(packed, origin, direction, 0, INFINITY, &hit))
+            break;
+        travelled += hit.t;
+        if (hit.instance != PACKED_NONE
+            && (packed_uint(packed, packed->instance_offset + hit.instance * PACKED_INSTANCE_STRIDE, 2)
+                & INSTANCE_VOLUME)) {
+            int k = 0;
+            while (k < tracked && volume[k] != hit.instance)
+                k++;
+            if (k == tracked && tracked < TRACKED) {
+                volume[tracked] = hit.instance;
+                crossings[tracked] = 0;
+                first_crossing[tracked] = travelled;
+                tracked++;
+            }
+            if (k < TRACKED)
+                crossings[k]++;
+        }
+        float step_length = hit.t + 1e-4f * (1.0f + fmaxf(fabsf(origin[0]), fmaxf(fabsf(origin[1]), fabsf(origin[2]))));
+        for (int i = 0; i < 3; i++)
+            origin[i] += step_length * direction[i];
+    }
+    uint32_t inner = 0, outer = 0;
+    float inner_distance = INFINITY, outer_distance = INFINITY;
+    for (int k = 0; k < tracked; k++) {
+        if (crossings[k] % 2 == 0)
+            continue;
+        if (first_crossing[k] < inner_distance) {
+            outer = inner;
+            outer_distance = inner_distance;
+            inner = volume[k] + 1;
+            inner_distance = first_crossing[k];
+        } else if (first_crossing[k] < outer_distance) {
+            outer = volume[k] + 1;
+            outer_distance = first_crossing[k];
+        }
+    }
+    return (inner & 0xffffu) | ((outer & 0xffffu) << 16);
 }

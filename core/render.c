@@ -57,6 +57,13 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     memcpy(p->camera_u, frame->u, sizeof p->camera_u);
     memcpy(p->camera_v, frame->v, sizeof p->camera_v);
     p->lens_radius = frame->lens_radius;
+    p->shutter_open = s->camera.shutter_open;
+    p->shutter_close = s->camera.shutter_close;
+    p->sky_intensity = s->sky.intensity;
+    p->sky_rotation_radians = s->sky.rotation_degrees * 3.14159265358979f / 180.0f;
+    for (int face = 0; face < 6; face++)
+        p->sky_faces[face] = s->sky.faces[face] >= 0 ? (uint32_t)s->sky.faces[face] : 0;
+    p->sky_environment = s->sky.environment >= 0 ? (uint32_t)s->sky.environment : 0;
     p->sky_type = s->sky.type;
     memcpy(p->sky_bottom, s->sky.bottom, sizeof p->sky_bottom);
     memcpy(p->sky_top, s->sky.top, sizeof p->sky_top);
@@ -168,7 +175,13 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     uint64_t hash = 0xcbf29ce484222325ull;
     hash = hash_bytes(hash, packed.texels, (size_t)packed.texel_count * 16u);
     hash = hash_bytes(hash, &frame, sizeof frame);
-    hash = hash_bytes(hash, &s->sky, sizeof s->sky);
+    hash = hash_bytes(hash, &s->sky.type, sizeof s->sky.type);
+    hash = hash_bytes(hash, s->sky.bottom, sizeof s->sky.bottom);
+    hash = hash_bytes(hash, s->sky.top, sizeof s->sky.top);
+    hash = hash_bytes(hash, &s->sky.intensity, sizeof s->sky.intensity);
+    hash = hash_bytes(hash, &s->sky.rotation_degrees, sizeof s->sky.rotation_degrees);
+    hash = hash_bytes(hash, &s->camera.shutter_open, sizeof s->camera.shutter_open);
+    hash = hash_bytes(hash, &s->camera.shutter_close, sizeof s->camera.shutter_close);
     int shape[3] = {s->render.width, s->render.height, s->render.max_depth};
     hash = hash_bytes(hash, shape, sizeof shape);
     result->scene_hash = hash;
@@ -182,6 +195,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
 
     gpu_tracer_parameters parameters;
     tracer_parameters(s, &frame, options, region, &parameters);
+    parameters.camera_media = packed_media_at(&packed, s->camera.look_from);
     uint64_t samples_resumed = 0;
     float *sums = NULL;
     if (options->resume != NULL) {
@@ -265,8 +279,9 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (totals.traversal_overflows > 0) {
         image_free(&result->image);
         return rt_error_set(error, RT_ERROR_RUNTIME,
-                            "RENDER: %.0f ray traversals exceeded the shader's hard work cap and were cut short; "
-                            "the image would be wrong. The scene's BVH is degenerate (many overlapping primitives)",
+                            "RENDER: %.0f ray traversals exceeded the shader's hard work cap or traversal stack and "
+                            "were cut short; the image would be wrong. The scene's BVH is degenerate (many "
+                            "overlapping primitives, or a huge leaf of instances)",
                             totals.traversal_overflows);
     }
 

@@ -10,17 +10,36 @@ void scene_defaults(scene *s)
     s->camera = (scene_camera){
         .look_from = {0, 0, 1}, .look_at = {0, 0, 0}, .up = {0, 1, 0},
         .vertical_fov_degrees = 40, .aperture = 0, .focus_distance = 0,
+        .shutter_open = 0, .shutter_close = 1,
     };
     s->render = (scene_render_settings){
         .width = 640, .height = 360, .samples_per_pixel = 64, .max_depth = 16, .seed = 1,
     };
-    s->sky = (scene_sky){.type = SKY_GRADIENT, .bottom = {1, 1, 1}, .top = {0.5f, 0.7f, 1.0f}};
+    s->sky = (scene_sky){
+        .type = SKY_GRADIENT, .bottom = {1, 1, 1}, .top = {0.5f, 0.7f, 1.0f},
+        .faces = {-1, -1, -1, -1, -1, -1}, .environment = -1, .intensity = 1, .rotation_degrees = 0,
+    };
 }
 
 void scene_free(scene *s)
 {
     free(s->materials);
     free(s->spheres);
+    free(s->shapes);
+    free(s->objects);
+    free(s->instances);
+    for (int i = 0; i < s->mesh_count; i++) {
+        free(s->meshes[i].positions);
+        free(s->meshes[i].normals);
+        free(s->meshes[i].uvs);
+        free(s->meshes[i].indices);
+        free(s->meshes[i].triangle_materials);
+    }
+    free(s->meshes);
+    free(s->textures);
+    for (int i = 0; i < s->image_count; i++)
+        free(s->images[i].pixels);
+    free(s->images);
     scene_defaults(s);
 }
 
@@ -53,6 +72,71 @@ int scene_add_sphere(scene *s, const scene_sphere *sphere)
         return -1;
     s->spheres[s->sphere_count] = *sphere;
     return s->sphere_count++;
+}
+
+int scene_add_shape(scene *s, const scene_shape *shape)
+{
+    if (grow((void **)&s->shapes, s->shape_count, &s->shape_capacity, sizeof *shape))
+        return -1;
+    s->shapes[s->shape_count] = *shape;
+    return s->shape_count++;
+}
+
+int scene_add_object(scene *s, const scene_object *object)
+{
+    if (grow((void **)&s->objects, s->object_count, &s->object_capacity, sizeof *object))
+        return -1;
+    s->objects[s->object_count] = *object;
+    return s->object_count++;
+}
+
+int scene_add_instance(scene *s, const scene_instance *instance)
+{
+    if (grow((void **)&s->instances, s->instance_count, &s->instance_capacity, sizeof *instance))
+        return -1;
+    s->instances[s->instance_count] = *instance;
+    return s->instance_count++;
+}
+
+int scene_add_mesh(scene *s, const scene_mesh *mesh)
+{
+    if (grow((void **)&s->meshes, s->mesh_count, &s->mesh_capacity, sizeof *mesh))
+        return -1;
+    s->meshes[s->mesh_count] = *mesh;
+    return s->mesh_count++;
+}
+
+int scene_add_texture(scene *s, const scene_texture *texture)
+{
+    if (grow((void **)&s->textures, s->texture_count, &s->texture_capacity, sizeof *texture))
+        return -1;
+    s->textures[s->texture_count] = *texture;
+    return s->texture_count++;
+}
+
+int scene_add_image(scene *s, const scene_image *image)
+{
+    if (grow((void **)&s->images, s->image_count, &s->image_capacity, sizeof *image))
+        return -1;
+    s->images[s->image_count] = *image;
+    return s->image_count++;
+}
+
+scene_material scene_material_defaults(void)
+{
+    scene_material material;
+    memset(&material, 0, sizeof material);
+    material.albedo_texture = -1;
+    material.emission_texture = -1;
+    material.normal_map = -1;
+    return material;
+}
+
+void scene_identity_transform(float m[3][4])
+{
+    for (int row = 0; row < 3; row++)
+        for (int column = 0; column < 4; column++)
+            m[row][column] = row == column ? 1.0f : 0.0f;
 }
 
 int scene_find_material(const scene *s, const char *name)

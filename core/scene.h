@@ -8,12 +8,16 @@
  *   camera:  look_from (0,0,1), look_at (0,0,0), up (0,1,0), vertical fov 40 degrees,
  *            aperture 0 (pinhole), focus_distance 0 (= distance from look_from to look_at)
  *   render:  640x360, 64 samples per pixel, max depth 16, seed 1
- *   sky:     gradient from (1,1,1) at the horizon/below to (0.5,0.7,1.0) straight up
- *   no materials, no spheres
+ *   camera shutter open 0, close 1
+ *   sky:     gradient from (1,1,1) at the horizon/below to (0.5,0.7,1.0) straight up,
+ *            intensity 1, rotation 0, faces and environment -1
+ *   materials added by hand should set the texture fields to -1 (scene_material_defaults)
+ *   no materials, spheres, shapes, objects, instances or meshes
  */
 #ifndef RT_SCENE_H
 #define RT_SCENE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "packed_layout.h"
@@ -27,6 +31,8 @@ typedef struct scene_camera {
     float vertical_fov_degrees;  /* full vertical field of view, 0 < fov < 180 */
     float aperture;              /* lens diameter; 0 is a pinhole */
     float focus_distance;        /* 0 means |look_at - look_from| */
+    float shutter_open;          /* each ray gets a time uniform in [open, close]; moving */
+    float shutter_close;         /* spheres are at their time-0 and time-1 centres; 0 and 1 */
 } scene_camera;
 
 typedef struct scene_render_settings {
@@ -39,13 +45,43 @@ typedef struct scene_render_settings {
 typedef enum scene_sky_type {
     SKY_GRADIENT = 0,            /* lerp(bottom, top, 0.5 * (direction.y + 1)) */
     SKY_CONSTANT = 1,            /* bottom colour everywhere */
+    SKY_BOX = 2,                 /* a cube map from six images (faces) */
+    SKY_ENVIRONMENT = 3,         /* an equirectangular (latitude-longitude) image */
 } scene_sky_type;
+
+/* Cube-map face order, as the seed report's sky box and OpenGL use it. */
+enum { SKY_FACE_POSITIVE_X, SKY_FACE_NEGATIVE_X, SKY_FACE_POSITIVE_Y, SKY_FACE_NEGATIVE_Y, SKY_FACE_POSITIVE_Z,
+       SKY_FACE_NEGATIVE_Z, SKY_FACE_COUNT };
 
 typedef struct scene_sky {
     scene_sky_type type;
     float bottom[3];             /* gradient: colour at direction.y = -1; constant: the colour */
     float top[3];                /* gradient: colour at direction.y = +1 */
+    int faces[SKY_FACE_COUNT];   /* box: indices into scene.images, +X -X +Y -Y +Z -Z */
+    int environment;             /* environment: index into scene.images */
+    float intensity;             /* multiplies every kind of sky; default 1 */
+    float rotation_degrees;      /* box and environment: turn about +Y; default 0 */
 } scene_sky;
+
+/* An image file used by a texture, a normal map or the sky: recorded by the parser
+ * (deduplicated by resolved path), pixels filled by the asset loader. */
+typedef struct scene_image {
+    char path[1024];
+    char position[256];          /* "file:line:column" of the first statement naming it */
+    int width, height;           /* filled by the loader */
+    float *pixels;               /* filled by the loader: RGBA, linear, rows top to bottom */
+} scene_image;
+
+/* A named texture: a colour that varies over a surface. type is a TEXTURE_* tag of
+ * packed_layout.h. */
+typedef struct scene_texture {
+    char name[SCENE_NAME_MAX];
+    int type;
+    float color[3];              /* constant */
+    float scale;                 /* checker: cell size in world units; noise kinds: frequency */
+    int even, odd;               /* checker: the two textures (indices into scene.textures) */
+    int image;                   /* image: index into scene.images */
+} scene_texture;
 
 /* One named material. type is a MATERIAL_* tag of packed_layout.h; fields that the
  * type does not use are ignored (and left at zero by the parser). */
@@ -56,6 +92,9 @@ typedef struct scene_material {
     float fuzz;                  /* metal, 0..1 */
     float index_of_refraction;   /* dielectric, > 0 */
     float emission[3];           /* emissive: colour x strength (radiance) */
+    int albedo_texture;          /* -1: albedo is the colour above; else index into scene.textures */
+    int emission_texture;        /* -1, or a texture whose colour x strength is the emission */
+    int normal_map;              /* -1, or index into scene.images: a tangent-space normal map */
 } scene_material;
 
 typedef struct scene_sphere {
@@ -63,6 +102,65 @@ typedef struct scene_sphere {
     float radius;                /* > 0 */
     int material;                /* index into scene.materials */
 } scene_sphere;
+
+/* ---- the general scene model (groups, transforms, instancing, meshes, volumes) --------
+ *
+ * Geometry lives in objects: an object is a set of shapes (or one mesh) in its own
+ * coordinates. Instances place objects in the world with a transform, so an object placed
+ * many times costs its geometry once (the renderer builds one bottom-level BVH per object
+ * and a top-level BVH over instances, as hardware ray tracing APIs do). The parser turns
+ * nested groups into objects and instances, composing transforms.
+ *
+ * The plain `spheres` array above is the world's own spheres, with no transform: the
+ * common case of simple scenes, kept as it is.
+ */
+
+typedef enum scene_shape_type {
+    SHAPE_SPHERE = 0,            /* points[0] centre, radius */
+    SHAPE_MOVING_SPHERE = 1,     /* points[0] centre at time 0, points[1] at time 1, radius */
+    SHAPE_TRIANGLE = 2,          /* points[0..2] corners (counter-clockwise seen from the front) */
+    SHAPE_QUAD = 3,              /* points[0] corner Q, points[1] edge u, points[2] edge v:
+                                  * the parallelogram Q + a u + b v, a, b in [0,1]; uv = (a, b) */
+} scene_shape_type;
+
+typedef struct scene_shape {
+    scene_shape_type type;
+    int material;                /* index into scene.materials, or -1: the instance's */
+    float points[3][3];
+    float radius;
+} scene_shape;
+
+/* A triangle mesh, loaded from an OBJ file once however often it is placed. The parser
+ * records path and position; the mesh loader (mesh_load.h) fills the arrays. */
+typedef struct scene_mesh {
+    char path[1024];             /* resolved relative to the scene file that names it */
+    char position[256];          /* "file:line:column" of the first statement naming it */
+    int default_material;        /* for faces without a usable usemtl: -1 = the instance's */
+    /* Filled by the loader: */
+    float *positions;            /* 3 per vertex */
+    float *normals;              /* 3 per vertex, or NULL: flat shading */
+    float *uvs;                  /* 2 per vertex, or NULL */
+    uint32_t *indices;           /* 3 per triangle, into the vertex arrays */
+    int *triangle_materials;     /* per triangle: index into scene.materials or -1 */
+    int vertex_count, triangle_count;
+} scene_mesh;
+
+/* An object: shapes[first_shape .. first_shape + shape_count - 1], or mesh >= 0. */
+typedef struct scene_object {
+    int first_shape, shape_count;
+    int mesh;                    /* index into scene.meshes, or -1 */
+} scene_object;
+
+/* One placement of an object. object_to_world maps object coordinates to the world:
+ * world = M[:, 0..2] * p + M[:, 3], rows x, y, z. */
+typedef struct scene_instance {
+    int object;
+    float object_to_world[3][4];
+    int material;                /* overrides shapes whose material is -1; -1: none */
+    bool volume;                 /* the object is the closed boundary of a constant medium */
+    float density;               /* volume: scattering events per unit length */
+    float volume_albedo[3];      /* volume: colour of the isotropic scattering */
+} scene_instance;
 
 typedef struct scene {
     scene_camera camera;
@@ -72,6 +170,18 @@ typedef struct scene {
     int material_count, material_capacity;
     scene_sphere *spheres;
     int sphere_count, sphere_capacity;
+    scene_shape *shapes;
+    int shape_count, shape_capacity;
+    scene_object *objects;
+    int object_count, object_capacity;
+    scene_instance *instances;
+    int instance_count, instance_capacity;
+    scene_mesh *meshes;
+    int mesh_count, mesh_capacity;
+    scene_texture *textures;
+    int texture_count, texture_capacity;
+    scene_image *images;
+    int image_count, image_capacity;
 } scene;
 
 /* Fills *s with the defaults above and empty arrays. Never fails; frees nothing. */
@@ -80,11 +190,25 @@ void scene_defaults(scene *s);
 /* Frees the arrays of *s (not *s itself) and leaves it as scene_defaults() would. */
 void scene_free(scene *s);
 
+/* Returns a material with no textures (texture fields -1), everything else zero. */
+scene_material scene_material_defaults(void);
+
 /* Appends a material and returns its index, or -1 when memory runs out. */
 int scene_add_material(scene *s, const scene_material *material);
 
 /* Appends a sphere and returns its index, or -1 when memory runs out. */
 int scene_add_sphere(scene *s, const scene_sphere *sphere);
+
+/* Append one element and return its index, or -1 when memory runs out. */
+int scene_add_shape(scene *s, const scene_shape *shape);
+int scene_add_object(scene *s, const scene_object *object);
+int scene_add_instance(scene *s, const scene_instance *instance);
+int scene_add_mesh(scene *s, const scene_mesh *mesh);
+int scene_add_texture(scene *s, const scene_texture *texture);
+int scene_add_image(scene *s, const scene_image *image);
+
+/* Sets m to the identity placement (object_to_world = [I | 0]). */
+void scene_identity_transform(float m[3][4]);
 
 /* Returns the index of the material called name, or -1. */
 int scene_find_material(const scene *s, const char *name);

@@ -965,7 +965,7 @@ static bool statement_sky(parser *p, source_line *line)
     token type = {.kind = TOKEN_END};
     if (!next_token(p, line, &type))
         return false;
-    scene_sky sky;
+    scene_sky sky = p->scene->sky;
     if (token_is(line, &type, "gradient")) {
         sky.type = SKY_GRADIENT;
         if (!read_colour(p, line, "the sky's bottom colour", sky.bottom) ||
@@ -1039,7 +1039,7 @@ static bool statement_material(parser *p, source_line *line)
     if (name.length > SCENE_NAME_MAX - 1)
         return fail_at(p, line, name.offset, "material name %s is %zu bytes long; the limit is %d",
                        describe_token(line, &name, found, sizeof found), name.length, SCENE_NAME_MAX - 1);
-    scene_material material = {.type = MATERIAL_LAMBERTIAN};
+    scene_material material = scene_material_defaults(); material.type = MATERIAL_LAMBERTIAN;
     memcpy(material.name, name_text, name.length);
     material.name[name.length] = '\0';
     int existing = scene_find_material(p->scene, material.name);

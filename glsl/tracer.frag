@@ -18,7 +18,9 @@ layout(location = 0) out vec4 out_origin;       // ray origin of the path in fli
 layout(location = 1) out vec4 out_direction;    // ray direction (unit)
 layout(location = 2) out vec4 out_throughput;   // path throughput so far
 layout(location = 3) out vec4 out_radiance;     // radiance gathered by the path in flight
-layout(location = 4) out uvec4 out_counters;    // x: samples started, y: bounce (0: no path in flight)
+layout(location = 4) out uvec4 out_counters;    // x: samples started, y: bounce (0: no path in
+                                                // flight), z: media the path is in (two 16-bit
+                                                // volume instance numbers + 1, inner low)
 layout(location = 5) out vec4 out_accumulated;  // rgb: sum over finished samples, a: finished samples
 layout(location = 6) out vec4 out_statistics;   // x: path segments traced, y: traversal overflows
 
@@ -43,9 +45,16 @@ uniform vec3 camera_vertical;
 uniform vec3 camera_u;
 uniform vec3 camera_v;
 uniform float lens_radius;
+uniform float shutter_open;
+uniform float shutter_close;
+uniform uint camera_media;      // media the camera is in, packed like out_counters.z
 uniform int sky_type;
 uniform vec3 sky_bottom;
 uniform vec3 sky_top;
+uniform float sky_intensity;
+uniform float sky_rotation;     // radians about +Y
+uniform uint sky_faces[6];      // sky box: image indices +X -X +Y -Y +Z -Z
+uniform uint sky_environment;   // equirectangular image index
 uniform uint seed;
 uniform uint sample_start;
 uniform uint samples_per_pixel;
@@ -60,6 +69,11 @@ const float INFINITY = 1.0 / 0.0;
 const float PI = 3.14159265358979;
 const int TRAVERSAL_HARD_CAP = 60000;
 const int SKY_CONSTANT = 1;
+const int SKY_BOX = 2;
+const int SKY_ENVIRONMENT = 3;
+const uint NONE = PACKED_NONE;
+const uint ENTER_INSTANCE = 0x80000000u;
+const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 
 // ---- packed scene access ---------------------------------------------------------
 
@@ -71,6 +85,17 @@ uvec4 packed_texel(uint index)
 }
 
 vec3 packed_xyz(uvec4 texel) { return uintBitsToFloat(texel.xyz); }
+vec4 packed_vec4(uint index) { return uintBitsToFloat(packed_texel(index)); }
+
+uint material_offset;
+uint primitive_offset;
+uint node_offset;
+uint node_count;
+uint instance_offset;
+uint attribute_offset;
+uint default_material;
+uint texture_offset;
+uint image_offset;
 
 // ---- random numbers (glsl/random.glsl, prepended) ----------------------------------
 
@@ -89,31 +114,59 @@ vec4 random4(uint bounce, uint stream)
 struct Hit {
     float t;
     uint primitive;   // slot in the primitive section
+    uint instance;    // NONE: a world primitive
+    vec2 barycentric; // triangles: (b1, b2) of v1, v2; quads: (a, b) along the edges
 };
 
 // Nearest root of |origin + t*direction - center| = radius with t in (0, t_max), or
-// INFINITY. direction is unit length. The discriminant is computed from the squared
-// distance of the centre to the ray's closest point, which keeps float32 precise for the
-// radius-1000 ground sphere (Haines et al., Ray Tracing Gems, ch. 7).
+// INFINITY, for a direction of any length (instances scale it). The discriminant is
+// computed from the squared distance of the centre to the ray's closest point, which
+// keeps float32 precise for the radius-1000 ground sphere (Haines et al., Ray Tracing
+// Gems, ch. 7).
 float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direction, float t_max)
 {
+    float direction_length = length(direction);
+    vec3 unit = direction / direction_length;
     vec3 to_origin = origin - center;
-    float b = dot(to_origin, direction);
-    vec3 closest_offset = to_origin - b * direction;
+    float b = dot(to_origin, unit);
+    vec3 closest_offset = to_origin - b * unit;
     float discriminant = radius * radius - dot(closest_offset, closest_offset);
     if (discriminant < 0.0)
         return INFINITY;
     float root = sqrt(discriminant);
     float c = dot(to_origin, to_origin) - radius * radius;
     float q = -b - (b >= 0.0 ? root : -root);
-    float t_near = c / q;
-    float t_far = q;
+    float t_near = c / q / direction_length;
+    float t_far = q / direction_length;
     if (t_near > t_far) { float swap = t_near; t_near = t_far; t_far = swap; }
     if (t_near > 0.0 && t_near < t_max)
         return t_near;
     if (t_far > 0.0 && t_far < t_max)
         return t_far;
     return INFINITY;
+}
+
+// Moller-Trumbore for a triangle (corner, edge1, edge2), or the parallelogram spanned by
+// the same vectors when quad is true. Returns t and the two edge coordinates.
+float intersect_flat(vec3 corner, vec3 edge1, vec3 edge2, bool quad, vec3 origin, vec3 direction, float t_max,
+                     out vec2 coordinates)
+{
+    coordinates = vec2(0.0);
+    vec3 p = cross(direction, edge2);
+    float determinant = dot(edge1, p);
+    if (abs(determinant) < 1e-20)
+        return INFINITY;
+    float inverse = 1.0 / determinant;
+    vec3 s = origin - corner;
+    float u = dot(s, p) * inverse;
+    vec3 q = cross(s, edge1);
+    float v = dot(direction, q) * inverse;
+    bool inside = quad ? (u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0) : (u >= 0.0 && v >= 0.0 && u + v <= 1.0);
+    if (!inside)
+        return INFINITY;
+    float t = dot(edge2, q) * inverse;
+    coordinates = vec2(u, v);
+    return t > 0.0 && t < t_max ? t : INFINITY;
 }
 
 // Entry distance of the ray into a box, or INFINITY when it misses or enters beyond t_max.
@@ -128,54 +181,86 @@ float intersect_box(vec3 box_min, vec3 box_max, vec3 origin, vec3 inverse_direct
     return enter <= leave ? enter : INFINITY;
 }
 
-uint primitive_offset;
-uint primitive_count;
-uint node_offset;
-uint node_count;
-uint material_offset;
+float node_entry_distance(uint node, vec3 origin, vec3 inverse_direction, float t_max)
+{
+    uint base = node_offset + node * uint(PACKED_NODE_STRIDE);
+    return intersect_box(packed_xyz(packed_texel(base)), packed_xyz(packed_texel(base + 1u)), origin,
+                         inverse_direction, t_max);
+}
 
-// Tests one primitive (by slot); on a nearer hit updates hit.
-void intersect_primitive(uint slot, vec3 origin, vec3 direction, inout Hit hit)
+// Tests one primitive (by slot) of the current level; on a nearer hit updates hit.
+void intersect_primitive(uint slot, uvec4 head, vec3 origin, vec3 direction, float time, uint instance,
+                         inout Hit hit)
 {
     uint base = primitive_offset + slot * uint(PACKED_PRIMITIVE_STRIDE);
-    uvec4 head = packed_texel(base);
+    vec4 a = packed_vec4(base + 1u);
+    float t = INFINITY;
+    vec2 coordinates = vec2(0.0);
     if (head.x == uint(PRIMITIVE_SPHERE)) {
-        vec4 sphere = uintBitsToFloat(packed_texel(base + 1u));
-        float t = intersect_sphere(sphere.xyz, sphere.w, origin, direction, hit.t);
-        if (t < hit.t) {
-            hit.t = t;
-            hit.primitive = slot;
-        }
+        t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
+    } else if (head.x == uint(PRIMITIVE_MOVING_SPHERE)) {
+        vec3 later = packed_vec4(base + 2u).xyz;
+        t = intersect_sphere(mix(a.xyz, later, time), a.w, origin, direction, hit.t);
+    } else {
+        vec3 edge1 = packed_vec4(base + 2u).xyz;
+        vec3 edge2 = packed_vec4(base + 3u).xyz;
+        t = intersect_flat(a.xyz, edge1, edge2, head.x == uint(PRIMITIVE_QUAD), origin, direction, hit.t,
+                           coordinates);
+    }
+    if (t < hit.t) {
+        hit.t = t;
+        hit.primitive = slot;
+        hit.instance = instance;
+        hit.barycentric = coordinates;
     }
 }
 
-// Finds the nearest hit along the ray by walking the BVH nearer child first with a small
-// stack. work counts node visits and primitive tests; overflow is set when the hard cap
-// cut the traversal short.
-bool trace(vec3 origin, vec3 direction, out Hit hit, inout int work, inout bool overflow)
+// Moves a world ray into an instance's object coordinates (the direction is not
+// renormalised, so t keeps meaning the world ray's parameter).
+void to_object(uint instance, vec3 origin, vec3 direction, out vec3 object_origin, out vec3 object_direction)
+{
+    uint base = instance_offset + instance * uint(PACKED_INSTANCE_STRIDE);
+    vec4 row0 = packed_vec4(base + 1u), row1 = packed_vec4(base + 2u), row2 = packed_vec4(base + 3u);
+    object_origin = vec3(dot(row0.xyz, origin) + row0.w, dot(row1.xyz, origin) + row1.w, dot(row2.xyz, origin) + row2.w);
+    object_direction = vec3(dot(row0.xyz, direction), dot(row1.xyz, direction), dot(row2.xyz, direction));
+}
+
+// Finds the nearest hit along the ray by walking the top-level BVH and, through instance
+// records, the objects' BVHs, nearer child first, with one explicit stack. work counts
+// node visits and primitive tests; overflow is set when the hard cap cut the traversal.
+// Entering an instance pushes a marker (NONE) that restores the world ray when popped.
+bool trace(vec3 world_origin, vec3 world_direction, float time, out Hit hit, inout int work, inout bool overflow)
 {
     hit.t = INFINITY;
     hit.primitive = 0u;
+    hit.instance = NONE;
+    hit.barycentric = vec2(0.0);
     if (node_count == 0u)
         return false;
+    vec3 origin = world_origin;
+    vec3 direction = world_direction;
     vec3 inverse_direction = 1.0 / direction;
-    uvec4 root_min = packed_texel(node_offset);
-    uvec4 root_max = packed_texel(node_offset + 1u);
-    if (intersect_box(packed_xyz(root_min), packed_xyz(root_max), origin, inverse_direction, INFINITY) == INFINITY)
+    uint instance = NONE;
+    float node_entry = node_entry_distance(0u, origin, inverse_direction, INFINITY);
+    if (node_entry == INFINITY)
         return false;
 
-    uint stack_node[BVH_MAX_DEPTH + 1];
-    float stack_entry[BVH_MAX_DEPTH + 1];
+    uint stack_node[STACK_SIZE];
+    float stack_entry[STACK_SIZE];
     int stack_size = 0;
     uint node = 0u;
-    float node_entry = 0.0;
     for (;;) {
         work++;
-        if (work > TRAVERSAL_HARD_CAP) {
+        if (work > TRAVERSAL_HARD_CAP || overflow) {
             overflow = true;
             break;
         }
-        if (node_entry < hit.t) {
+        if (node == NONE) {
+            origin = world_origin;
+            direction = world_direction;
+            inverse_direction = 1.0 / direction;
+            instance = NONE;
+        } else if (node_entry < hit.t) {
             uint base = node_offset + node * uint(PACKED_NODE_STRIDE);
             uvec4 low = packed_texel(base);
             uvec4 high = packed_texel(base + 1u);
@@ -184,16 +269,24 @@ bool trace(vec3 origin, vec3 direction, out Hit hit, inout int work, inout bool 
             if (count > 0u) {
                 for (uint slot = first; slot < first + count; slot++) {
                     work++;
-                    intersect_primitive(slot, origin, direction, hit);
+                    uvec4 head = packed_texel(primitive_offset + slot * uint(PACKED_PRIMITIVE_STRIDE));
+                    if (head.x == uint(PRIMITIVE_INSTANCE)) {
+                        if (stack_size + 2 <= STACK_SIZE) {
+                            stack_node[stack_size] = NONE;
+                            stack_entry[stack_size] = -INFINITY;
+                            stack_node[stack_size + 1] = head.w | ENTER_INSTANCE;
+                            stack_entry[stack_size + 1] = -INFINITY;
+                            stack_size += 2;
+                        } else {
+                            overflow = true;   // reported as an error, never skipped silently
+                        }
+                    } else {
+                        intersect_primitive(slot, head, origin, direction, time, instance, hit);
+                    }
                 }
             } else {
-                uint left_base = node_offset + first * uint(PACKED_NODE_STRIDE);
-                float left_entry = intersect_box(packed_xyz(packed_texel(left_base)),
-                                                 packed_xyz(packed_texel(left_base + 1u)),
-                                                 origin, inverse_direction, hit.t);
-                float right_entry = intersect_box(packed_xyz(packed_texel(left_base + 2u)),
-                                                  packed_xyz(packed_texel(left_base + 3u)),
-                                                  origin, inverse_direction, hit.t);
+                float left_entry = node_entry_distance(first, origin, inverse_direction, hit.t);
+                float right_entry = node_entry_distance(first + 1u, origin, inverse_direction, hit.t);
                 uint near_node = first, far_node = first + 1u;
                 float near_entry = left_entry, far_entry = right_entry;
                 if (right_entry < left_entry) {
@@ -202,9 +295,13 @@ bool trace(vec3 origin, vec3 direction, out Hit hit, inout int work, inout bool 
                 }
                 if (near_entry < INFINITY) {
                     if (far_entry < INFINITY) {
-                        stack_node[stack_size] = far_node;
-                        stack_entry[stack_size] = far_entry;
-                        stack_size++;
+                        if (stack_size < STACK_SIZE) {
+                            stack_node[stack_size] = far_node;
+                            stack_entry[stack_size] = far_entry;
+                            stack_size++;
+                        } else {
+                            overflow = true;
+                        }
                     }
                     node = near_node;
                     node_entry = near_entry;
@@ -217,18 +314,133 @@ bool trace(vec3 origin, vec3 direction, out Hit hit, inout int work, inout bool 
         stack_size--;
         node = stack_node[stack_size];
         node_entry = stack_entry[stack_size];
+        if (node != NONE && (node & ENTER_INSTANCE) != 0u) {
+            instance = node & ~ENTER_INSTANCE;
+            to_object(instance, world_origin, world_direction, origin, direction);
+            inverse_direction = 1.0 / direction;
+            node = packed_texel(instance_offset + instance * uint(PACKED_INSTANCE_STRIDE)).x;
+            node_entry = node_entry_distance(node, origin, inverse_direction, hit.t);
+        }
     }
     return hit.t < INFINITY;
 }
 
-// ---- shading ---------------------------------------------------------------------
+// ---- images and textures ---------------------------------------------------------
+
+// Bilinear lookup of image (index) at uv (u right, v down from the top row), wrapping.
+vec3 image_lookup(uint image, vec2 uv)
+{
+    uvec4 record = packed_texel(image_offset + image * uint(PACKED_IMAGE_STRIDE));
+    uint first = record.x;
+    int width = int(record.y), height = int(record.z);
+    if (width == 0 || height == 0)
+        return vec3(1.0, 0.0, 1.0);
+    vec2 position = fract(uv) * vec2(width, height) - 0.5;
+    ivec2 corner = ivec2(floor(position));
+    vec2 weight = position - vec2(corner);
+    vec3 colour = vec3(0.0);
+    for (int k = 0; k < 4; k++) {
+        ivec2 texel = corner + ivec2(k & 1, k >> 1);
+        texel.x = (texel.x % width + width) % width;
+        texel.y = clamp(texel.y, 0, height - 1);
+        float w = ((k & 1) != 0 ? weight.x : 1.0 - weight.x) * ((k >> 1) != 0 ? weight.y : 1.0 - weight.y);
+        colour += w * packed_vec4(first + uint(texel.y * width + texel.x)).rgb;
+    }
+    return colour;
+}
+
+// Gradient noise in [-1, 1] with hashed gradients (Perlin's construction, hash instead
+// of a permutation table so that no table needs uploading).
+float gradient_noise(vec3 p)
+{
+    vec3 cell = floor(p);
+    vec3 f = p - cell;
+    vec3 fade = f * f * f * (f * (f * 6.0 - 15.0) + 10.0);
+    float result = 0.0;
+    for (int k = 0; k < 8; k++) {
+        ivec3 offset = ivec3(k & 1, (k >> 1) & 1, k >> 2);
+        uvec4 h = hash4(uvec4(uvec3(ivec3(cell) + offset), 0x5eedu));
+        vec3 gradient = normalize(vec3(h.xyz >> 8u) * (2.0 / 16777216.0) - 1.0 + 1e-6);
+        vec3 weight = mix(1.0 - fade, fade, vec3(offset));
+        result += weight.x * weight.y * weight.z * dot(gradient, f - vec3(offset));
+    }
+    return result;
+}
+
+float turbulence(vec3 p)
+{
+    float sum = 0.0, weight = 1.0;
+    for (int octave = 0; octave < 7; octave++) {
+        sum += weight * abs(gradient_noise(p));
+        weight *= 0.5;
+        p *= 2.0;
+    }
+    return sum;
+}
+
+// The colour of texture (index) at a surface point: world position p, uv.
+vec3 texture_value(uint texture, vec3 p, vec2 uv)
+{
+    // Checkers nest at most one level: their two cells are evaluated as flat textures.
+    for (int level = 0; level < 2; level++) {
+        uint base = texture_offset + texture * uint(PACKED_TEXTURE_STRIDE);
+        uvec4 head = packed_texel(base);
+        vec4 data = packed_vec4(base + 1u);
+        if (head.x == uint(TEXTURE_CONSTANT))
+            return data.rgb;
+        if (head.x == uint(TEXTURE_IMAGE))
+            return image_lookup(head.w, uv);
+        if (head.x == uint(TEXTURE_NOISE))
+            return vec3(0.5 * (1.0 + gradient_noise(data.w * p)));
+        if (head.x == uint(TEXTURE_TURBULENCE))
+            return vec3(turbulence(data.w * p));
+        if (head.x == uint(TEXTURE_MARBLE))
+            return vec3(0.5 * (1.0 + sin(data.w * p.z + 10.0 * turbulence(p))));
+        // Checker: the cell parity of floor(p / scale) picks the even or the odd texture.
+        ivec3 cell = ivec3(floor(p / data.w));
+        texture = ((cell.x + cell.y + cell.z) & 1) == 0 ? head.y : head.z;
+    }
+    return vec3(1.0, 0.0, 1.0);
+}
+
+// ---- sky -------------------------------------------------------------------------
 
 vec3 sky_radiance(vec3 direction)
 {
     if (sky_type == SKY_CONSTANT)
-        return sky_bottom;
-    return mix(sky_bottom, sky_top, 0.5 * (direction.y + 1.0));
+        return sky_intensity * sky_bottom;
+    if (sky_type != SKY_BOX && sky_type != SKY_ENVIRONMENT)
+        return sky_intensity * mix(sky_bottom, sky_top, 0.5 * (direction.y + 1.0));
+    // Turn the direction into the sky's own frame (the sky turns by +rotation about Y).
+    float c = cos(sky_rotation), s = sin(sky_rotation);
+    vec3 d = vec3(c * direction.x - s * direction.z, direction.y, s * direction.x + c * direction.z);
+    if (sky_type == SKY_ENVIRONMENT) {
+        vec2 uv = vec2(0.5 + atan(d.x, -d.z) / (2.0 * PI), acos(clamp(d.y, -1.0, 1.0)) / PI);
+        return sky_intensity * image_lookup(sky_environment, uv);
+    }
+    // Cube map faces as OpenGL lays them out: major axis, then (s, t) on the face.
+    vec3 a = abs(d);
+    uint face;
+    vec2 st;
+    float major;
+    if (a.x >= a.y && a.x >= a.z) {
+        major = a.x;
+        face = d.x > 0.0 ? 0u : 1u;
+        st = d.x > 0.0 ? vec2(-d.z, -d.y) : vec2(d.z, -d.y);
+    } else if (a.y >= a.z) {
+        major = a.y;
+        face = d.y > 0.0 ? 2u : 3u;
+        st = d.y > 0.0 ? vec2(d.x, d.z) : vec2(d.x, -d.z);
+    } else {
+        major = a.z;
+        face = d.z > 0.0 ? 4u : 5u;
+        st = d.z > 0.0 ? vec2(d.x, -d.y) : vec2(-d.x, -d.y);
+    }
+    vec2 uv = clamp(0.5 * (st / major + 1.0), 0.0, 0.99999);
+    return sky_intensity * image_lookup(sky_faces[face], uv);
 }
+
+// ---- shading helpers ------------------------------------------------------------
 
 vec3 random_unit_vector(vec2 u)
 {
@@ -265,6 +477,104 @@ float ray_offset(vec3 p)
     return 1e-4 * (1.0 + max(a.x, max(a.y, a.z)));
 }
 
+// What shading needs to know about a hit.
+struct Surface {
+    vec3 position;        // world
+    vec3 geometric;       // world, unit, outward (the side the primitive faces)
+    vec3 shading;         // world, unit, outward (interpolated vertex normals, else geometric)
+    vec2 uv;
+    uint material;        // material index
+    bool volume_boundary; // the hit is on a volume instance's boundary
+    uint instance;
+};
+
+// Computes the surface at a hit: normals (object space, moved to the world by the
+// inverse transpose of the placement, which is the transpose of world-to-object), uv and
+// the material (the primitive's own, else the instance's, else the default).
+Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
+{
+    Surface surface;
+    surface.position = origin + hit.t * direction;
+    surface.instance = hit.instance;
+    surface.volume_boundary = false;
+    uint base = primitive_offset + hit.primitive * uint(PACKED_PRIMITIVE_STRIDE);
+    uvec4 head = packed_texel(base);
+    vec4 a = packed_vec4(base + 1u);
+    vec3 object_point = surface.position;
+    mat3 normal_to_world = mat3(1.0);
+    uint instance_material = NONE;
+    if (hit.instance != NONE) {
+        uint instance_base = instance_offset + hit.instance * uint(PACKED_INSTANCE_STRIDE);
+        uvec4 instance_head = packed_texel(instance_base);
+        instance_material = instance_head.y;
+        surface.volume_boundary = (instance_head.z & uint(INSTANCE_VOLUME)) != 0u;
+        vec4 row0 = packed_vec4(instance_base + 1u), row1 = packed_vec4(instance_base + 2u),
+             row2 = packed_vec4(instance_base + 3u);
+        vec3 object_direction;
+        to_object(hit.instance, origin, direction, object_point, object_direction);
+        object_point += hit.t * object_direction;
+        // Columns are the rows of world-to-object: transpose(M) * n.
+        normal_to_world = mat3(row0.xyz, row1.xyz, row2.xyz);
+    }
+    vec3 normal;
+    vec3 shading_normal;
+    vec2 uv = hit.barycentric;
+    if (head.x == uint(PRIMITIVE_SPHERE) || head.x == uint(PRIMITIVE_MOVING_SPHERE)) {
+        vec3 center = head.x == uint(PRIMITIVE_SPHERE) ? a.xyz : mix(a.xyz, packed_vec4(base + 2u).xyz, time);
+        normal = (object_point - center) / a.w;
+        shading_normal = normal;
+        // Longitude/latitude of the normal: u around +Y from -X, v from the top.
+        uv = vec2(0.5 + atan(-normal.z, normal.x) / (2.0 * PI), acos(clamp(-normal.y, -1.0, 1.0)) / PI);
+        uv.y = 1.0 - uv.y;
+    } else {
+        vec3 edge1 = packed_vec4(base + 2u).xyz;
+        vec3 edge2 = packed_vec4(base + 3u).xyz;
+        normal = cross(edge1, edge2);
+        shading_normal = normal;
+        if (head.z != NONE) {
+            // Mesh triangle with vertex attributes: interpolate by barycentrics.
+            uint attribute_base = attribute_offset + head.z * uint(PACKED_ATTRIBUTE_STRIDE);
+            vec4 t0 = packed_vec4(attribute_base), t1 = packed_vec4(attribute_base + 1u), t2 = packed_vec4(attribute_base + 2u);
+            uvec4 t3_bits = packed_texel(attribute_base + 3u);
+            vec4 t3 = uintBitsToFloat(t3_bits);
+            vec3 weights = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
+            if ((t3_bits.w & uint(ATTRIBUTE_HAS_NORMALS)) != 0u) {
+                vec3 interpolated = weights.x * t0.xyz + weights.y * t1.xyz + weights.z * t2.xyz;
+                if (dot(interpolated, interpolated) > 0.0)
+                    shading_normal = interpolated;
+            }
+            if ((t3_bits.w & uint(ATTRIBUTE_HAS_UVS)) != 0u)
+                uv = weights.x * vec2(t0.w, t1.w) + weights.y * vec2(t2.w, t3.x) + weights.z * t3.yz;
+        }
+    }
+    surface.geometric = normalize(normal_to_world * normal);
+    surface.shading = normalize(normal_to_world * shading_normal);
+    // Keep the shading normal on the geometric side, or light leaks through.
+    if (dot(surface.shading, surface.geometric) < 0.0)
+        surface.shading = surface.geometric;
+    surface.uv = uv;
+    surface.material = head.y != NONE ? head.y : instance_material != NONE ? instance_material : default_material;
+    return surface;
+}
+
+// Media stack in one uint: two 16-bit volume instance numbers + 1, the inner one low.
+uint media_inner(uint media) { return media & 0xffffu; }
+
+uint media_enter(uint media, uint instance)
+{
+    return ((media & 0xffffu) << 16) | ((instance + 1u) & 0xffffu);
+}
+
+uint media_leave(uint media, uint instance)
+{
+    uint number = (instance + 1u) & 0xffffu;
+    if ((media & 0xffffu) == number)
+        return media >> 16;
+    if ((media >> 16) == number)
+        return media & 0xffffu;
+    return media;
+}
+
 // ---- main ------------------------------------------------------------------------
 
 void main()
@@ -279,14 +589,19 @@ void main()
     vec4 statistics = texelFetch(state_statistics, frag_pixel, 0);
     uint samples_started = counters.x;
     uint bounce = counters.y;
+    uint media = counters.z;
 
-    uvec4 header_low = packed_texel(0u);
-    uvec4 header_high = packed_texel(1u);
-    material_offset = header_low.z;
-    primitive_offset = header_high.x;
-    primitive_count = header_high.y;
-    node_offset = header_high.z;
-    node_count = header_high.w;
+    uvec4 header0 = packed_texel(0u), header1 = packed_texel(1u), header2 = packed_texel(2u),
+          header3 = packed_texel(3u);
+    material_offset = header0.z;
+    primitive_offset = header1.x;
+    node_offset = header1.z;
+    node_count = header1.w;
+    instance_offset = header2.x;
+    attribute_offset = header2.z;
+    default_material = header2.w;
+    texture_offset = header3.x;
+    image_offset = header3.z;
 
     // Full-image pixel, row 0 at the top: a crop or tile renders exactly the pixels
     // (and random numbers) of the full render.
@@ -315,59 +630,98 @@ void main()
                                   + film.y * camera_vertical - origin);
             throughput = vec3(1.0);
             radiance = vec3(0.0);
+            media = camera_media;
             bounce = 1u;
         }
         if (work >= pass_work_budget)
             break;
 
+        // The sample's moment within the shutter: the same for all its segments.
+        float time = mix(shutter_open, shutter_close, random4(0u, 3u).x);
         Hit hit;
-        bool hit_something = trace(origin, direction, hit, work, overflow);
+        bool hit_something = trace(origin, direction, time, hit, work, overflow);
         statistics.x += 1.0;
         bool path_done = false;
+        vec4 u = random4(bounce, 1u);
+
+        // In a medium: scatter before the surface with probability 1 - exp(-density * t).
+        uint medium = media_inner(media);
+        if (medium != 0u) {
+            uint medium_base = instance_offset + (medium - 1u) * uint(PACKED_INSTANCE_STRIDE);
+            vec4 volume = packed_vec4(medium_base + 4u);
+            float distance = -log(1.0 - random4(bounce, 4u).x) / volume.x;
+            if (distance < hit.t) {
+                origin += distance * direction;
+                direction = random_unit_vector(u.xy);
+                throughput *= volume.yzw;
+                hit_something = false;
+                bounce++;
+                if (bounce > max_depth)
+                    path_done = true;
+                if (path_done) {
+                    accumulated += vec4(radiance, 1.0);
+                    bounce = 0u;
+                    finished_here++;
+                }
+                if (overflow)
+                    break;
+                continue;
+            }
+        }
+
         if (!hit_something) {
             radiance += throughput * sky_radiance(direction);
             path_done = true;
         } else {
-            uint base = primitive_offset + hit.primitive * uint(PACKED_PRIMITIVE_STRIDE);
-            uvec4 head = packed_texel(base);
-            vec4 sphere = uintBitsToFloat(packed_texel(base + 1u));
-            vec3 p = origin + hit.t * direction;
-            vec3 outward_normal = (p - sphere.xyz) / sphere.w;
-            bool front_face = dot(direction, outward_normal) < 0.0;
-            vec3 normal = front_face ? outward_normal : -outward_normal;
-
-            uint material = material_offset + head.y * uint(PACKED_MATERIAL_STRIDE);
-            uvec4 material0 = packed_texel(material);
-            uvec4 material1 = packed_texel(material + 1u);
-            uint material_type = material0.x;
-            vec3 albedo = uintBitsToFloat(material0.yzw);
-            vec4 u = random4(bounce, 1u);
+            Surface surface = surface_at(hit, origin, direction, time);
+            vec3 p = surface.position;
+            bool front_face = dot(direction, surface.geometric) < 0.0;
+            vec3 normal = front_face ? surface.geometric : -surface.geometric;
+            vec3 shading = front_face ? surface.shading : -surface.shading;
             vec3 next_direction = direction;
-            if (material_type == uint(MATERIAL_EMISSIVE)) {
-                radiance += throughput * uintBitsToFloat(material1.xyz);
-                path_done = true;
-            } else if (material_type == uint(MATERIAL_LAMBERTIAN)) {
-                // normal + a uniform unit vector is cosine-distributed about the normal.
-                next_direction = normal + random_unit_vector(u.xy);
-                float length_squared = dot(next_direction, next_direction);
-                next_direction = length_squared > 1e-12 ? next_direction * inversesqrt(length_squared) : normal;
-                throughput *= albedo;
-            } else if (material_type == uint(MATERIAL_METAL)) {
-                float fuzz = uintBitsToFloat(material1.w);
-                vec3 reflected = reflect(direction, normal);
-                next_direction = normalize(reflected + fuzz * random_in_unit_sphere(u.xyz));
-                throughput *= albedo;
-                if (dot(next_direction, normal) <= 0.0)
-                    path_done = true;   // scattered below the surface: absorbed
+            if (surface.volume_boundary) {
+                // Crossing a medium's boundary: the ray goes on unchanged.
+                media = front_face ? media_enter(media, surface.instance) : media_leave(media, surface.instance);
             } else {
-                float ior = uintBitsToFloat(packed_texel(material + 2u).x);
-                float eta_ratio = front_face ? 1.0 / ior : ior;
-                float cosine = min(dot(-direction, normal), 1.0);
-                float sine = sqrt(max(0.0, 1.0 - cosine * cosine));
-                if (eta_ratio * sine > 1.0 || schlick_reflectance(cosine, eta_ratio) > u.w)
-                    next_direction = reflect(direction, normal);
-                else
-                    next_direction = refract(direction, normal, eta_ratio);
+                uint material = material_offset + surface.material * uint(PACKED_MATERIAL_STRIDE);
+                uvec4 material0 = packed_texel(material);
+                uvec4 material1 = packed_texel(material + 1u);
+                uvec4 material2 = packed_texel(material + 2u);
+                uint material_type = material0.x;
+                vec3 albedo = uintBitsToFloat(material0.yzw);
+                if (material2.y != NONE)
+                    albedo *= texture_value(material2.y, p, surface.uv);
+                if (material_type == uint(MATERIAL_EMISSIVE)) {
+                    vec3 emission = uintBitsToFloat(material1.xyz);
+                    if (material2.z != NONE)
+                        emission *= texture_value(material2.z, p, surface.uv);
+                    radiance += throughput * emission;
+                    path_done = true;
+                } else if (material_type == uint(MATERIAL_LAMBERTIAN)) {
+                    // normal + a uniform unit vector is cosine-distributed about the normal.
+                    next_direction = shading + random_unit_vector(u.xy);
+                    float length_squared = dot(next_direction, next_direction);
+                    next_direction = length_squared > 1e-12 ? next_direction * inversesqrt(length_squared) : shading;
+                    if (dot(next_direction, normal) <= 0.0)
+                        next_direction = reflect(next_direction, normal);
+                    throughput *= albedo;
+                } else if (material_type == uint(MATERIAL_METAL)) {
+                    float fuzz = uintBitsToFloat(material1.w);
+                    vec3 reflected = reflect(direction, shading);
+                    next_direction = normalize(reflected + fuzz * random_in_unit_sphere(u.xyz));
+                    throughput *= albedo;
+                    if (dot(next_direction, normal) <= 0.0)
+                        path_done = true;   // scattered below the surface: absorbed
+                } else {
+                    float ior = uintBitsToFloat(material2.x);
+                    float eta_ratio = front_face ? 1.0 / ior : ior;
+                    float cosine = min(dot(-direction, shading), 1.0);
+                    float sine = sqrt(max(0.0, 1.0 - cosine * cosine));
+                    if (eta_ratio * sine > 1.0 || schlick_reflectance(cosine, eta_ratio) > u.w)
+                        next_direction = reflect(direction, shading);
+                    else
+                        next_direction = refract(direction, shading, eta_ratio);
+                }
             }
             if (!path_done) {
                 float side = dot(next_direction, normal) > 0.0 ? 1.0 : -1.0;
@@ -407,7 +761,7 @@ void main()
     out_direction = vec4(direction, 0.0);
     out_throughput = vec4(throughput, 0.0);
     out_radiance = vec4(radiance, 0.0);
-    out_counters = uvec4(samples_started, bounce, 0u, 0u);
+    out_counters = uvec4(samples_started, bounce, media, 0u);
     out_accumulated = accumulated;
     out_statistics = statistics;
 }
