@@ -17,6 +17,7 @@ static void print_usage(FILE *stream)
             "  diff A B                 compare two images (exit 0 pass, 1 fail, 2 error)\n"
             "  info                     show the EGL device and OpenGL renderer that would be used\n"
             "  stats IMAGE              per-channel mean/min/max of an image and its rtspheres metadata\n"
+            "  merge PARTS... -o OUT    merge EXR parts of one render (sample ranges, tiles, shards)\n"
             "\n"
             "Run 'rtspheres COMMAND --help' for a command's options.\n");
 }
@@ -48,6 +49,8 @@ int main(int argc, char **argv)
         return command_info(argc - 1, argv + 1);
     if (strcmp(command, "stats") == 0)
         return command_stats(argc - 1, argv + 1);
+    if (strcmp(command, "merge") == 0)
+        return command_merge(argc - 1, argv + 1);
     if (strcmp(command, "--help") == 0 || strcmp(command, "-h") == 0 || strcmp(command, "help") == 0) {
         print_usage(stdout);
         return EXIT_OK;

@@ -1,0 +1,110 @@
+/* merge.h: combines EXR parts of one render (sample ranges, tiles, crops, shards) into
+ * the full image, exactly. Plain C on rt_image arrays; never prints, never exits.
+ *
+ * A part is an image with channels R, G, B (the mean radiance of its samples) and
+ * `samples` (per-pixel count of finished samples), placed in the full image by its data
+ * window (rt_image x, y, full_width, full_height), plus the rtspheres metadata that says
+ * which render it belongs to (merge_metadata).
+ *
+ * The rules:
+ *   - Every part must agree with the first on full image size, seed, max depth, frame and
+ *     scene hash; otherwise RT_ERROR_INPUT naming both parts and both values.
+ *   - Parts with the same data window are sample-range parts of one region. Their sample
+ *     ranges [sample_start, sample_start + spp) must not intersect (the same samples
+ *     would count twice). Per pixel: colour = sum(colour_i * n_i) / sum(n_i) in double,
+ *     samples = sum(n_i); a pixel with no samples stays 0.
+ *   - Regions with different data windows must not intersect. Pixels no region covers
+ *     are an error ("missing pieces: ...") unless allow_missing is set; they stay 0 with
+ *     0 samples.
+ *   - A region whose set of sample ranges differs from the first region's is a warning
+ *     (merge_summary.warnings), not an error: its per-pixel counts stay right.
+ *   - The summary's complete is true only when every part is complete, each region's
+ *     sample ranges are contiguous, every region has the same ranges and every pixel is
+ *     covered.
+ *
+ * Use: merger_create, merger_add once per part (it validates the part against the ones
+ * added before and adds its pixels to running double sums, so the caller may free the
+ * part's pixels at once and a farm's parts never all sit in memory), merger_finish,
+ * merger_free. merge_read_part reads a part file with its metadata.
+ */
+#ifndef RT_MERGE_H
+#define RT_MERGE_H
+
+#include <stdbool.h>
+
+#include "image_io.h"
+#include "status.h"
+
+#define MERGE_TEXT_MAX 512
+#define MERGE_MAX_WARNINGS 8
+#define MERGE_WARNING_MAX 512
+
+/* The rtspheres:* metadata of one part that the merge checks or carries over. */
+typedef struct merge_metadata {
+    char scene[MERGE_TEXT_MAX];          /* rtspheres:scene, the scene file's path */
+    char scene_hash[MERGE_TEXT_MAX];     /* rtspheres:scene_hash */
+    unsigned long long seed;             /* rtspheres:seed */
+    int max_depth;                       /* rtspheres:max_depth */
+    int frame;                           /* rtspheres:frame, -1 without --frames */
+    unsigned long long sample_start;     /* rtspheres:sample_start */
+    long long spp;                       /* rtspheres:spp: the samples the part was asked for */
+    bool complete;                       /* rtspheres:complete */
+    double render_seconds;               /* rtspheres:render_seconds, 0 when absent */
+    double path_segments;                /* rtspheres:path_segments, 0 when absent */
+} merge_metadata;
+
+typedef struct merge_options {
+    bool allow_missing;                  /* uncovered pixels are not an error */
+} merge_options;
+
+/* What merger_finish found, besides the image. */
+typedef struct merge_summary {
+    int part_count;
+    int region_count;
+    int full_width, full_height;
+    long long min_samples;               /* smallest per-pixel sample count of the full image */
+    long long max_samples;
+    double total_samples;                /* sum of the samples channel */
+    unsigned long long sample_start;     /* lowest sample_start of any part */
+    bool complete;                       /* see the rules above */
+    long long missing_pixels;            /* uncovered pixels (only with allow_missing) */
+    merge_metadata metadata;             /* the common values, from the first part */
+    double render_seconds;               /* sums over the parts */
+    double path_segments;
+    int warning_count;                   /* may exceed MERGE_MAX_WARNINGS; the rest are dropped */
+    char warnings[MERGE_MAX_WARNINGS][MERGE_WARNING_MAX];
+} merge_summary;
+
+typedef struct merger merger;
+
+/* Returns options with every field at its default (all false). */
+merge_options merge_options_defaults(void);
+
+/* Creates an empty merger into *out. Returns RT_ERROR_RUNTIME when memory runs out.
+ * Free with merger_free(). */
+rt_status merger_create(merger **out, rt_error *error);
+
+/* Frees the merger and everything it holds; NULL is allowed. */
+void merger_free(merger *m);
+
+/* Checks part image (named name in messages) with its metadata against the parts added
+ * before and adds its pixels to the sums. The image must have channels named R, G, B and
+ * samples. Returns RT_ERROR_INPUT naming both parts on a mismatch or overlap (the merger
+ * is then unchanged and should be freed), RT_ERROR_RUNTIME when memory runs out. The
+ * merger keeps copies of name and metadata, not the image: the caller still owns it. */
+rt_status merger_add(merger *m, const char *name, const rt_image *image, const merge_metadata *metadata,
+                     rt_error *error);
+
+/* Assembles the full image into *out (channels R, G, B, samples; no data-window offset;
+ * allocated, free with image_free()) and fills *summary. options may be NULL. No parts,
+ * or missing pieces without allow_missing: RT_ERROR_INPUT; out is then left empty. */
+rt_status merger_finish(merger *m, const merge_options *options, rt_image *out, merge_summary *summary,
+                        rt_error *error);
+
+/* Reads the part file at path: its pixels into *image (allocated; free with image_free())
+ * and its rtspheres metadata into *metadata. A file that cannot be read, lacks the
+ * rtspheres metadata or the `samples` channel is RT_ERROR_INPUT naming the file; *image
+ * is then empty. */
+rt_status merge_read_part(const char *path, rt_image *image, merge_metadata *metadata, rt_error *error);
+
+#endif

@@ -1,0 +1,161 @@
+#!/bin/sh
+# test-merge.sh: `rtspheres merge` on real renders: sample-range parts, tiles and shards
+# merge back into the single-machine render, and mismatched, overlapping or missing parts
+# are refused with exit 2 and a message.
+#   usage: sh tests/render/test-merge.sh PROGRAM SCRATCH_DIR
+set -u
+program=$1
+scratch=$2
+. "$(dirname "$0")/lib.sh"
+
+scene=scenes/materials/metal.txt
+size="--size 48x27"
+full=$scratch/full.exr
+
+# render OUTPUT [OPTIONS...]: renders the test scene at the test size, 16 spp, quietly.
+render() {
+    out=$1
+    shift
+    "$program" render "$scene" -o "$out" $size --spp 16 --quiet "$@"
+}
+
+# stats_of FILE [--crop C]: runs `stats` once and keeps its output in $scratch/stats, which
+# stat_range and stat_metadata read (each `stats` run costs an OpenImageIO start-up).
+stats_of() {
+    "$program" stats "$@" >"$scratch/stats" 2>&1
+}
+
+# stat_range CHANNEL: "min max" of a channel in the last stats_of output.
+stat_range() {
+    sed -n "s/^channel $1: mean [^ ]* min \([^ ]*\) max \([^ ]*\)/\1 \2/p" "$scratch/stats"
+}
+
+# stat_metadata NAME: an rtspheres:NAME value in the last stats_of output.
+stat_metadata() {
+    sed -n "s/^metadata rtspheres:$1: //p" "$scratch/stats"
+}
+
+# merge_ok NAME EXPECTED TOLERANCE PARTS...: merges PARTS into $scratch/NAME.exr and
+# compares the result with EXPECTED by `diff --fail TOLERANCE --failpercent 0`; also
+# checks that every pixel has 16 samples and the merged image says it is complete.
+merge_ok() {
+    name=$1 expected=$2 tolerance=$3
+    shift 3
+    merged=$scratch/$name.exr
+    if ! "$program" merge "$@" -o "$merged" --quiet 2>"$scratch/stderr"; then
+        fail "$name" "merge failed: $(head -c 300 "$scratch/stderr")"
+    elif ! "$program" diff "$merged" "$expected" --fail "$tolerance" --failpercent 0 >"$scratch/diff" 2>&1; then
+        fail "$name" "merged image differs from the full render: $(tr '\n' ' ' <"$scratch/diff")"
+    elif ! stats_of "$merged" || [ "$(stat_range samples)" != "16 16" ]; then
+        fail "$name" "samples channel min/max is '$(stat_range samples)', expected '16 16'"
+    elif [ "$(stat_metadata spp)" != 16 ] || [ "$(stat_metadata complete)" != 1 ]; then
+        fail "$name" "metadata spp '$(stat_metadata spp)', complete '$(stat_metadata complete)'"
+    elif grep -q merged_parts "$scratch/stats" && [ "$(stat_metadata merged_parts)" != $# ]; then
+        # (checked where `stats` prints rtspheres:merged_parts)
+        fail "$name" "metadata merged_parts '$(stat_metadata merged_parts)', expected $#"
+    else
+        pass "$name"
+    fi
+}
+
+# refuse NAME PATTERN PARTS...: merging PARTS exits 2, says PATTERN (grep -E) on stderr and
+# writes no output.
+refuse() {
+    name=$1 pattern=$2
+    shift 2
+    rm -f "$scratch/refused.exr"
+    "$program" merge "$@" -o "$scratch/refused.exr" >/dev/null 2>"$scratch/stderr"
+    got=$?
+    if [ "$got" != 2 ]; then
+        fail "$name" "exit $got, expected 2; stderr: $(head -c 300 "$scratch/stderr")"
+    elif ! grep -qE -e "$pattern" "$scratch/stderr"; then
+        fail "$name" "stderr lacks /$pattern/: $(head -c 300 "$scratch/stderr")"
+    elif [ -e "$scratch/refused.exr" ]; then
+        fail "$name" "an output was written although the merge was refused"
+    else
+        pass "$name"
+    fi
+}
+
+if ! render "$full"; then
+    fail "full render" "rtspheres render failed"
+    finish
+    exit
+fi
+
+# (a) Two sample-range parts, 0:6 and 6:10: the same samples as the full render, summed in
+# another order, so equal within float rounding.
+# The second part runs with a larger environment, which moves the stack: a scene hash
+# that picked up uninitialised bytes (it hashes whole structs) would then differ, and
+# parts of one render made on different machines would be refused.
+render "$scratch/s0.exr" --samples 0:6 \
+    && RTSPHERES_TEST_PADDING=$(printf '%0777d' 0) render "$scratch/s1.exr" --samples 6:10
+merge_ok "merge-sample-ranges" "$full" 1e-5 "$scratch/s0.exr" "$scratch/s1.exr"
+
+# (b) Three tiles: every pixel is the full render's, so bit-exact.
+for i in 0 1 2; do render "$scratch/tile$i.exr" --tile $i/3; done
+merge_ok "merge-tiles-exact" "$full" 0 "$scratch/tile2.exr" "$scratch/tile0.exr" "$scratch/tile1.exr"
+
+# (c) Four sample shards.
+for i in 0 1 2 3; do render "$scratch/shard$i.exr" --shard $i/4; done
+merge_ok "merge-shards" "$full" 1e-5 "$scratch/shard0.exr" "$scratch/shard1.exr" "$scratch/shard2.exr" \
+    "$scratch/shard3.exr"
+
+# (d) Refusals.
+render "$scratch/seed.exr" --samples 6:10 --seed 99
+refuse "refuse-different-seed" "seed 1.*seed 99" "$scratch/s0.exr" "$scratch/seed.exr"
+"$program" render "$scene" -o "$scratch/size.exr" --size 40x27 --spp 16 --quiet --samples 6:10
+refuse "refuse-different-size" "48x27.*40x27" "$scratch/s0.exr" "$scratch/size.exr"
+"$program" render scenes/materials/lambertian.txt -o "$scratch/other.exr" $size --spp 16 --quiet --samples 6:10
+refuse "refuse-other-scene" "different scenes" "$scratch/s0.exr" "$scratch/other.exr"
+# Shard 1/4 of 16 samples is 4:4, which shares samples 4 and 5 with part 0:6.
+refuse "refuse-overlapping-samples" "s0.exr.*shard1.exr.*samples 4-5" "$scratch/s0.exr" "$scratch/shard1.exr"
+refuse "refuse-missing-tile" "missing pieces: 432 pixels.*rows 9-17" "$scratch/tile0.exr" "$scratch/tile2.exr"
+refuse "refuse-overlapping-tiles" "overlap" "$scratch/tile0.exr" "$scratch/tile1.exr" "$scratch/s0.exr"
+refuse "refuse-unreadable-part" "nonexistent.exr" "$scratch/s0.exr" "$scratch/nonexistent.exr"
+# A PPM written by hand: an image, but with no samples channel and no metadata.
+printf 'P6\n48 27\n255\n' >"$scratch/plain.ppm"
+head -c 3888 /dev/zero >>"$scratch/plain.ppm"
+refuse "refuse-part-without-samples" "plain.ppm.*samples" "$scratch/s0.exr" "$scratch/plain.ppm"
+
+# -o naming a part is refused and the part is left as it was.
+before=$(cksum <"$scratch/s0.exr")
+"$program" merge "$scratch/s0.exr" "$scratch/s1.exr" -o "$scratch/s0.exr" >/dev/null 2>"$scratch/stderr"
+got=$?
+if [ "$got" = 2 ] && grep -q "is one of the parts" "$scratch/stderr" && [ "$(cksum <"$scratch/s0.exr")" = "$before" ]; then
+    pass "refuse-overwriting-a-part"
+else
+    fail "refuse-overwriting-a-part" "exit $got; stderr: $(head -c 300 "$scratch/stderr")"
+fi
+
+# A missing tile is allowed with --allow-missing: its rows stay black with 0 samples.
+name=allow-missing
+if ! "$program" merge "$scratch/tile0.exr" "$scratch/tile2.exr" -o "$scratch/$name.exr" --allow-missing \
+        --quiet 2>"$scratch/stderr"; then
+    fail "$name" "merge failed: $(head -c 300 "$scratch/stderr")"
+elif ! stats_of "$scratch/$name.exr" --crop 0,9,48,18 || [ "$(stat_range samples)" != "0 0" ] \
+        || [ "$(stat_range R)" != "0 0" ] || [ "$(stat_metadata complete)" != 0 ]; then
+    fail "$name" "missing rows: samples '$(stat_range samples)', R '$(stat_range R)';" \
+        "complete '$(stat_metadata complete)'"
+elif ! stats_of "$scratch/$name.exr" --crop 0,0,48,9 || [ "$(stat_range samples)" != "16 16" ]; then
+    fail "$name" "tile 0 rows: samples '$(stat_range samples)', expected '16 16'"
+else
+    pass "$name"
+fi
+
+# Tiles with different sample ranges merge with a warning; the counts say what each has.
+name=warn-uneven-tiles
+"$program" render "$scene" -o "$scratch/tile1-8.exr" $size --spp 8 --quiet --tile 1/3
+if ! "$program" merge "$scratch/tile0.exr" "$scratch/tile1-8.exr" "$scratch/tile2.exr" -o "$scratch/$name.exr" \
+        --quiet 2>"$scratch/stderr"; then
+    fail "$name" "merge failed: $(head -c 300 "$scratch/stderr")"
+elif ! grep -q "warning:.*tile1-8.exr.*samples 0:8.*samples 0:16" "$scratch/stderr"; then
+    fail "$name" "no warning naming the tile and its samples: $(head -c 300 "$scratch/stderr")"
+elif ! stats_of "$scratch/$name.exr" || [ "$(stat_range samples)" != "8 16" ] || [ "$(stat_metadata spp)" != 8 ] \
+        || [ "$(stat_metadata complete)" != 0 ]; then
+    fail "$name" "samples '$(stat_range samples)', spp '$(stat_metadata spp)', complete '$(stat_metadata complete)'"
+else
+    pass "$name"
+fi
+
+finish

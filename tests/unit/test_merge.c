@@ -1,0 +1,537 @@
+/* test_merge.c: the merge rules of core/merge.h on small hand-made parts whose expected
+ * results are worked out in the comments: weighted means, uneven and zero counts, tiles
+ * put in place, and every refusal (overlaps, missing pieces, mismatched renders). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "merge.h"
+
+/* Makes a part: a width x height region at (x, y) of a full_width x full_height image,
+ * channels R, G, B, samples, every pixel colour (r, g, b) with n samples. full_width 0
+ * makes it the full image. */
+static rt_image make_part(int x, int y, int width, int height, int full_width, int full_height, float r, float g,
+                          float b, float n)
+{
+    rt_image image;
+    rt_error error;
+    assert_int_equal(image_create(&image, width, height, 4, &error), RT_OK);
+    static const char *const names[4] = {"R", "G", "B", "samples"};
+    for (int c = 0; c < 4; c++)
+        strcpy(image.channel_names[c], names[c]);
+    for (int i = 0; i < width * height; i++) {
+        image.pixels[4 * i + 0] = r;
+        image.pixels[4 * i + 1] = g;
+        image.pixels[4 * i + 2] = b;
+        image.pixels[4 * i + 3] = n;
+    }
+    image.x = x;
+    image.y = y;
+    image.full_width = full_width;
+    image.full_height = full_height;
+    return image;
+}
+
+/* The metadata of a complete part of samples start .. start+spp-1 of one common render. */
+static merge_metadata make_metadata(unsigned long long start, long long spp)
+{
+    merge_metadata metadata;
+    memset(&metadata, 0, sizeof metadata);
+    strcpy(metadata.scene, "scene.txt");
+    strcpy(metadata.scene_hash, "00112233aabbccdd");
+    metadata.seed = 1;
+    metadata.max_depth = 16;
+    metadata.frame = -1;
+    metadata.sample_start = start;
+    metadata.spp = spp;
+    metadata.complete = true;
+    metadata.render_seconds = 0.5;
+    metadata.path_segments = 100;
+    return metadata;
+}
+
+static float *pixel(rt_image *image, int x, int y)
+{
+    return &image->pixels[((size_t)y * image->width + x) * image->channels];
+}
+
+/* Adds part under name and frees its pixels (the merger keeps none). */
+static rt_status add(merger *m, const char *name, rt_image part, merge_metadata metadata, rt_error *error)
+{
+    rt_status status = merger_add(m, name, &part, &metadata, error);
+    image_free(&part);
+    return status;
+}
+
+/* Asserts that text contains every one of the NULL-terminated fragments. */
+static void assert_mentions(const char *text, ...)
+{
+    va_list fragments;
+    va_start(fragments, text);
+    const char *fragment;
+    while ((fragment = va_arg(fragments, const char *)) != NULL) {
+        if (strstr(text, fragment) == NULL) {
+            print_error("'%s' does not mention '%s'\n", text, fragment);
+            va_end(fragments);
+            fail();
+        }
+    }
+    va_end(fragments);
+}
+
+/* Two sample-range parts of a 2x1 image: colour 0.25 with 6 samples and 0.75 with 10 give
+ * (0.25*6 + 0.75*10) / 16 = 9 / 16 = 0.5625, exactly; G and B the same way. */
+static void test_weighted_mean(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "a.exr", make_part(0, 0, 2, 1, 0, 0, 0.25f, 1.0f, 0.0f, 6), make_metadata(0, 6), &error),
+                     RT_OK);
+    assert_int_equal(add(m, "b.exr", make_part(0, 0, 2, 1, 0, 0, 0.75f, 0.5f, 2.0f, 10), make_metadata(6, 10), &error),
+                     RT_OK);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(out.width, 2);
+    assert_int_equal(out.height, 1);
+    assert_int_equal(out.channels, 4);
+    assert_string_equal(out.channel_names[3], "samples");
+    assert_int_equal(out.x, 0);
+    assert_int_equal(out.full_width, 0);
+    for (int x = 0; x < 2; x++) {
+        assert_true(pixel(&out, x, 0)[0] == 0.5625f);
+        assert_true(pixel(&out, x, 0)[1] == (1.0f * 6 + 0.5f * 10) / 16);  /* 0.6875 */
+        assert_true(pixel(&out, x, 0)[2] == 20.0f / 16);
+        assert_true(pixel(&out, x, 0)[3] == 16.0f);
+    }
+    assert_int_equal(summary.part_count, 2);
+    assert_int_equal(summary.region_count, 1);
+    assert_int_equal(summary.min_samples, 16);
+    assert_true(summary.total_samples == 32);
+    assert_int_equal(summary.sample_start, 0);
+    assert_true(summary.complete);
+    assert_int_equal(summary.warning_count, 0);
+    assert_true(summary.render_seconds == 1.0);
+    assert_true(summary.path_segments == 200);
+    assert_string_equal(summary.metadata.scene_hash, "00112233aabbccdd");
+    image_free(&out);
+    merger_free(m);
+}
+
+/* Per-pixel counts differ (an interrupted part): pixel 0 has 3 samples of 1.0 and 1 of
+ * 0.0 -> 0.75; pixel 1 has 0 samples in the first part (its colour 9 means nothing and
+ * must not leak) and 2 of 0.5 -> 0.5; pixel 2 has none at all -> 0 with 0 samples. */
+static void test_uneven_and_zero_counts(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    rt_image a = make_part(0, 0, 3, 1, 0, 0, 1.0f, 1.0f, 1.0f, 3);
+    pixel(&a, 1, 0)[0] = pixel(&a, 1, 0)[1] = pixel(&a, 1, 0)[2] = 9.0f;
+    pixel(&a, 1, 0)[3] = 0;
+    pixel(&a, 2, 0)[0] = 5.0f;
+    pixel(&a, 2, 0)[3] = 0;
+    merge_metadata interrupted = make_metadata(0, 4);
+    interrupted.complete = false;
+    assert_int_equal(add(m, "a.exr", a, interrupted, &error), RT_OK);
+    rt_image b = make_part(0, 0, 3, 1, 0, 0, 0.0f, 0.0f, 0.0f, 1);
+    pixel(&b, 1, 0)[0] = pixel(&b, 1, 0)[1] = pixel(&b, 1, 0)[2] = 0.5f;
+    pixel(&b, 1, 0)[3] = 2;
+    pixel(&b, 2, 0)[3] = 0;
+    assert_int_equal(add(m, "b.exr", b, make_metadata(4, 4), &error), RT_OK);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_true(pixel(&out, 0, 0)[0] == 0.75f);
+    assert_true(pixel(&out, 0, 0)[3] == 4.0f);
+    assert_true(pixel(&out, 1, 0)[0] == 0.5f);
+    assert_true(pixel(&out, 1, 0)[3] == 2.0f);
+    for (int c = 0; c < 4; c++)
+        assert_true(pixel(&out, 2, 0)[c] == 0.0f);
+    assert_int_equal(summary.min_samples, 0);
+    assert_int_equal(summary.max_samples, 4);
+    assert_false(summary.complete);  /* a part was interrupted */
+    image_free(&out);
+    merger_free(m);
+}
+
+/* Three horizontal bands of a 5x7 image (rows 0-1, 2-4, 5-6, as --tile I/3 cuts them)
+ * with each pixel's red = x + 10 y: the merge puts every pixel back exactly. */
+static void test_tiles_assembled(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    const int rows[4] = {0, 2, 5, 7};
+    /* Added out of order, to show order does not matter. */
+    const int order[3] = {2, 0, 1};
+    for (int k = 0; k < 3; k++) {
+        int t = order[k];
+        rt_image tile = make_part(0, rows[t], 5, rows[t + 1] - rows[t], 5, 7, 0, 0.1f, 0.2f, 8);
+        for (int y = 0; y < tile.height; y++)
+            for (int x = 0; x < 5; x++)
+                pixel(&tile, x, y)[0] = (float)(x + 10 * (rows[t] + y)) / 3.0f;
+        char name[32];
+        snprintf(name, sizeof name, "tile-%d.exr", t);
+        assert_int_equal(add(m, name, tile, make_metadata(0, 8), &error), RT_OK);
+    }
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(out.width, 5);
+    assert_int_equal(out.height, 7);
+    for (int y = 0; y < 7; y++)
+        for (int x = 0; x < 5; x++) {
+            assert_true(pixel(&out, x, y)[0] == (float)(x + 10 * y) / 3.0f);
+            assert_true(pixel(&out, x, y)[1] == 0.1f);
+            assert_true(pixel(&out, x, y)[3] == 8.0f);
+        }
+    assert_int_equal(summary.region_count, 3);
+    assert_true(summary.complete);
+    image_free(&out);
+    merger_free(m);
+}
+
+/* Tiles that each have two sample-range parts: regions and ranges combine. */
+static void test_tiles_with_sample_ranges(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "t0a", make_part(0, 0, 2, 1, 2, 2, 1, 1, 1, 4), make_metadata(4, 4), &error), RT_OK);
+    assert_int_equal(add(m, "t1a", make_part(0, 1, 2, 1, 2, 2, 2, 2, 2, 4), make_metadata(0, 4), &error), RT_OK);
+    assert_int_equal(add(m, "t0b", make_part(0, 0, 2, 1, 2, 2, 3, 3, 3, 4), make_metadata(0, 4), &error), RT_OK);
+    assert_int_equal(add(m, "t1b", make_part(0, 1, 2, 1, 2, 2, 4, 4, 4, 4), make_metadata(4, 4), &error), RT_OK);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_true(pixel(&out, 1, 0)[0] == 2.0f);
+    assert_true(pixel(&out, 1, 1)[0] == 3.0f);
+    assert_true(pixel(&out, 0, 1)[3] == 8.0f);
+    assert_true(summary.complete);
+    assert_int_equal(summary.warning_count, 0);
+    image_free(&out);
+    merger_free(m);
+}
+
+/* Tile 0 with samples 0:16, tile 1 with only 0:8: a warning naming both, not an error;
+ * the counts say 16 and 8, spp is the minimum, and the result is not complete. */
+static void test_regions_with_different_ranges_warn(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "top.exr", make_part(0, 0, 2, 1, 2, 2, 1, 1, 1, 16), make_metadata(0, 16), &error), RT_OK);
+    assert_int_equal(add(m, "bottom.exr", make_part(0, 1, 2, 1, 2, 2, 1, 1, 1, 8), make_metadata(0, 8), &error), RT_OK);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(summary.warning_count, 1);
+    assert_mentions(summary.warnings[0], "top.exr", "bottom.exr", "0:16", "0:8", NULL);
+    assert_int_equal(summary.min_samples, 8);
+    assert_int_equal(summary.max_samples, 16);
+    assert_false(summary.complete);
+    image_free(&out);
+    merger_free(m);
+}
+
+/* Samples 0:4 and 8:4 of one region merge (no overlap) but leave a gap: not complete. */
+static void test_gap_in_sample_ranges_is_not_complete(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "a", make_part(0, 0, 1, 1, 0, 0, 1, 1, 1, 4), make_metadata(8, 4), &error), RT_OK);
+    assert_int_equal(add(m, "b", make_part(0, 0, 1, 1, 0, 0, 1, 1, 1, 4), make_metadata(0, 4), &error), RT_OK);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_false(summary.complete);
+    assert_int_equal(summary.sample_start, 0);
+    assert_int_equal(summary.min_samples, 8);
+    image_free(&out);
+    merger_free(m);
+}
+
+/* Samples 0:8 and 4:8 share samples 4-7: refused, naming both parts; the merger is left
+ * as it was, so the first part alone still merges. */
+static void test_overlapping_sample_ranges(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "first.exr", make_part(0, 0, 2, 2, 0, 0, 1, 1, 1, 8), make_metadata(0, 8), &error), RT_OK);
+    assert_int_equal(add(m, "second.exr", make_part(0, 0, 2, 2, 0, 0, 1, 1, 1, 8), make_metadata(4, 8), &error),
+                     RT_ERROR_INPUT);
+    assert_mentions(error.message, "first.exr", "second.exr", "0:8", "4:8", "4-7", NULL);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(summary.part_count, 1);
+    assert_true(pixel(&out, 1, 1)[3] == 8.0f);
+    image_free(&out);
+    merger_free(m);
+}
+
+/* Rows 0-2 and rows 2-3 of a 4x4 image share row 2: refused, naming both. */
+static void test_overlapping_regions(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "upper.exr", make_part(0, 0, 4, 3, 4, 4, 1, 1, 1, 1), make_metadata(0, 1), &error), RT_OK);
+    assert_int_equal(add(m, "lower.exr", make_part(0, 2, 4, 2, 4, 4, 1, 1, 1, 1), make_metadata(0, 1), &error),
+                     RT_ERROR_INPUT);
+    assert_mentions(error.message, "upper.exr", "lower.exr", "overlap", "rows 0-2", "rows 2-3", NULL);
+    merger_free(m);
+}
+
+/* Rows 0-1 and 4-5 of a 3x6 image leave rows 2-3 uncovered: 6 pixels missing. With
+ * allow_missing they stay 0 with 0 samples and the result is not complete. */
+static void test_missing_pieces(void **state)
+{
+    (void)state;
+    for (int allow = 0; allow <= 1; allow++) {
+        merger *m;
+        rt_error error;
+        assert_int_equal(merger_create(&m, &error), RT_OK);
+        assert_int_equal(add(m, "a", make_part(0, 0, 3, 2, 3, 6, 1, 1, 1, 2), make_metadata(0, 2), &error), RT_OK);
+        assert_int_equal(add(m, "b", make_part(0, 4, 3, 2, 3, 6, 1, 1, 1, 2), make_metadata(0, 2), &error), RT_OK);
+        merge_options options = merge_options_defaults();
+        options.allow_missing = allow;
+        rt_image out;
+        merge_summary summary;
+        rt_status status = merger_finish(m, &options, &out, &summary, &error);
+        if (!allow) {
+            assert_int_equal(status, RT_ERROR_INPUT);
+            assert_mentions(error.message, "missing pieces", "6 pixels", "rows 2-3", NULL);
+            assert_null(out.pixels);
+        } else {
+            assert_int_equal(status, RT_OK);
+            assert_int_equal(summary.missing_pixels, 6);
+            assert_false(summary.complete);
+            assert_int_equal(summary.min_samples, 0);
+            assert_true(pixel(&out, 1, 2)[0] == 0.0f);
+            assert_true(pixel(&out, 1, 3)[3] == 0.0f);
+            assert_true(pixel(&out, 1, 4)[0] == 1.0f);
+            image_free(&out);
+        }
+        merger_free(m);
+    }
+}
+
+/* A missing corner and a missing band are both described, with their columns. */
+static void test_missing_pieces_described(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    /* 10x10 image: rows 0-3 full; rows 4-5 only columns 0-4; rows 6-7 full; 8-9 missing. */
+    assert_int_equal(add(m, "a", make_part(0, 0, 10, 4, 10, 10, 1, 1, 1, 1), make_metadata(0, 1), &error), RT_OK);
+    assert_int_equal(add(m, "b", make_part(0, 4, 5, 2, 10, 10, 1, 1, 1, 1), make_metadata(0, 1), &error), RT_OK);
+    assert_int_equal(add(m, "c", make_part(0, 6, 10, 2, 10, 10, 1, 1, 1, 1), make_metadata(0, 1), &error), RT_OK);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "30 pixels", "rows 4-5 (columns 5-9)", "rows 8-9 (columns 0-9)", NULL);
+    merger_free(m);
+}
+
+/* Every kind of mismatch with the first part is refused, naming both parts and values. */
+static void test_mismatched_parts(void **state)
+{
+    (void)state;
+    struct {
+        const char *what;
+        int full_width;
+        merge_metadata metadata;
+        const char *mentions[2];
+    } cases[5];
+    for (int i = 0; i < 5; i++) {
+        cases[i].full_width = 4;
+        cases[i].metadata = make_metadata(8, 8);
+    }
+    cases[0].what = "size", cases[0].full_width = 5, cases[0].mentions[0] = "4x4", cases[0].mentions[1] = "5x4";
+    cases[1].what = "seed", cases[1].metadata.seed = 7, cases[1].mentions[0] = "seed 1", cases[1].mentions[1] = "seed 7";
+    cases[2].what = "depth", cases[2].metadata.max_depth = 3, cases[2].mentions[0] = "16";
+    cases[2].mentions[1] = "depth 3";
+    cases[3].what = "frame", cases[3].metadata.frame = 12, cases[3].mentions[0] = "frame -1";
+    cases[3].mentions[1] = "frame 12";
+    cases[4].what = "scene", strcpy(cases[4].metadata.scene_hash, "ffff"), strcpy(cases[4].metadata.scene, "other.txt");
+    cases[4].mentions[0] = "ffff", cases[4].mentions[1] = "other.txt";
+    for (int i = 0; i < 5; i++) {
+        merger *m;
+        rt_error error;
+        assert_int_equal(merger_create(&m, &error), RT_OK);
+        assert_int_equal(add(m, "one.exr", make_part(0, 0, 4, 4, 4, 4, 1, 1, 1, 8), make_metadata(0, 8), &error),
+                         RT_OK);
+        rt_status status = add(m, "two.exr", make_part(0, 0, 4, 4, cases[i].full_width, 4, 1, 1, 1, 8),
+                               cases[i].metadata, &error);
+        if (status != RT_ERROR_INPUT) {
+            print_error("a different %s was accepted\n", cases[i].what);
+            fail();
+        }
+        assert_mentions(error.message, "one.exr", "two.exr", cases[i].mentions[0], cases[i].mentions[1], NULL);
+        merger_free(m);
+    }
+}
+
+/* A part without a samples channel, or with a data window outside its image, is refused. */
+static void test_malformed_parts(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    rt_image no_samples = make_part(0, 0, 2, 2, 0, 0, 1, 1, 1, 1);
+    strcpy(no_samples.channel_names[3], "A");
+    assert_int_equal(add(m, "rgba.exr", no_samples, make_metadata(0, 1), &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "rgba.exr", "samples", NULL);
+    assert_int_equal(add(m, "outside.exr", make_part(3, 0, 2, 2, 4, 4, 1, 1, 1, 1), make_metadata(0, 1), &error),
+                     RT_ERROR_INPUT);
+    assert_mentions(error.message, "outside.exr", "outside", NULL);
+    assert_int_equal(add(m, "negative.exr", make_part(0, 0, 2, 2, 0, 0, 1, 1, 1, -1), make_metadata(0, 1), &error),
+                     RT_ERROR_INPUT);
+    rt_image out;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "no parts", NULL);
+    merger_free(m);
+}
+
+typedef struct scratch {
+    char directory[256];
+    char path[512];
+} scratch;
+
+static int make_scratch(void **state)
+{
+    scratch *s = calloc(1, sizeof *s);
+    const char *tmp = getenv("TMPDIR");
+    snprintf(s->directory, sizeof s->directory, "%s/test_merge.XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    if (mkdtemp(s->directory) == NULL) {
+        free(s);
+        return -1;
+    }
+    *state = s;
+    return 0;
+}
+
+static int remove_scratch(void **state)
+{
+    scratch *s = *state;
+    static const char *const names[] = {"part.exr", "bare.exr", "rgb.exr"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        snprintf(s->path, sizeof s->path, "%s/%s", s->directory, names[i]);
+        unlink(s->path);
+    }
+    rmdir(s->directory);
+    free(s);
+    return 0;
+}
+
+static const char *in_scratch(scratch *s, const char *name)
+{
+    snprintf(s->path, sizeof s->path, "%s/%s", s->directory, name);
+    return s->path;
+}
+
+/* merge_read_part reads what render writes: the data window and the metadata. */
+static void test_read_part(void **state)
+{
+    scratch *s = *state;
+    rt_error error;
+    rt_image tile = make_part(0, 2, 3, 2, 3, 6, 0.5f, 0.25f, 0.125f, 12);
+    image_attribute attributes[] = {
+        {.name = "rtspheres:scene", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "scenes/x.txt"},
+        {.name = "rtspheres:scene_hash", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "0123456789abcdef"},
+        {.name = "rtspheres:spp", .type = IMAGE_ATTRIBUTE_INT, .int_value = 12},
+        {.name = "rtspheres:sample_start", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "4000000000"},
+        {.name = "rtspheres:seed", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "4294967295"},
+        {.name = "rtspheres:max_depth", .type = IMAGE_ATTRIBUTE_INT, .int_value = 50},
+        {.name = "rtspheres:frame", .type = IMAGE_ATTRIBUTE_INT, .int_value = -1},
+        {.name = "rtspheres:complete", .type = IMAGE_ATTRIBUTE_INT, .int_value = 0},
+        {.name = "rtspheres:render_seconds", .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = 2.5},
+        {.name = "rtspheres:path_segments", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "123456"},
+    };
+    image_write_options options = image_write_options_defaults();
+    options.attributes = attributes;
+    options.attribute_count = (int)(sizeof attributes / sizeof attributes[0]);
+    assert_int_equal(image_write(in_scratch(s, "part.exr"), &tile, &options, &error), RT_OK);
+
+    rt_image image;
+    merge_metadata metadata;
+    assert_int_equal(merge_read_part(in_scratch(s, "part.exr"), &image, &metadata, &error), RT_OK);
+    assert_int_equal(image.y, 2);
+    assert_int_equal(image.height, 2);
+    assert_int_equal(image.full_height, 6);
+    assert_string_equal(metadata.scene, "scenes/x.txt");
+    assert_string_equal(metadata.scene_hash, "0123456789abcdef");
+    assert_int_equal(metadata.spp, 12);
+    assert_true(metadata.sample_start == 4000000000ull);
+    assert_true(metadata.seed == 4294967295ull);
+    assert_int_equal(metadata.max_depth, 50);
+    assert_int_equal(metadata.frame, -1);
+    assert_false(metadata.complete);
+    assert_true(metadata.render_seconds == 2.5);
+    assert_true(metadata.path_segments == 123456);
+    image_free(&image);
+
+    /* Without metadata: refused, naming the file and what is missing. */
+    assert_int_equal(image_write(in_scratch(s, "bare.exr"), &tile, NULL, &error), RT_OK);
+    assert_int_equal(merge_read_part(in_scratch(s, "bare.exr"), &image, &metadata, &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "bare.exr", "rtspheres:scene_hash", NULL);
+    assert_null(image.pixels);
+
+    /* Without a samples channel: refused. */
+    rt_image rgb;
+    assert_int_equal(image_create(&rgb, 2, 2, 3, &error), RT_OK);
+    assert_int_equal(image_write(in_scratch(s, "rgb.exr"), &rgb, &options, &error), RT_OK);
+    image_free(&rgb);
+    assert_int_equal(merge_read_part(in_scratch(s, "rgb.exr"), &image, &metadata, &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "rgb.exr", "samples", NULL);
+
+    /* A missing file: refused as bad input. */
+    assert_int_equal(merge_read_part(in_scratch(s, "absent.exr"), &image, &metadata, &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "absent.exr", NULL);
+    image_free(&tile);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_weighted_mean),
+        cmocka_unit_test(test_uneven_and_zero_counts),
+        cmocka_unit_test(test_tiles_assembled),
+        cmocka_unit_test(test_tiles_with_sample_ranges),
+        cmocka_unit_test(test_regions_with_different_ranges_warn),
+        cmocka_unit_test(test_gap_in_sample_ranges_is_not_complete),
+        cmocka_unit_test(test_overlapping_sample_ranges),
+        cmocka_unit_test(test_overlapping_regions),
+        cmocka_unit_test(test_missing_pieces),
+        cmocka_unit_test(test_missing_pieces_described),
+        cmocka_unit_test(test_mismatched_parts),
+        cmocka_unit_test(test_malformed_parts),
+        cmocka_unit_test_setup_teardown(test_read_part, make_scratch, remove_scratch),
+    };
+    return cmocka_run_group_tests_name("merge", tests, NULL, NULL);
+}
