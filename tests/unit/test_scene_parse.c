@@ -584,7 +584,9 @@ static void test_unknown_statement(void **state)
 {
     (void)state;
     assert_parse_error("spere 0 0 0 1 m", "s.txt:1:1: ",
-                       "unknown statement 'spere' (expected include, set, camera, render, sky, material or sphere)");
+                       "unknown statement 'spere' (expected include, set, camera, render, sky, texture, material, "
+                       "sphere, moving_sphere, triangle, quad, box, mesh, group, instance, volume, translate, "
+                       "rotate, scale or matrix)");
     assert_parse_error("\n\n   Camera fov 30", "s.txt:3:4: ", "unknown statement 'Camera'");
     assert_parse_error("\"camera\"", "s.txt:1:1: ", "unknown statement the string \"camera\"");
     assert_parse_error("42", "s.txt:1:1: ", "unknown statement '42'");
@@ -594,14 +596,17 @@ static void test_unknown_clause(void **state)
 {
     (void)state;
     assert_parse_error("camera from 0 0 1 zoom 2", "s.txt:1:19: ",
-                       "unknown camera clause 'zoom' (expected from, at, up, fov, aperture or focus)");
+                       "unknown camera clause 'zoom' (expected from, at, up, fov, aperture, focus or shutter)");
     assert_parse_error("render size 10 10 quality 3", "s.txt:1:19: ",
                        "unknown render clause 'quality' (expected size, spp, depth or seed)");
     assert_parse_error("camera from 0 0 1 2", "s.txt:1:19: ", "unknown camera clause '2'");
-    assert_parse_error("material m metal 1 1 1 shine 2", "s.txt:1:24: ", "unknown metal material clause 'shine' (expected fuzz)");
+    assert_parse_error("material m metal 1 1 1 shine 2", "s.txt:1:24: ",
+                       "unknown metal material clause 'shine' (expected fuzz or normal_map)");
     assert_parse_error("material m emissive 1 1 1 fuzz 2", "s.txt:1:27: ",
                        "unknown emissive material clause 'fuzz' (expected strength)");
-    assert_parse_error("sky rainbow 1 1 1", "s.txt:1:5: ", "expected a sky type (gradient or constant), found 'rainbow'");
+    assert_parse_error("sky rainbow 1 1 1", "s.txt:1:5: ",
+                       "expected a sky type (gradient, constant, box or environment), found 'rainbow'");
+    assert_parse_error("sky constant 1 1 1 rotate 3", "s.txt:1:20: ", "unknown sky clause 'rotate' (expected intensity)");
     assert_parse_error("material m plastic 1 1 1", "s.txt:1:12: ",
                        "expected a material type (lambertian, metal, dielectric or emissive), found 'plastic'");
 }
@@ -636,7 +641,7 @@ static void test_missing_arguments(void **state)
     assert_parse_error("sky gradient 1 1 1 0 0", "s.txt:1:23: ",
                        "expected a number for the blue component of the sky's top colour, found end of line");
     assert_parse_error("sky constant 1", "s.txt:1:15: ", "the green component of the sky colour");
-    assert_parse_error("sky", "s.txt:1:4: ", "expected a sky type (gradient or constant), found end of line");
+    assert_parse_error("sky", "s.txt:1:4: ", "expected a sky type (gradient, constant, box or environment), found end of line");
     assert_parse_error("material", "s.txt:1:9: ", "expected a material name after material, found end of line");
     assert_parse_error("material m", "s.txt:1:11: ", "expected a material type");
     assert_parse_error("material m lambertian 1 1", "s.txt:1:26: ", "the blue component of material 'm', found end of line");
@@ -652,11 +657,13 @@ static void test_extra_tokens(void **state)
     (void)state;
     assert_parse_error("material m lambertian 1 1 1\nsphere 0 0 0 1 m extra", "s.txt:2:18: ",
                        "unexpected 'extra' after the sphere (expected end of line)");
-    assert_parse_error("sky constant 1 1 1 2", "s.txt:1:20: ", "unexpected '2' after the sky");
-    assert_parse_error("sky gradient 1 1 1 0 0 0 \"x\"", "s.txt:1:26: ", "unexpected the string \"x\" after the sky");
-    assert_parse_error("material g dielectric 1.5 2", "s.txt:1:27: ", "unexpected '2' after a dielectric material");
+    /* Statements with optional clauses name the clauses they take. */
+    assert_parse_error("sky constant 1 1 1 2", "s.txt:1:20: ", "unknown sky clause '2' (expected intensity)");
+    assert_parse_error("sky gradient 1 1 1 0 0 0 \"x\"", "s.txt:1:26: ", "unknown sky clause the string \"x\"");
+    assert_parse_error("material g dielectric 1.5 2", "s.txt:1:27: ",
+                       "unknown dielectric material clause '2' (expected normal_map)");
     assert_parse_error("material g lambertian 1 1 1 fuzz 0.5", "s.txt:1:29: ",
-                       "unexpected 'fuzz' after a lambertian material");
+                       "unknown lambertian material clause 'fuzz' (expected normal_map)");
     assert_parse_error("include \"a.txt\" more", "s.txt:1:17: ", "unexpected 'more' after the included path");
 }
 
@@ -1113,6 +1120,994 @@ static void test_documented_example(void **state)
     scene_free(&s);
 }
 
+/* ------------------------------------------------------------------ the scene model: helpers */
+
+/* Maps the point (x, y, z) through an instance's object_to_world into out. */
+static void map_point(const scene_instance *instance, double x, double y, double z, double out[3])
+{
+    const float (*m)[4] = instance->object_to_world;
+    for (int row = 0; row < 3; row++)
+        out[row] = m[row][0] * x + m[row][1] * y + m[row][2] * z + m[row][3];
+}
+
+/* Checks that instance maps (x, y, z) to (ex, ey, ez) within float rounding. */
+#define assert_maps(instance, x, y, z, ex, ey, ez)                  \
+    do {                                                            \
+        double mapped_[3];                                          \
+        map_point((instance), (x), (y), (z), mapped_);              \
+        assert_double_equal(mapped_[0], (ex), 1e-4);                \
+        assert_double_equal(mapped_[1], (ey), 1e-4);                \
+        assert_double_equal(mapped_[2], (ez), 1e-4);                \
+    } while (0)
+
+/* True when the instance's transform is exactly the identity. */
+static bool is_identity(const scene_instance *instance)
+{
+    for (int row = 0; row < 3; row++)
+        for (int column = 0; column < 4; column++)
+            if (instance->object_to_world[row][column] != (row == column ? 1.0f : 0.0f))
+                return false;
+    return true;
+}
+
+/* ------------------------------------------------------------------ textures, materials, sky, camera */
+
+static void test_textures(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("texture white constant 1 1 1\n"
+             "texture checks checker 0.5 0.1 0.2 0.3 @white\n"
+             "texture grain noise 4\n"
+             "texture swirl turbulence (2*2)\n"
+             "texture stone marble 0.25\n"
+             "texture wood image \"img/wood.png\"\n"
+             "texture nested checker 2 @checks @grain\n"
+             "texture same constant @white   # another name for white\n"
+             "texture wood2 image \"img/wood.png\"\n", NULL, &s);
+    /* The checker's plain colour is a hidden texture (empty name) just before it. */
+    assert_int_equal(s.texture_count, 10);
+    assert_string_equal(s.textures[0].name, "white");
+    assert_int_equal(s.textures[0].type, TEXTURE_CONSTANT);
+    assert_vector_equal(s.textures[0].color, 1, 1, 1);
+    assert_string_equal(s.textures[1].name, "");
+    assert_int_equal(s.textures[1].type, TEXTURE_CONSTANT);
+    assert_vector_equal(s.textures[1].color, 0.1, 0.2, 0.3);
+    assert_string_equal(s.textures[2].name, "checks");
+    assert_int_equal(s.textures[2].type, TEXTURE_CHECKER);
+    assert_double_equal(s.textures[2].scale, 0.5, 0);
+    assert_int_equal(s.textures[2].even, 1);
+    assert_int_equal(s.textures[2].odd, 0);
+    assert_int_equal(s.textures[3].type, TEXTURE_NOISE);
+    assert_double_equal(s.textures[3].scale, 4, 0);
+    assert_int_equal(s.textures[4].type, TEXTURE_TURBULENCE);
+    assert_double_equal(s.textures[4].scale, 4, 0);
+    assert_int_equal(s.textures[5].type, TEXTURE_MARBLE);
+    assert_int_equal(s.textures[6].type, TEXTURE_IMAGE);
+    assert_int_equal(s.textures[6].image, 0);
+    assert_int_equal(s.textures[7].even, 2);
+    assert_int_equal(s.textures[7].odd, 3);
+    assert_string_equal(s.textures[8].name, "same");
+    assert_int_equal(s.textures[8].type, TEXTURE_CONSTANT);
+    assert_vector_equal(s.textures[8].color, 1, 1, 1);
+    assert_int_equal(s.textures[9].image, 0);                  /* one image per path */
+    assert_int_equal(s.image_count, 1);
+    assert_string_equal(s.images[0].path, "img/wood.png");
+    assert_string_equal(s.images[0].position, "s.txt:6:20");
+    assert_null(s.images[0].pixels);
+    assert_int_equal(s.material_count, 0);
+    scene_free(&s);
+
+    /* Texture names are their own namespace: a material may have the same name. */
+    parse_ok("texture red constant 1 0 0\nmaterial red lambertian @red\n", NULL, &s);
+    assert_int_equal(s.materials[0].albedo_texture, 0);
+    scene_free(&s);
+}
+
+static void test_texture_errors(void **state)
+{
+    (void)state;
+    assert_parse_error("texture a constant 1 1 1\n\ntexture a noise 1", "s.txt:3:9: ",
+                       "texture 'a' is already defined at s.txt:1:9");
+    assert_parse_error("texture c checker 1 @nope 0 0 0", "s.txt:1:21: ",
+                       "texture 'nope' is not defined (a texture must be defined before it is used)");
+    assert_parse_error("texture c checker 1 0 0 0 @later\ntexture later constant 1 1 1", "s.txt:1:27: ",
+                       "texture 'later' is not defined");
+    assert_parse_error("material m lambertian @missing", "s.txt:1:23: ", "texture 'missing' is not defined");
+    assert_parse_error("material m emissive @missing strength 2", "s.txt:1:21: ", "texture 'missing' is not defined");
+    assert_parse_error("material m lambertian @", "s.txt:1:23: ", "expected a texture reference @NAME, found '@'");
+    assert_parse_error("texture c checker 0 1 1 1 0 0 0", "s.txt:1:19: ",
+                       "the scale of texture 'c' must be > 0, found 0");
+    assert_parse_error("texture n noise -1", "s.txt:1:17: ", "the scale of texture 'n' must be > 0, found -1");
+    assert_parse_error("texture n turbulence 0", "s.txt:1:22: ", "must be > 0");
+    assert_parse_error("texture n marble 1e-50", "s.txt:1:18: ", "too small for the renderer's 32-bit floats");
+    assert_parse_error("texture i image \"\"", "s.txt:1:17: ",
+                       "expected a path inside the quotes of the image of texture 'i', found an empty string");
+    assert_parse_error("texture i image wood.png", "s.txt:1:17: ", "expected a quoted path for the image of texture 'i'");
+    assert_parse_error("texture x wavy 1", "s.txt:1:11: ",
+                       "expected a texture type (constant, checker, noise, turbulence, marble or image), found 'wavy'");
+    assert_parse_error("texture", "s.txt:1:8: ", "expected a texture name after texture, found end of line");
+    assert_parse_error("texture $t constant 1 1 1", "s.txt:1:9: ", "expected a texture name");
+    assert_parse_error("texture k constant 1 -1 1", "s.txt:1:22: ",
+                       "the green component of texture 'k' must be >= 0");
+    assert_parse_error("texture k checker 1 1 1 1 1 1", "s.txt:1:30: ",
+                       "expected a number for the blue component of the odd colour of texture 'k', found end of line");
+    assert_parse_error("texture k noise 1 2", "s.txt:1:19: ", "unexpected '2' after the texture");
+}
+
+static void test_material_textures_and_normal_maps(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("texture grain noise 3\n"
+             "texture glow constant 1 0.5 0\n"
+             "material plain lambertian 0.5 0.5 0.5\n"
+             "material wood lambertian @grain normal_map \"maps/n.png\"\n"
+             "material brushed metal @grain fuzz 0.25 normal_map \"maps/n.png\"\n"
+             "material shiny metal 0.9 0.9 0.9 normal_map \"maps/m.png\" fuzz 0.5\n"
+             "material glass dielectric 1.5 normal_map \"maps/m.png\"\n"
+             "material lamp emissive @glow strength 3\n", NULL, &s);
+    assert_int_equal(s.material_count, 6);
+    /* Plain materials have no textures. */
+    assert_int_equal(s.materials[0].albedo_texture, -1);
+    assert_int_equal(s.materials[0].emission_texture, -1);
+    assert_int_equal(s.materials[0].normal_map, -1);
+    /* A texture colour leaves the albedo at 1 1 1. */
+    assert_int_equal(s.materials[1].albedo_texture, 0);
+    assert_vector_equal(s.materials[1].albedo, 1, 1, 1);
+    assert_int_equal(s.materials[1].normal_map, 0);
+    assert_int_equal(s.materials[2].type, MATERIAL_METAL);
+    assert_int_equal(s.materials[2].albedo_texture, 0);
+    assert_double_equal(s.materials[2].fuzz, 0.25, 0);
+    assert_int_equal(s.materials[2].normal_map, 0);           /* same path, same image */
+    assert_int_equal(s.materials[3].albedo_texture, -1);
+    assert_double_equal(s.materials[3].fuzz, 0.5, 0);
+    assert_int_equal(s.materials[3].normal_map, 1);
+    assert_int_equal(s.materials[4].normal_map, 1);
+    assert_double_equal(s.materials[4].index_of_refraction, 1.5, 0);
+    /* emissive @texture: emission is 1 1 1 x strength, times the texture. */
+    assert_int_equal(s.materials[5].emission_texture, 1);
+    assert_int_equal(s.materials[5].albedo_texture, -1);
+    assert_vector_equal(s.materials[5].emission, 3, 3, 3);
+    assert_int_equal(s.image_count, 2);
+    assert_string_equal(s.images[0].path, "maps/n.png");
+    assert_string_equal(s.images[0].position, "s.txt:4:44");
+    assert_string_equal(s.images[1].position, "s.txt:6:45");
+    scene_free(&s);
+
+    assert_parse_error("material m lambertian 1 1 1 normal_map \"\"", "s.txt:1:40: ",
+                       "expected a path inside the quotes of the normal_map of the lambertian material, found an "
+                       "empty string");
+    assert_parse_error("material m metal 1 1 1 normal_map", "s.txt:1:34: ",
+                       "expected a quoted path for the normal_map of the metal material");
+    assert_parse_error("material m dielectric 1.5 normal_map \"a.png\" normal_map \"b.png\"", "s.txt:1:46: ",
+                       "clause 'normal_map' given twice");
+    assert_parse_error("material m emissive 1 1 1 normal_map \"a.png\"", "s.txt:1:27: ",
+                       "unknown emissive material clause 'normal_map' (expected strength)");
+}
+
+static void test_sky_images_intensity_and_rotation(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("sky gradient 0 0 0 1 1 1 intensity 2.5", NULL, &s);
+    assert_int_equal(s.sky.type, SKY_GRADIENT);
+    assert_double_equal(s.sky.intensity, 2.5, 0);
+    assert_double_equal(s.sky.rotation_degrees, 0, 0);
+    assert_int_equal(s.sky.environment, -1);
+    assert_int_equal(s.sky.faces[0], -1);
+    scene_free(&s);
+
+    parse_ok("sky constant 1 2 3 intensity 0", NULL, &s);
+    assert_int_equal(s.sky.type, SKY_CONSTANT);
+    assert_double_equal(s.sky.intensity, 0, 0);
+    scene_free(&s);
+
+    parse_ok("texture t image \"sky/py.png\"\n"
+             "sky box \"sky/px.png\" \"sky/nx.png\" \"sky/py.png\" \"sky/ny.png\" \"sky/pz.png\" \"sky/nz.png\" "
+             "rotate 90 intensity 0.5\n", NULL, &s);
+    assert_int_equal(s.sky.type, SKY_BOX);
+    assert_int_equal(s.image_count, 6);
+    assert_int_equal(s.sky.faces[SKY_FACE_POSITIVE_X], 1);
+    assert_int_equal(s.sky.faces[SKY_FACE_NEGATIVE_X], 2);
+    assert_int_equal(s.sky.faces[SKY_FACE_POSITIVE_Y], 0);    /* shared with the texture */
+    assert_int_equal(s.sky.faces[SKY_FACE_NEGATIVE_Y], 3);
+    assert_int_equal(s.sky.faces[SKY_FACE_POSITIVE_Z], 4);
+    assert_int_equal(s.sky.faces[SKY_FACE_NEGATIVE_Z], 5);
+    assert_string_equal(s.images[5].path, "sky/nz.png");
+    assert_double_equal(s.sky.intensity, 0.5, 0);
+    assert_double_equal(s.sky.rotation_degrees, 90, 0);
+    assert_int_equal(s.sky.environment, -1);
+    scene_free(&s);
+
+    /* A later sky replaces all of an earlier one. */
+    parse_ok("sky environment \"studio.hdr\" intensity 2 rotate -45\nsky environment \"other.hdr\"", NULL, &s);
+    assert_int_equal(s.sky.type, SKY_ENVIRONMENT);
+    assert_int_equal(s.sky.environment, 1);
+    assert_double_equal(s.sky.intensity, 1, 0);
+    assert_double_equal(s.sky.rotation_degrees, 0, 0);
+    assert_string_equal(s.images[0].path, "studio.hdr");
+    scene_free(&s);
+    parse_ok("sky environment \"studio.hdr\"\nsky gradient 1 1 1 0 0 0", NULL, &s);
+    assert_int_equal(s.sky.environment, -1);
+    scene_free(&s);
+
+    assert_parse_error("sky constant 1 1 1 intensity -1", "s.txt:1:30: ", "the sky's intensity must be >= 0, found -1");
+    assert_parse_error("sky environment \"e.hdr\" intensity -0.5", "s.txt:1:35: ", "intensity must be >= 0");
+    assert_parse_error("sky environment \"\"", "s.txt:1:17: ",
+                       "expected a path inside the quotes of the sky environment, found an empty string");
+    assert_parse_error("sky environment", "s.txt:1:16: ", "expected a quoted path for the sky environment");
+    assert_parse_error("sky box \"a\" \"b\" \"c\" \"\" \"e\" \"f\"", "s.txt:1:21: ",
+                       "expected a path inside the quotes of the sky box's -Y face, found an empty string");
+    assert_parse_error("sky box \"a\" \"b\" \"c\" \"d\" \"e\"", "s.txt:1:28: ",
+                       "expected a quoted path for the sky box's -Z face (e.g. \"file.png\"), found end of line");
+    assert_parse_error("sky gradient 1 1 1 1 1 1 rotate 5", "s.txt:1:26: ", "unknown sky clause 'rotate'");
+    assert_parse_error("sky environment \"e.hdr\" rotate 1 rotate 2", "s.txt:1:34: ", "clause 'rotate' given twice");
+}
+
+static void test_camera_shutter(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("", NULL, &s);
+    assert_double_equal(s.camera.shutter_open, 0, 0);
+    assert_double_equal(s.camera.shutter_close, 1, 0);
+    scene_free(&s);
+    parse_ok("camera fov 30 shutter 0.25 0.75", NULL, &s);
+    assert_double_equal(s.camera.shutter_open, 0.25, 0);
+    assert_double_equal(s.camera.shutter_close, 0.75, 0);
+    scene_free(&s);
+    parse_ok("camera shutter 0.5 0.5", NULL, &s);                  /* open == close: no blur */
+    assert_double_equal(s.camera.shutter_close, 0.5, 0);
+    scene_free(&s);
+
+    assert_parse_error("camera shutter -0.1 1", "s.txt:1:16: ",
+                       "the camera's shutter must have 0 <= open <= close <= 1, found open -0.1 and close 1");
+    assert_parse_error("camera shutter 0.6 0.4", "s.txt:1:20: ", "found open 0.6 and close 0.4");
+    assert_parse_error("camera shutter 0 1.5", "s.txt:1:18: ", "0 <= open <= close <= 1");
+    assert_parse_error("camera shutter 1.5 2", "s.txt:1:16: ", "0 <= open <= close <= 1");
+    assert_parse_error("camera shutter 0", "s.txt:1:17: ",
+                       "expected a number for the camera's shutter close time, found end of line");
+}
+
+/* ------------------------------------------------------------------ shapes */
+
+static void test_top_level_shapes_form_one_world_object(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material m lambertian 1 1 1\n"
+             "material n metal 1 1 1\n"
+             "sphere 0 0 0 1 m                 # a plain sphere, as in the first version\n"
+             "triangle 0 0 0  1 0 0  0 1 0 m\n"
+             "moving_sphere 0 0 0  0 1 0  0.5 n\n"
+             "quad 0 0 0  2 0 0  0 0 3 n\n"
+             "sphere 5 0 0 2 n\n", NULL, &s);
+    assert_int_equal(s.sphere_count, 2);
+    assert_vector_equal(s.spheres[1].center, 5, 0, 0);
+    assert_int_equal(s.spheres[1].material, 1);
+    assert_int_equal(s.object_count, 1);
+    assert_int_equal(s.instance_count, 1);
+    assert_int_equal(s.instances[0].object, 0);
+    assert_int_equal(s.instances[0].material, -1);
+    assert_false(s.instances[0].volume);
+    assert_true(is_identity(&s.instances[0]));
+    assert_int_equal(s.objects[0].first_shape, 0);
+    assert_int_equal(s.objects[0].shape_count, 3);
+    assert_int_equal(s.objects[0].mesh, -1);
+    assert_int_equal(s.shape_count, 3);
+    assert_int_equal(s.shapes[0].type, SHAPE_TRIANGLE);
+    assert_int_equal(s.shapes[0].material, 0);
+    assert_vector_equal(s.shapes[0].points[1], 1, 0, 0);
+    assert_vector_equal(s.shapes[0].points[2], 0, 1, 0);
+    assert_int_equal(s.shapes[1].type, SHAPE_MOVING_SPHERE);
+    assert_int_equal(s.shapes[1].material, 1);
+    assert_vector_equal(s.shapes[1].points[0], 0, 0, 0);
+    assert_vector_equal(s.shapes[1].points[1], 0, 1, 0);
+    assert_double_equal(s.shapes[1].radius, 0.5, 0);
+    assert_int_equal(s.shapes[2].type, SHAPE_QUAD);
+    assert_vector_equal(s.shapes[2].points[1], 2, 0, 0);
+    assert_vector_equal(s.shapes[2].points[2], 0, 0, 3);
+    scene_free(&s);
+
+    /* Only spheres: nothing but the plain array, as before. */
+    parse_ok("material m lambertian 1 1 1\nsphere 0 0 0 1 m\n", NULL, &s);
+    assert_int_equal(s.object_count, 0);
+    assert_int_equal(s.instance_count, 0);
+    scene_free(&s);
+}
+
+static void test_box_expands_to_six_outward_quads(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material m lambertian 1 1 1\nbox -1 0 2  3 1 5 m\n", NULL, &s);
+    assert_int_equal(s.shape_count, 6);
+    assert_int_equal(s.objects[0].shape_count, 6);
+    const double low[3] = {-1, 0, 2}, high[3] = {3, 1, 5};
+    const double centre[3] = {1, 0.5, 3.5};
+    /* +X -X +Y -Y +Z -Z: each quad lies on its face, covers it, and u x v points out. */
+    for (int face = 0; face < 6; face++) {
+        const scene_shape *quad = &s.shapes[face];
+        assert_int_equal(quad->type, SHAPE_QUAD);
+        assert_int_equal(quad->material, 0);
+        int axis = face / 2;
+        double sign = face % 2 == 0 ? 1 : -1;
+        const float *q = quad->points[0], *u = quad->points[1], *v = quad->points[2];
+        double normal[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        for (int i = 0; i < 3; i++) {
+            double expected = i == axis ? sign * (high[(i + 1) % 3] - low[(i + 1) % 3]) *
+                                              (high[(i + 2) % 3] - low[(i + 2) % 3])
+                                        : 0;
+            assert_double_equal(normal[i], expected, 1e-6);
+            /* The quad's centre is the face's centre. */
+            double quad_centre = q[i] + 0.5 * (u[i] + v[i]);
+            double face_centre = i == axis ? (sign > 0 ? high[i] : low[i]) : centre[i];
+            assert_double_equal(quad_centre, face_centre, 1e-6);
+        }
+    }
+    scene_free(&s);
+
+    assert_parse_error("material m lambertian 1 1 1\nbox 0 0 0  1 0 1 m", "s.txt:2:14: ",
+                       "the box's minimum y (0) must be less than its maximum y (0)");
+    assert_parse_error("material m lambertian 1 1 1\nbox 0 0 2  1 1 1 m", "s.txt:2:16: ", "the box's minimum z (2)");
+    assert_parse_error("box 0 0 0  1 1", "s.txt:1:15: ",
+                       "expected a number for the box's maximum corner z, found end of line");
+}
+
+static void test_shape_errors(void **state)
+{
+    (void)state;
+    const char *m = "material m lambertian 1 1 1\n";
+    char text[256];
+    snprintf(text, sizeof text, "%squad 0 0 0  1 0 0  2 0 0 m", m);
+    assert_parse_error(text, "s.txt:2:13: ", "the quad's edges u (1 0 0) and v (2 0 0) are parallel or zero, so it "
+                       "has no area");
+    snprintf(text, sizeof text, "%squad 0 0 0  0 0 0  0 1 0 m", m);
+    assert_parse_error(text, "s.txt:2:13: ", "are parallel or zero");
+    snprintf(text, sizeof text, "%squad 0 0 0  1 0 0  0 0 0 m", m);
+    assert_parse_error(text, "s.txt:2:13: ", "are parallel or zero");
+    snprintf(text, sizeof text, "%smoving_sphere 0 0 0 1 1 1 0 m", m);
+    assert_parse_error(text, "s.txt:2:27: ", "the moving sphere's radius must be > 0, found 0");
+    snprintf(text, sizeof text, "%sgroup {\n  sphere 0 0 0 -2\n}", m);
+    assert_parse_error(text, "s.txt:3:16: ", "the sphere's radius must be > 0, found -2");
+    snprintf(text, sizeof text, "%striangle 0 0 0 1 0 0 0 1 0 nope", m);
+    assert_parse_error(text, "s.txt:2:28: ",
+                       "the triangle's material 'nope' is not defined (a material must be defined before the "
+                       "triangles that use it)");
+
+    /* At the top level, where no group can supply one, every shape needs a material. */
+    assert_parse_error("sphere 0 0 0 1", "s.txt:1:15: ", "a shape needs a material outside a group");
+    assert_parse_error("triangle 0 0 0  1 0 0  0 1 0", "s.txt:1:29: ",
+                       "expected a material name for the triangle, found end of line (a shape needs a material "
+                       "outside a group)");
+    assert_parse_error("moving_sphere 0 0 0 0 1 0 1", "s.txt:1:28: ", "needs a material outside a group");
+    assert_parse_error("quad 0 0 0 1 0 0 0 1 0  # no material", "s.txt:1:23: ", "needs a material outside a group");
+    assert_parse_error("box 0 0 0 1 1 1", "s.txt:1:16: ", "needs a material outside a group");
+    assert_parse_error("mesh \"a.obj\"", "s.txt:1:13: ", "expected a material name for the mesh, found end of line (a "
+                       "shape needs a material outside a group)");
+}
+
+/* ------------------------------------------------------------------ groups and transforms */
+
+static void test_transform_order(void **state)
+{
+    (void)state;
+    scene s;
+    /* The first transform written applies first: rotate, then move. */
+    parse_ok("material m lambertian 1 1 1\n"
+             "group material m {\n"
+             "    rotate 0 0 1 90\n"
+             "    translate 10 0 0\n"
+             "    triangle 0 0 0  1 0 0  0 1 0\n"
+             "}\n"
+             "group material m {\n"
+             "    translate 10 0 0\n"
+             "    rotate 0 0 1 90\n"
+             "    triangle 0 0 0  1 0 0  0 1 0\n"
+             "}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 2);
+    assert_maps(&s.instances[0], 1, 0, 0, 10, 1, 0);
+    assert_maps(&s.instances[1], 1, 0, 0, 0, 11, 0);
+    scene_free(&s);
+
+    /* The example of the format description: rotate 15 degrees about y, then move. */
+    parse_ok("material m lambertian 1 1 1\n"
+             "group {\n"
+             "    rotate 0 1 0 15\n"
+             "    translate 265 0 295\n"
+             "    box 0 0 0  165 330 165 m\n"
+             "}\n", NULL, &s);
+    double c = cos(15 * 3.14159265358979323846 / 180), sn = sin(15 * 3.14159265358979323846 / 180);
+    /* Right-handed about +y: +x turns towards -z, +z towards +x. */
+    assert_maps(&s.instances[0], 1, 0, 0, 265 + c, 0, 295 - sn);
+    assert_maps(&s.instances[0], 0, 0, 1, 265 + sn, 0, 295 + c);
+    assert_maps(&s.instances[0], 0, 1, 0, 265, 1, 295);
+    scene_free(&s);
+
+    /* An enclosing block's transform applies after the inner one's. */
+    parse_ok("material m lambertian 1 1 1\n"
+             "group {\n"
+             "    translate 0 0 5\n"
+             "    group {\n"
+             "        scale 2\n"
+             "        rotate 1 0 0 90\n"
+             "        quad 0 0 0  1 0 0  0 1 0 m\n"
+             "    }\n"
+             "}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 1);
+    assert_maps(&s.instances[0], 0, 1, 0, 0, 0, 7);       /* (0,1,0) -> (0,2,0) -> (0,0,2) -> (0,0,7) */
+    assert_maps(&s.instances[0], 1, 0, 0, 2, 0, 5);
+    scene_free(&s);
+}
+
+static void test_scale_matrix_and_rotate_forms(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material m lambertian 1 1 1\n"
+             "group material m {\n  scale 1 2 -3   # a negative factor mirrors\n  sphere 0 0 0 1\n}\n"
+             "group material m {\n  matrix 0 -1 0 1  1 0 0 2  0 0 2 3\n  sphere 0 0 0 1\n}\n"
+             "group material m {\n  rotate 0 0 7 90   # the axis need not be a unit vector\n  sphere 0 0 0 1\n}\n"
+             "group material m {\n  scale 3\n  translate 1 1 1\n  scale 0.5\n  sphere 0 0 0 1\n}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 4);
+    assert_maps(&s.instances[0], 1, 1, 1, 1, 2, -3);
+    assert_maps(&s.instances[1], 0, 0, 0, 1, 2, 3);
+    assert_maps(&s.instances[1], 1, 0, 0, 1, 3, 3);       /* column 0 of the matrix, plus column 3 */
+    assert_maps(&s.instances[1], 0, 1, 0, 0, 2, 3);
+    assert_maps(&s.instances[1], 0, 0, 1, 1, 2, 5);
+    assert_maps(&s.instances[2], 1, 0, 0, 0, 1, 0);
+    assert_maps(&s.instances[3], 2, 0, 0, 3.5, 0.5, 0.5); /* (2,0,0) -> (6,0,0) -> (7,1,1) -> (3.5,.5,.5) */
+    /* The shape keeps its own coordinates; the instance carries the transform. */
+    assert_vector_equal(s.shapes[0].points[0], 0, 0, 0);
+    scene_free(&s);
+}
+
+static void test_transform_errors(void **state)
+{
+    (void)state;
+    assert_parse_error("group {\n  rotate 0 0 0 45\n}", "s.txt:2:10: ",
+                       "the rotation axis (0 0 0) has zero length");
+    assert_parse_error("group {\n  scale 0\n}", "s.txt:2:9: ",
+                       "the scale must not be 0 on any axis (it would flatten the contents), found 0");
+    assert_parse_error("group {\n  scale 1 0 2\n}", "s.txt:2:11: ", "the scale must not be 0 on any axis");
+    assert_parse_error("group {\n  scale 1 2 0\n}", "s.txt:2:13: ", "the scale must not be 0 on any axis");
+    assert_parse_error("group {\n  scale 1 2\n}", "s.txt:2:12: ", "expected a number for the scale z, found end of line");
+    assert_parse_error("group {\n  scale 1e-50\n}", "s.txt:2:9: ", "too small for the renderer's 32-bit floats");
+    assert_parse_error("group {\n  matrix 1 0 0 0  0 1 0 0  2 0 0 0\n}", "s.txt:2:3: ",
+                       "the matrix is singular (the determinant of its 3x3 part is 0); a transform must be invertible");
+    assert_parse_error("group {\n  matrix 1e-5 0 0 0  0 1e-5 0 0  0 0 1e-5 0\n}", "s.txt:2:3: ", "the matrix is singular");
+    assert_parse_error("group {\n  matrix 1 0 0 0  0 1 0 0  0 0 1\n}", "s.txt:2:33: ",
+                       "expected a number for the matrix element M23, found end of line");
+    assert_parse_error("group {\n  translate 1 2 3 4\n}", "s.txt:2:19: ", "unexpected '4' after the translation");
+    assert_parse_error("group {\n  translate 1e39 0 0\n}", "s.txt:2:13: ", "too large for the renderer's 32-bit floats");
+    assert_parse_error("group {\n  rotate 0 1 0\n}", "s.txt:2:15: ",
+                       "expected a number for the rotation angle in degrees, found end of line");
+
+    /* Transforms come first in their block, and only inside one. */
+    assert_parse_error("material m lambertian 1 1 1\ngroup material m {\n  sphere 0 0 0 1\n  translate 1 0 0\n}",
+                       "s.txt:4:3: ", "'translate' after the group's contents: transforms come first in a group");
+    assert_parse_error("volume 1 1 1 1 {\n  group {\n  }\n  scale 2\n}", "s.txt:4:3: ",
+                       "'scale' after the volume's contents: transforms come first in a group");
+    assert_parse_error("group {\n  material m lambertian 1 1 1\n  rotate 0 1 0 5\n}", "s.txt:3:3: ",
+                       "transforms come first in a group");
+    assert_parse_error("translate 1 2 3", "s.txt:1:1: ",
+                       "'translate' outside a block: a transform applies to the contents of a group, instance or volume");
+    assert_parse_error("group {\n}\nmatrix 1 0 0 0 0 1 0 0 0 0 1 0", "s.txt:3:1: ", "'matrix' outside a block");
+    /* A composition past the float range is caught where it is placed. */
+    assert_parse_error("material m lambertian 1 1 1\ngroup {\n scale 1e30\n group {\n  scale 1e30\n  sphere 0 0 0 1 m\n"
+                       " }\n}", "s.txt:6:3: ", "too large for the renderer's 32-bit floats");
+}
+
+static void test_named_group_placed_again_shares_objects(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material m lambertian 1 1 1\n"
+             "group pair material m {\n"
+             "    translate 0 1 0\n"
+             "    sphere 0 0 0 1\n"
+             "    group {\n"
+             "        translate 3 0 0\n"
+             "        quad 0 0 0  1 0 0  0 0 1\n"
+             "    }\n"
+             "}\n"
+             "instance pair {\n"
+             "    translate 100 0 0   # after the group's own transform\n"
+             "}\n"
+             "instance pair\n", NULL, &s);
+    /* Two objects (the group's sphere, the inner group's quad), each placed three times. */
+    assert_int_equal(s.object_count, 2);
+    assert_int_equal(s.shape_count, 2);
+    assert_int_equal(s.instance_count, 6);
+    for (int i = 0; i < 6; i++) {
+        assert_int_equal(s.instances[i].object, i % 2);
+        assert_int_equal(s.instances[i].material, 0);
+    }
+    assert_maps(&s.instances[0], 0, 0, 0, 0, 1, 0);
+    assert_maps(&s.instances[1], 0, 0, 0, 3, 1, 0);
+    assert_maps(&s.instances[2], 0, 0, 0, 100, 1, 0);
+    assert_maps(&s.instances[3], 0, 0, 0, 103, 1, 0);
+    assert_maps(&s.instances[4], 0, 0, 0, 0, 1, 0);
+    assert_maps(&s.instances[5], 0, 0, 0, 3, 1, 0);
+    scene_free(&s);
+
+    /* A group's placements are relative to its parent's frame: instancing a nested
+     * group elsewhere does not repeat the transforms of the blocks around it. */
+    parse_ok("material m lambertian 1 1 1\n"
+             "group {\n"
+             "    translate 50 0 0\n"
+             "    group inner {\n"
+             "        translate 1 0 0\n"
+             "        sphere 0 0 0 1 m\n"
+             "    }\n"
+             "}\n"
+             "group outer {\n"
+             "    translate 0 0 7\n"
+             "    instance inner { \n"
+             "        scale 2\n"
+             "    }\n"
+             "}\n"
+             "instance outer {\n"
+             "    translate 0 9 0\n"
+             "}\n", NULL, &s);
+    assert_int_equal(s.object_count, 1);
+    assert_int_equal(s.instance_count, 3);
+    assert_maps(&s.instances[0], 0, 0, 0, 51, 0, 0);
+    assert_maps(&s.instances[1], 0, 0, 0, 2, 0, 7);        /* inner's (1,0,0), scaled, then moved */
+    assert_maps(&s.instances[2], 0, 0, 0, 2, 9, 7);
+    assert_maps(&s.instances[2], 1, 0, 0, 4, 9, 7);
+    scene_free(&s);
+}
+
+static void test_material_inheritance(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material red lambertian 1 0 0\n"
+             "material blue lambertian 0 0 1\n"
+             "material green lambertian 0 1 0\n"
+             "group material red {\n"
+             "    sphere 0 0 0 1              # red, from the group\n"
+             "    sphere 2 0 0 1 blue         # keeps its own\n"
+             "    group {\n"
+             "        sphere 4 0 0 1          # red, from the nearest group with a material\n"
+             "    }\n"
+             "    group material green {\n"
+             "        sphere 6 0 0 1          # green\n"
+             "    }\n"
+             "}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 3);
+    /* Instances come in the order of each block's first shape. */
+    assert_int_equal(s.instances[0].material, 0);
+    assert_int_equal(s.objects[s.instances[0].object].shape_count, 2);
+    int first = s.objects[s.instances[0].object].first_shape;
+    assert_int_equal(s.shapes[first].material, -1);
+    assert_int_equal(s.shapes[first + 1].material, 1);
+    assert_int_equal(s.instances[1].material, 0);
+    assert_int_equal(s.instances[2].material, 2);
+    scene_free(&s);
+
+    /* An instance's material fills only what has no material yet. */
+    parse_ok("material red lambertian 1 0 0\n"
+             "material blue lambertian 0 0 1\n"
+             "material green lambertian 0 1 0\n"
+             "group material red {\n"
+             "    group plain {\n"
+             "        sphere 0 0 0 1\n"
+             "    }\n"
+             "    group coloured material blue {\n"
+             "        sphere 0 0 0 1\n"
+             "    }\n"
+             "}\n"
+             "instance plain material green\n"
+             "instance coloured material green\n"
+             "group material blue {\n"
+             "    instance plain\n"
+             "}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 5);
+    assert_int_equal(s.instances[0].material, 0);          /* plain, where defined: red */
+    assert_int_equal(s.instances[1].material, 1);          /* coloured: its own blue */
+    assert_int_equal(s.instances[2].material, 2);          /* plain again, green */
+    assert_int_equal(s.instances[3].material, 1);          /* coloured stays blue */
+    assert_int_equal(s.instances[4].material, 1);          /* plain inside a blue group */
+    scene_free(&s);
+
+    assert_parse_error("group material nope {\n}", "s.txt:1:16: ",
+                       "the group's material 'nope' is not defined (a material must be defined before the groups "
+                       "that use it)");
+    assert_parse_error("group material {\n}", "s.txt:1:16: ", "expected a material name for the group, found '{'");
+    assert_parse_error("group g {\n}\ninstance g material nope", "s.txt:3:21: ", "the instance's material 'nope' is not defined");
+}
+
+static void test_shapes_without_any_material(void **state)
+{
+    (void)state;
+    /* A shape in a group needs a material from somewhere when it is placed. */
+    assert_parse_error("group {\n  translate 1 0 0\n  quad 0 0 0 1 0 0 0 1 0\n}", "s.txt:3:3: ",
+                       "this shape has no material: give it one, or give a group around it (or the instance that "
+                       "places it) a material");
+    assert_parse_error("material m lambertian 1 1 1\ngroup g {\n  sphere 0 0 0 1 m\n  box 0 0 0 1 1 1\n}\n"
+                       "instance g material m", "s.txt:4:3: ", "this shape has no material");
+    /* A volume's boundary and a mesh (which may carry its own) need none. */
+    scene s;
+    parse_ok("volume 0.5 1 1 1 {\n  sphere 0 0 0 1\n}\ngroup {\n  mesh \"a.obj\"\n}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 2);
+    assert_int_equal(s.instances[0].material, -1);
+    assert_int_equal(s.instances[1].material, -1);
+    scene_free(&s);
+}
+
+static void test_meshes(void **state)
+{
+    write_text(state, "models/a.obj", "# not read by the parser\n");
+    write_text(state, "models/part.txt", "mesh \"a.obj\"            # next to part.txt\nmesh \"../models/a.obj\"\n");
+    const char *directory = ((temporary_directory *)*state)->path;
+    write_text(state, "top.txt",
+               "material m lambertian 1 1 1\n"
+               "material n metal 1 1 1\n"
+               "mesh \"models/a.obj\" m\n"
+               "group material n {\n"
+               "    translate 0 2 0\n"
+               "    mesh \"models/a.obj\"\n"
+               "    mesh \"models/b.obj\" m\n"
+               "    include \"models/part.txt\"\n"
+               "}\n");
+    scene s;
+    load_file_ok(state, "top.txt", NULL, &s);
+    char expected[512];
+    /* One mesh (and one object) per resolved path; "models/../models/a.obj" is spelt
+     * differently, so it is a mesh of its own (the loader may read it twice). */
+    assert_int_equal(s.mesh_count, 3);
+    snprintf(expected, sizeof expected, "%s/models/a.obj", directory);
+    assert_string_equal(s.meshes[0].path, expected);
+    snprintf(expected, sizeof expected, "%s/top.txt:3:6", directory);
+    assert_string_equal(s.meshes[0].position, expected);
+    assert_int_equal(s.meshes[0].default_material, -1);
+    assert_null(s.meshes[0].positions);
+    assert_int_equal(s.meshes[0].triangle_count, 0);
+    snprintf(expected, sizeof expected, "%s/models/b.obj", directory);
+    assert_string_equal(s.meshes[1].path, expected);
+    snprintf(expected, sizeof expected, "%s/models/../models/a.obj", directory);
+    assert_string_equal(s.meshes[2].path, expected);
+    snprintf(expected, sizeof expected, "%s/models/part.txt:2:6", directory);
+    assert_string_equal(s.meshes[2].position, expected);
+
+    assert_int_equal(s.object_count, 3);
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(s.objects[i].mesh, i);
+        assert_int_equal(s.objects[i].shape_count, 0);
+    }
+    assert_int_equal(s.instance_count, 5);
+    int objects[5] = {0, 0, 1, 0, 2}, materials[5] = {0, 1, 0, 1, 1};
+    for (int i = 0; i < 5; i++) {
+        assert_int_equal(s.instances[i].object, objects[i]);
+        assert_int_equal(s.instances[i].material, materials[i]);
+    }
+    assert_true(is_identity(&s.instances[0]));
+    assert_maps(&s.instances[1], 0, 0, 0, 0, 2, 0);
+    assert_maps(&s.instances[3], 0, 0, 0, 0, 2, 0);
+    scene_free(&s);
+
+    assert_parse_error("mesh \"\" m", "s.txt:1:6: ", "expected a path inside the quotes of the mesh, found an empty string");
+    assert_parse_error("mesh a.obj", "s.txt:1:6: ", "expected a quoted path for the mesh (e.g. \"file.png\"), found 'a.obj'");
+    char long_path[1100];
+    memset(long_path, 'x', 1024);
+    long_path[1024] = '\0';
+    char text[1200];
+    snprintf(text, sizeof text, "group {\n  mesh \"%s\"\n}", long_path);
+    assert_parse_error(text, "s.txt:2:8: ", "the path of the mesh is 1024 bytes long once resolved; the limit is 1023");
+}
+
+static void test_volumes(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material glass dielectric 1.5\n"
+             "volume 0.2 0.1 0.5 1 {\n"
+             "    translate 0 1 0\n"
+             "    box 0 0 0 1 1 1\n"
+             "    group material glass {\n"
+             "        sphere 0 0 0 1\n"
+             "    }\n"
+             "    volume 3 1 1 1 {\n"
+             "        sphere 5 0 0 1\n"
+             "    }\n"
+             "}\n"
+             "group material glass {\n"
+             "    sphere 0 0 0 1             # not in a volume\n"
+             "}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 4);
+    assert_true(s.instances[0].volume);
+    assert_double_equal(s.instances[0].density, 0.2, 1e-7);
+    assert_vector_equal(s.instances[0].volume_albedo, 0.1, 0.5, 1);
+    assert_int_equal(s.instances[0].material, -1);
+    assert_int_equal(s.objects[s.instances[0].object].shape_count, 6);
+    assert_maps(&s.instances[0], 0, 0, 0, 0, 1, 0);
+    /* A group inside a volume is part of the volume's boundary. */
+    assert_true(s.instances[1].volume);
+    assert_double_equal(s.instances[1].density, 0.2, 1e-7);
+    assert_int_equal(s.instances[1].material, 0);
+    assert_maps(&s.instances[1], 0, 0, 0, 0, 1, 0);
+    /* The nearest volume counts. */
+    assert_true(s.instances[2].volume);
+    assert_double_equal(s.instances[2].density, 3, 0);
+    assert_vector_equal(s.instances[2].volume_albedo, 1, 1, 1);
+    assert_false(s.instances[3].volume);
+    assert_double_equal(s.instances[3].density, 0, 0);
+    scene_free(&s);
+
+    /* A named group's placements keep the volumes inside it... */
+    parse_ok("group fog {\n  volume 1 0.5 0.5 0.5 {\n    sphere 0 0 0 1\n  }\n}\ninstance fog\n", NULL, &s);
+    assert_int_equal(s.instance_count, 2);
+    assert_true(s.instances[1].volume);
+    assert_double_equal(s.instances[1].volume_albedo[0], 0.5, 0);
+    scene_free(&s);
+    /* ... but not one around it: placed elsewhere, this sphere is a surface without a material. */
+    assert_parse_error("volume 1 0.5 0.5 0.5 {\n  group fog {\n    sphere 0 0 0 1\n  }\n}\ninstance fog\n",
+                       "s.txt:3:5: ", "this shape has no material");
+
+    assert_parse_error("volume 0 1 1 1 {\n}", "s.txt:1:8: ", "the volume's density must be > 0, found 0");
+    assert_parse_error("volume -2 1 1 1 {\n}", "s.txt:1:8: ", "the volume's density must be > 0, found -2");
+    assert_parse_error("volume 1 1 1.5 1 {\n}", "s.txt:1:12: ",
+                       "the green component of the volume's albedo must be between 0 and 1, found 1.5");
+    assert_parse_error("volume 1 -0.1 1 1 {\n}", "s.txt:1:10: ", "the red component of the volume's albedo");
+    assert_parse_error("volume 1 1 1 1\n", "s.txt:1:15: ", "expected '{' at the end of the volume line, found end of line");
+    assert_parse_error("volume 1 1 1", "s.txt:1:13: ",
+                       "expected a number for the blue component of the volume's albedo, found end of line");
+}
+
+static void test_instance_forms_and_errors(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("material m lambertian 1 1 1\n"
+             "group g material m {\n  sphere 0 0 0 1\n}\n"
+             "instance g {   # a comment after the brace\n"
+             "    rotate 0 1 0 90\n"
+             "    translate 1 0 0\n"
+             "} # and after the closing one\n"
+             "instance g {\n}\n"
+             "instance g material m\n", NULL, &s);
+    assert_int_equal(s.instance_count, 4);
+    assert_maps(&s.instances[1], 0, 0, 1, 2, 0, 0);
+    assert_true(is_identity(&s.instances[2]));
+    assert_true(is_identity(&s.instances[3]));
+    scene_free(&s);
+
+    /* An empty group places nothing, and so does its instance. */
+    parse_ok("group empty {\n}\ninstance empty\n", NULL, &s);
+    assert_int_equal(s.instance_count, 0);
+    assert_int_equal(s.object_count, 0);
+    scene_free(&s);
+
+    assert_parse_error("instance nothing", "s.txt:1:10: ",
+                       "unknown group 'nothing' (a group must be defined with group nothing { ... } before it is "
+                       "instanced)");
+    assert_parse_error("group self {\n  instance self\n}", "s.txt:2:12: ",
+                       "group 'self' is still open: a group cannot contain an instance of itself");
+    assert_parse_error("group outer {\n  group inner {\n    instance outer {\n    }\n  }\n}", "s.txt:3:14: ",
+                       "group 'outer' is still open");
+    assert_parse_error("group g {\n}\n\ngroup g {\n}", "s.txt:4:7: ", "group 'g' is already defined at s.txt:1:7");
+    assert_parse_error("group g {\n}\ngroup {\n  group g {\n  }\n}", "s.txt:4:9: ", "group 'g' is already defined");
+    assert_parse_error("group g {\n}\ninstance g {\n  sphere 0 0 0 1\n}", "s.txt:4:3: ",
+                       "only transforms (translate, rotate, scale, matrix) may appear inside an instance block, found "
+                       "'sphere'");
+    assert_parse_error("group g {\n}\ninstance g {\n  set x 1\n}", "s.txt:4:3: ", "inside an instance block");
+    assert_parse_error("instance", "s.txt:1:9: ", "expected a group name after instance, found end of line");
+    assert_parse_error("group g {\n}\ninstance g extra", "s.txt:3:12: ",
+                       "expected '{' at the end of the instance line (or end of line), found 'extra'");
+    assert_parse_error("group $g {\n}", "s.txt:1:7: ", "expected a group name (letters, digits, '_', '-' and '.'), found '$g'");
+    assert_parse_error("group g h {\n}", "s.txt:1:9: ", "expected '{' at the end of the group line, found 'h'");
+    assert_parse_error("group g", "s.txt:1:8: ", "expected '{' at the end of the group line, found end of line");
+}
+
+static void test_braces(void **state)
+{
+    (void)state;
+    scene s;
+    /* Blocks with nothing in them, comments and blank lines, '{' right after the keyword. */
+    parse_ok("group{\n\n  # nothing\n}\nvolume 1 1 1 1{\n}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 0);
+    scene_free(&s);
+
+    assert_parse_error("render spp 1\n  group g {\n  group {\n  }\n", "s.txt:2:3: ",
+                       "this group is never closed (expected a '}' on a line of its own before the end of s.txt)");
+    assert_parse_error("volume 1 1 1 1 {\n", "s.txt:1:1: ", "this volume is never closed");
+    assert_parse_error("group g {\n}\ninstance g {\n  translate 1 0 0", "s.txt:3:1: ", "this instance block is never closed");
+    assert_parse_error("group {\n}\n}", "s.txt:3:1: ", "unexpected '}' (no block is open)");
+    assert_parse_error("material m lambertian 1 1 1\ngroup {\n  sphere 0 0 0 1 m }\n}", "s.txt:3:20: ",
+                       "unexpected '}' (a '}' closes a block on a line of its own)");
+    assert_parse_error("group {\n} group {", "s.txt:2:3: ",
+                       "unexpected 'group' after '}' (a '}' stands alone on its line) (expected end of line)");
+    assert_parse_error("group {\n}}", "s.txt:2:2: ", "unexpected '}' (a '}' closes a block on a line of its own)");
+    assert_parse_error("group { sphere 0 0 0 1\n}", "s.txt:1:9: ", "unexpected 'sphere' after '{' (a block's '{' ends its line)");
+    assert_parse_error("{\n}", "s.txt:1:1: ", "unexpected '{' (only a group, instance or volume line ends with '{')");
+    assert_parse_error("camera fov 30 {", "s.txt:1:15: ", "unexpected '{'");
+}
+
+/* Builds depth nested groups, each with a translate, the innermost with a sphere. */
+static char *nested_groups(int depth)
+{
+    size_t size = (size_t)depth * 40 + 128;
+    char *text = malloc(size);
+    assert_non_null(text);
+    size_t used = (size_t)snprintf(text, size, "material m lambertian 1 1 1\n");
+    for (int i = 0; i < depth; i++)
+        used += (size_t)snprintf(text + used, size - used, "group {\ntranslate 1 0 0\n");
+    used += (size_t)snprintf(text + used, size - used, "sphere 0 0 0 1 m\n");
+    for (int i = 0; i < depth; i++)
+        used += (size_t)snprintf(text + used, size - used, "}\n");
+    return text;
+}
+
+static void test_nesting_limit(void **state)
+{
+    (void)state;
+    char *text = nested_groups(64);
+    scene s;
+    parse_ok(text, NULL, &s);
+    assert_int_equal(s.instance_count, 1);
+    assert_maps(&s.instances[0], 0, 0, 0, 64, 0, 0);
+    scene_free(&s);
+    free(text);
+
+    text = nested_groups(65);
+    /* Line 2 + 2 * 64 opens the 65th group. */
+    assert_parse_error(text, "s.txt:130:1: ", "blocks nested too deeply: this group would be level 65, the limit is 64");
+    free(text);
+
+    /* An instance without braces at the deepest level is fine (it opens no block). */
+    size_t size = 64 * 10 + 256;
+    text = malloc(size);
+    assert_non_null(text);
+    size_t used = (size_t)snprintf(text, size, "material m lambertian 1 1 1\ngroup g material m {\nsphere 0 0 0 1\n}\n");
+    for (int i = 0; i < 64; i++)
+        used += (size_t)snprintf(text + used, size - used, "group {\n");
+    used += (size_t)snprintf(text + used, size - used, "instance g\n");
+    for (int i = 0; i < 64; i++)
+        used += (size_t)snprintf(text + used, size - used, "}\n");
+    parse_ok(text, NULL, &s);
+    assert_int_equal(s.instance_count, 2);
+    scene_free(&s);
+    free(text);
+}
+
+static void test_include_inside_a_block(void **state)
+{
+    write_text(state, "parts/transforms.txt", "rotate 0 0 1 90\n");
+    write_text(state, "parts/shapes.txt", "sphere 0 0 0 1\nquad 0 0 0 1 0 0 0 1 0 m\n");
+    write_text(state, "top.txt",
+               "material m lambertian 1 1 1\n"
+               "group material m {\n"
+               "    include \"parts/transforms.txt\"   # transforms may come from an include\n"
+               "    translate 5 0 0\n"
+               "    include \"parts/shapes.txt\"\n"
+               "    sphere 1 1 1 1\n"
+               "}\n");
+    scene s;
+    load_file_ok(state, "top.txt", NULL, &s);
+    assert_int_equal(s.sphere_count, 0);                   /* in a block: not plain spheres */
+    assert_int_equal(s.object_count, 1);
+    assert_int_equal(s.objects[0].shape_count, 3);
+    assert_int_equal(s.shapes[0].type, SHAPE_SPHERE);
+    assert_int_equal(s.shapes[1].type, SHAPE_QUAD);
+    assert_int_equal(s.shapes[1].material, 0);
+    assert_vector_equal(s.shapes[2].points[0], 1, 1, 1);
+    assert_int_equal(s.instance_count, 1);
+    assert_maps(&s.instances[0], 1, 0, 0, 5, 1, 0);
+    scene_free(&s);
+
+    /* A shape in the include ends the transforms of the includer's block. */
+    write_text(state, "late.txt", "material m lambertian 1 1 1\ngroup material m {\n  include \"parts/shapes.txt\"\n"
+                                  "  translate 1 0 0\n}\n");
+    assert_file_error(state, "late.txt", NULL, "%s/late.txt:4:3: ", "transforms come first in a group");
+
+    /* Each file closes the blocks it opens. */
+    write_text(state, "opens.txt", "group {\n");
+    write_text(state, "open-in-include.txt", "include \"opens.txt\"\n}\n");
+    assert_file_error(state, "open-in-include.txt", NULL, "%s/opens.txt:1:1: ",
+                      "this group is never closed (expected a '}' on a line of its own before the end of %s/opens.txt)");
+    write_text(state, "closes.txt", "# closes its includer's block\n}\n");
+    write_text(state, "close-in-include.txt", "volume 1 1 1 1 {\n  include \"closes.txt\"\n}\n");
+    assert_file_error(state, "close-in-include.txt", NULL, "%s/closes.txt:2:1: ",
+                      "unexpected '}': this file opened no block (the open volume was opened at "
+                      "%s/close-in-include.txt:1:1; a block must be closed in the file that opens it)");
+    /* An include inside an instance block may hold transforms only. */
+    write_text(state, "shift.txt", "translate 0 0 3\n");
+    write_text(state, "instanced.txt", "material m lambertian 1 1 1\ngroup g material m {\n  sphere 0 0 0 1\n}\n"
+                                       "instance g {\n  include \"shift.txt\"\n}\n");
+    load_file_ok(state, "instanced.txt", NULL, &s);
+    assert_int_equal(s.instance_count, 2);
+    assert_maps(&s.instances[1], 0, 0, 0, 0, 0, 3);
+    scene_free(&s);
+    write_text(state, "bad-instanced.txt", "material m lambertian 1 1 1\ngroup g material m {\n}\n"
+                                           "instance g {\n  include \"parts/shapes.txt\"\n}\n");
+    assert_file_error(state, "bad-instanced.txt", NULL, "%s/parts/shapes.txt:1:1: ", "inside an instance block");
+}
+
+/* ------------------------------------------------------------------ the documented scene-model example */
+
+static void test_documented_scene_model_example(void **state)
+{
+    (void)state;
+    /* The second example of docs/scene-format.md, kept in sync by hand. */
+    const char *text =
+        "# A wooden table with a glass ball on it, a second table behind it, and a puff of smoke.\n"
+        "render size 640 360 spp 128 depth 16\n"
+        "camera from 0 1.6 4 at 0 0.7 0 fov 40 shutter 0 1\n"
+        "sky gradient 1 1 1  0.5 0.7 1.0 intensity 1\n"
+        "\n"
+        "texture light constant 0.9 0.9 0.9\n"
+        "texture tiles checker 0.5 @light 0.2 0.2 0.2\n"
+        "texture grain marble 8\n"
+        "\n"
+        "material floor lambertian @tiles\n"
+        "material wood lambertian @grain\n"
+        "material glass dielectric 1.5\n"
+        "material lamp emissive 1 0.9 0.8 strength 8\n"
+        "\n"
+        "quad -10 0 10  20 0 0  0 0 -20 floor     # 20 x 20, facing up (u x v points up)\n"
+        "sphere 0 6 0 1 lamp\n"
+        "\n"
+        "group table material wood {\n"
+        "    group leg {\n"
+        "        translate -0.5 0 -0.3\n"
+        "        box -0.03 0 -0.03  0.03 0.7 0.03\n"
+        "    }\n"
+        "    instance leg {\n"
+        "        translate 1 0 0\n"
+        "    }\n"
+        "    instance leg {\n"
+        "        translate 0 0 0.6\n"
+        "    }\n"
+        "    instance leg {\n"
+        "        translate 1 0 0.6\n"
+        "    }\n"
+        "    box -0.6 0.7 -0.4  0.6 0.75 0.4         # the top\n"
+        "    sphere 0 0.95 0 0.2 glass\n"
+        "}\n"
+        "\n"
+        "instance table {\n"
+        "    rotate 0 1 0 30\n"
+        "    translate 1.5 0 -2\n"
+        "}\n"
+        "\n"
+        "volume 2 0.8 0.8 0.8 {\n"
+        "    translate -1.5 0.5 -1\n"
+        "    sphere 0 0 0 0.5\n"
+        "}\n";
+    scene s;
+    parse_ok(text, NULL, &s);
+    assert_int_equal(s.texture_count, 4);                  /* with the checker's hidden 0.2 0.2 0.2 */
+    assert_int_equal(s.material_count, 4);
+    assert_int_equal(s.materials[0].albedo_texture, 2);
+    assert_int_equal(s.sphere_count, 1);
+    /* Objects: the floor, a leg, the table's own shapes (top and ball), the smoke. */
+    assert_int_equal(s.object_count, 4);
+    assert_int_equal(s.objects[0].shape_count, 1);
+    assert_int_equal(s.objects[1].shape_count, 6);
+    assert_int_equal(s.objects[2].shape_count, 7);
+    assert_int_equal(s.shape_count, 15);
+    /* Instances: the floor; four legs and the table's shapes; all five again; the smoke. */
+    assert_int_equal(s.instance_count, 12);
+    assert_true(is_identity(&s.instances[0]));
+    for (int i = 1; i <= 10; i++) {
+        assert_int_equal(s.instances[i].object, i == 5 || i == 10 ? 2 : 1);
+        assert_int_equal(s.instances[i].material, 1);
+    }
+    assert_maps(&s.instances[1], 0, 0, 0, -0.5, 0, -0.3);
+    assert_maps(&s.instances[2], 0, 0, 0, 0.5, 0, -0.3);
+    assert_maps(&s.instances[4], 0, 0, 0, 0.5, 0, 0.3);
+    double c = cos(30 * 3.14159265358979323846 / 180), sn = sin(30 * 3.14159265358979323846 / 180);
+    assert_maps(&s.instances[6], 0, 0, 0, 1.5 - 0.5 * c - 0.3 * sn, 0, -2 + 0.5 * sn - 0.3 * c);
+    assert_true(s.instances[11].volume);
+    assert_double_equal(s.instances[11].density, 2, 0);
+    assert_maps(&s.instances[11], 0, 0, 0, -1.5, 0.5, -1);
+    assert_double_equal(s.camera.shutter_close, 1, 0);
+    scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1158,6 +2153,27 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_include_depth_limit, create_directory, remove_directory),
         cmocka_unit_test_setup_teardown(test_define_applies_across_includes, create_directory, remove_directory),
         cmocka_unit_test(test_documented_example),
+        cmocka_unit_test(test_textures),
+        cmocka_unit_test(test_texture_errors),
+        cmocka_unit_test(test_material_textures_and_normal_maps),
+        cmocka_unit_test(test_sky_images_intensity_and_rotation),
+        cmocka_unit_test(test_camera_shutter),
+        cmocka_unit_test(test_top_level_shapes_form_one_world_object),
+        cmocka_unit_test(test_box_expands_to_six_outward_quads),
+        cmocka_unit_test(test_shape_errors),
+        cmocka_unit_test(test_transform_order),
+        cmocka_unit_test(test_scale_matrix_and_rotate_forms),
+        cmocka_unit_test(test_transform_errors),
+        cmocka_unit_test(test_named_group_placed_again_shares_objects),
+        cmocka_unit_test(test_material_inheritance),
+        cmocka_unit_test(test_shapes_without_any_material),
+        cmocka_unit_test_setup_teardown(test_meshes, create_directory, remove_directory),
+        cmocka_unit_test(test_volumes),
+        cmocka_unit_test(test_instance_forms_and_errors),
+        cmocka_unit_test(test_braces),
+        cmocka_unit_test(test_nesting_limit),
+        cmocka_unit_test_setup_teardown(test_include_inside_a_block, create_directory, remove_directory),
+        cmocka_unit_test(test_documented_scene_model_example),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
