@@ -530,6 +530,7 @@ static void set_parameters(gpu_tracer *tracer, const gpu_tracer_parameters *p)
     glUniform1ui(glGetUniformLocation(program, "max_depth"), p->max_depth);
     glUniform1ui(glGetUniformLocation(program, "russian_roulette_depth"), p->russian_roulette_depth);
     glUniform1i(glGetUniformLocation(program, "pass_work_budget"), (GLint)p->pass_work_budget);
+    glUniform1i(glGetUniformLocation(program, "light_sampling"), p->light_sampling ? 1 : 0);
     glUniform1i(glGetUniformLocation(program, "packed_width_log2"), tracer->packed_width_log2);
     glUniform1i(glGetUniformLocation(program, "packed_scene"), STATE_TARGET_COUNT);
     for (int target = 0; target < STATE_TARGET_COUNT; target++)

@@ -86,6 +86,7 @@ typedef struct gpu_tracer_parameters {
     uint32_t max_depth;
     uint32_t russian_roulette_depth;      /* first bounce at which paths may end at random */
     uint32_t pass_work_budget;            /* work units a pixel may start in one pass */
+    bool light_sampling;                  /* next-event estimation with MIS at diffuse hits */
     const float *resume;                  /* NULL, or width*height*4 floats, rows top to bottom:
                                            * (sum r, g, b, finished samples) to continue from;
                                            * a pixel with n finished samples goes on with

@@ -1,5 +1,6 @@
-/* image_io.cpp: see image_io.h. The only C++ in rtspheres: a thin extern "C" shim over
- * OpenImageIO. No C++ exception crosses the C boundary; every entry point catches them.
+/* image_io.cpp: see image_io.h. A thin extern "C" shim over OpenImageIO (obj_load.cpp is
+ * the other C++ file). No C++ exception crosses the C boundary; every entry point catches
+ * them.
  *
  * Writing encodes the file into memory first (through an OIIO IOProxy) and then writes the
  * bytes to the temporary file itself, so every disk error is seen here with its errno:
@@ -392,8 +393,69 @@ std::unique_ptr<OIIO::ImageInput> open_input(const char *path, rt_error *error)
     return input;
 }
 
-/* Reads path into *out, which the caller has zeroed and frees on an exception. */
-rt_status image_read_impl(const char *path, rt_image *out, rt_error *error)
+/* The transfer functions a file's colour channels can be encoded with. */
+enum class transfer { linear, srgb, rec709, gamma };
+
+/* Returns how the colour channels of a file with this spec are encoded (see
+ * image_read_linear() in image_io.h); *gamma is set for transfer::gamma. */
+transfer transfer_of(const OIIO::ImageSpec &spec, float *gamma)
+{
+    std::string space = spec.get_string_attribute("oiio:ColorSpace");
+    const char *name = space.c_str();
+    if (strcasecmp(name, "sRGB") == 0)
+        return transfer::srgb;
+    if (strcasecmp(name, "Rec709") == 0)
+        return transfer::rec709;
+    if (strncasecmp(name, "GammaCorrected", 14) == 0) {
+        char *end = nullptr;
+        double g = strtod(name + 14, &end);
+        *gamma = end != name + 14 && std::isfinite(g) && g > 0 ? (float)g : 2.2f;
+        return transfer::gamma;
+    }
+    if (strcasecmp(name, "Linear") == 0 || strcasecmp(name, "scene_linear") == 0)
+        return transfer::linear;
+    return spec.format.is_floating_point() ? transfer::linear : transfer::srgb;
+}
+
+/* Returns the linear value of one encoded with t (IEC 61966-2-1 sRGB, ITU-R BT.709). */
+float decode_transfer(float value, transfer t, float gamma)
+{
+    switch (t) {
+    case transfer::linear:
+        return value;
+    case transfer::srgb:
+        return value <= 0.04045f ? value / 12.92f : std::pow((value + 0.055f) / 1.055f, 2.4f);
+    case transfer::rec709:
+        return value < 0.081f ? value / 4.5f : std::pow((value + 0.099f) / 1.099f, 1.0f / 0.45f);
+    case transfer::gamma:
+        return value <= 0.0f ? value : std::pow(value, gamma);
+    }
+    return value;
+}
+
+/* Converts the colour channels of out (read with spec) to linear light; alpha and depth
+ * channels are kept as stored. */
+void decode_to_linear(const OIIO::ImageSpec &spec, rt_image *out)
+{
+    float gamma = 1.0f;
+    transfer t = transfer_of(spec, &gamma);
+    if (t == transfer::linear)
+        return;
+    std::vector<bool> colour(out->channels);
+    for (int c = 0; c < out->channels; c++)
+        colour[c] = c != spec.alpha_channel && c != spec.z_channel
+                    && !is_alpha_name(out->channel_names[c]);
+    size_t count = (size_t)out->width * out->height * out->channels;
+    for (size_t i = 0; i < count; i++)
+        if (colour[i % out->channels])
+            out->pixels[i] = decode_transfer(out->pixels[i], t, gamma);
+}
+
+/* Reads path into *out, which the caller has zeroed and frees on an exception. Images
+ * wider or taller than max_side (when > 0) are refused before their pixels are read;
+ * linear asks for decode_to_linear(). */
+rt_status image_read_impl(const char *path, int max_side, bool linear, rt_image *out,
+                          rt_error *error)
 {
     auto input = open_input(path, error);
     if (!input)
@@ -403,6 +465,10 @@ rt_status image_read_impl(const char *path, rt_image *out, rt_error *error)
         return read_failed(error, path, "deep images are not supported");
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
         return read_failed(error, path, "the image has no pixels");
+    if (max_side > 0 && (spec.width > max_side || spec.height > max_side))
+        return read_failed(error, path,
+                           "it is " + std::to_string(spec.width) + "x" + std::to_string(spec.height)
+                               + " pixels, more than " + std::to_string(max_side) + " on a side");
     if (spec.nchannels > IMAGE_MAX_CHANNELS)
         return read_failed(error, path,
                            "it has " + std::to_string(spec.nchannels) + " channels; at most "
@@ -423,6 +489,8 @@ rt_status image_read_impl(const char *path, rt_image *out, rt_error *error)
         return read_failed(error, path,
                            one_line(input->geterror(), "the file is truncated or corrupt"));
     }
+    if (linear)
+        decode_to_linear(spec, out);
     input->close();
     return RT_OK;
 }
@@ -547,7 +615,27 @@ rt_status image_read(const char *path, rt_image *out, rt_error *error)
     if (path == nullptr)
         return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read an image from");
     try {
-        return image_read_impl(path, out, error);
+        return image_read_impl(path, 0, false, out, error);
+    } catch (const std::bad_alloc &) {
+        image_free(out);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory",
+                            path);
+    } catch (const std::exception &e) {
+        image_free(out);
+        return read_failed(error, path, one_line(e.what()));
+    } catch (...) {
+        image_free(out);
+        return read_failed(error, path, "unexpected C++ exception");
+    }
+}
+
+rt_status image_read_linear(const char *path, int max_side, rt_image *out, rt_error *error)
+{
+    memset(out, 0, sizeof *out);
+    if (path == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read an image from");
+    try {
+        return image_read_impl(path, max_side, true, out, error);
     } catch (const std::bad_alloc &) {
         image_free(out);
         return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory",

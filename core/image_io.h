@@ -82,6 +82,19 @@ rt_status image_write(const char *path, const rt_image *image, const image_write
  * Missing, unreadable or malformed file: RT_ERROR_INPUT naming the file. */
 rt_status image_read(const char *path, rt_image *out, rt_error *error);
 
+/* Reads the image at path like image_read(), and converts its colour channels to linear
+ * light by the colour space OpenImageIO reports for the file ("oiio:ColorSpace"):
+ *   "sRGB" (PNG, JPEG)        decoded with the sRGB curve: 8-bit 128 becomes 0.2158
+ *   "Rec709" (PPM, PGM)       decoded with the ITU-R BT.709 curve: 128 becomes 0.2615
+ *   "GammaCorrectedG"         raised to the power G
+ *   "Linear" (EXR, HDR)       kept
+ *   none, or another name     sRGB when the file stores integers (8/16-bit TIFF, TGA,
+ *                             BMP), kept when it stores floats
+ * Alpha (OIIO's alpha channel, or a channel named "A"/"Alpha") and depth are kept as
+ * stored. An image wider or taller than max_side pixels (when max_side > 0) is refused
+ * with RT_ERROR_INPUT before its pixels are read. Errors as image_read(). */
+rt_status image_read_linear(const char *path, int max_side, rt_image *out, rt_error *error);
+
 /* Reads one metadata attribute of the file as text into value (at most value_size bytes,
  * NUL-terminated). Returns RT_OK, or RT_ERROR_INPUT if the file or attribute is missing. */
 rt_status image_read_attribute(const char *path, const char *name, char *value, int value_size,

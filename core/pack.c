@@ -25,6 +25,9 @@ static float bits_float(uint32_t bits)
     return value;
 }
 
+static float dot3(const float a[3], const float b[3]);
+static void cross3(const float a[3], const float b[3], float out[3]);
+
 static double seconds_now(void)
 {
     struct timespec now;
@@ -438,7 +441,20 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     uint64_t instance_offset = node_offset + node_count * PACKED_NODE_STRIDE;
     uint64_t texture_offset = instance_offset + (uint64_t)p.packed_instances * PACKED_INSTANCE_STRIDE;
     uint64_t image_offset = texture_offset + (uint64_t)s->texture_count * PACKED_TEXTURE_STRIDE;
-    uint64_t pixel_offset = image_offset + (uint64_t)s->image_count * PACKED_IMAGE_STRIDE;
+    /* Lights: every emissive world-level sphere, quad and triangle (their material is
+     * concrete at the top level). Moving spheres are left to BSDF sampling. */
+    uint32_t light_count = 0;
+    for (uint32_t k = 0; k < p.top.primitives.count; k++) {
+        const pending_primitive *item = &p.top.primitives.items[k];
+        uint32_t material = item->material;
+        if (item->type != PRIMITIVE_SPHERE && item->type != PRIMITIVE_QUAD && item->type != PRIMITIVE_TRIANGLE)
+            continue;
+        if (material != PACKED_NONE && material < (uint32_t)s->material_count
+            && s->materials[material].type == MATERIAL_EMISSIVE)
+            light_count++;
+    }
+    uint64_t light_offset = image_offset + (uint64_t)s->image_count * PACKED_IMAGE_STRIDE;
+    uint64_t pixel_offset = light_offset + (uint64_t)light_count * PACKED_LIGHT_STRIDE;
     uint64_t texel_count = pixel_offset + image_pixels;
     if (texel_count > UINT32_MAX / 4) {
         status = rt_error_set(error, RT_ERROR_INPUT, "PACK: the scene needs %llu texels, more than 32-bit indices reach",
@@ -458,6 +474,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     put_texel(texels, 2, (uint32_t)instance_offset, p.packed_instances, (uint32_t)attribute_offset, default_material);
     put_texel(texels, 3, (uint32_t)texture_offset, (uint32_t)s->texture_count, (uint32_t)image_offset,
               (uint32_t)s->image_count);
+    put_texel(texels, 4, (uint32_t)light_offset, light_count, 0, 0);
 
     /* Materials, and the default grey one last. */
     for (uint64_t i = 0; i < material_count; i++) {
@@ -513,6 +530,53 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             put_texel(texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
                       float_bits(node->box.max[2]), node->count);
         }
+    }
+
+    /* Lights, chosen by power: emission luminance x area (x pi for the cosine lobe). */
+    if (light_count > 0) {
+        double *power = malloc(light_count * sizeof *power);
+        if (power == NULL) {
+            status = rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+            goto done;
+        }
+        double total = 0;
+        uint32_t light = 0;
+        for (uint32_t slot = 0; slot < p.top.primitives.count; slot++) {
+            const pending_primitive *item = &p.top.primitives.items[p.top.tree.primitive_indices[slot]];
+            if (item->type != PRIMITIVE_SPHERE && item->type != PRIMITIVE_QUAD && item->type != PRIMITIVE_TRIANGLE)
+                continue;
+            if (item->material == PACKED_NONE || item->material >= (uint32_t)s->material_count
+                || s->materials[item->material].type != MATERIAL_EMISSIVE)
+                continue;
+            const float *e = s->materials[item->material].emission;
+            double luminance = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
+            double area;
+            uint32_t type;
+            if (item->type == PRIMITIVE_SPHERE) {
+                area = 4 * M_PI * item->data[0][3] * item->data[0][3];
+                type = LIGHT_SPHERE;
+            } else {
+                float c[3];
+                cross3(item->data[1], item->data[2], c);
+                area = sqrt((double)dot3(c, c)) * (item->type == PRIMITIVE_QUAD ? 1.0 : 0.5);
+                type = item->type == PRIMITIVE_QUAD ? LIGHT_QUAD : LIGHT_TRIANGLE;
+            }
+            power[light] = luminance * area * M_PI;
+            /* A light of no power is still listed (for MIS weights) but never chosen. */
+            total += power[light];
+            uint64_t base = light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
+            put_texel(texels, base, type, (uint32_t)slot, 0, 0);
+            /* The primitive learns its light index (texel 0 .w) for MIS weights. */
+            texels[4 * (primitive_offset + (uint64_t)slot * PACKED_PRIMITIVE_STRIDE) + 3] = light;
+            light++;
+        }
+        double cumulative = 0;
+        for (uint32_t l = 0; l < light_count; l++) {
+            cumulative += total > 0 ? power[l] / total : 1.0 / light_count;
+            uint64_t base = light_offset + (uint64_t)l * PACKED_LIGHT_STRIDE;
+            put_texel(texels, base + 1, 0, 0, 0, float_bits(l + 1 == light_count ? 1.0f : (float)cumulative));
+        }
+        free(power);
     }
 
     /* Instances: the object's root, material, world-to-object matrix, volume. */
@@ -575,6 +639,8 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     out->texture_count = (uint32_t)s->texture_count;
     out->image_offset = (uint32_t)image_offset;
     out->image_count = (uint32_t)s->image_count;
+    out->light_offset = (uint32_t)light_offset;
+    out->light_count = light_count;
 
 done:
     free(texels);

@@ -37,6 +37,7 @@ typedef struct packed_scene {
     uint32_t instance_offset, instance_count;
     uint32_t texture_offset, texture_count;
     uint32_t image_offset, image_count;
+    uint32_t light_offset, light_count;
     uint32_t default_material;
     uint32_t triangle_count;     /* triangles stored (mesh triangles once per object) */
     int bvh_depth;               /* deepest level of any BVH */

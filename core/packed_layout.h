@@ -28,6 +28,7 @@
  *   instances   PACKED_INSTANCE_STRIDE texels each
  *   textures    PACKED_TEXTURE_STRIDE texels each
  *   images      PACKED_IMAGE_STRIDE texels each (a record), pixels elsewhere in the section
+ *   lights      PACKED_LIGHT_STRIDE texels each, for light sampling
  */
 #ifndef RT_PACKED_LAYOUT_H
 #define RT_PACKED_LAYOUT_H
@@ -38,7 +39,7 @@
 
 /* ---- header (4 texels), field i is component i % 4 of texel i / 4 */
 #define PACKED_MAGIC 1381258067
-#define PACKED_HEADER_TEXELS 4
+#define PACKED_HEADER_TEXELS 5
 #define PACKED_HEADER_MAGIC 0
 #define PACKED_HEADER_VERSION 1
 #define PACKED_HEADER_MATERIAL_OFFSET 2
@@ -55,6 +56,8 @@
 #define PACKED_HEADER_TEXTURE_COUNT 13
 #define PACKED_HEADER_IMAGE_OFFSET 14
 #define PACKED_HEADER_IMAGE_COUNT 15
+#define PACKED_HEADER_LIGHT_OFFSET 16
+#define PACKED_HEADER_LIGHT_COUNT 17
 
 /* ---- materials: 4 texels
  *   texel 0 = (type tag, albedo.r, albedo.g, albedo.b)
@@ -71,7 +74,8 @@
 
 /* ---- primitives: 4 texels
  *   texel 0 = (type tag, material index or PACKED_NONE (the instance's), attribute record
- *              index or PACKED_NONE, instance index for PRIMITIVE_INSTANCE)
+ *              index or PACKED_NONE, instance index for PRIMITIVE_INSTANCE, else the light
+ *              index of an emissive world primitive or PACKED_NONE)
  *   sphere:         texel 1 = (centre.xyz, radius)
  *   moving sphere:  texel 1 = (centre at time 0 .xyz, radius), texel 2 = (centre at time 1 .xyz, 0)
  *   triangle:       texel 1 = (v0.xyz, 0), texel 2 = (v1 - v0 .xyz, 0), texel 3 = (v2 - v0 .xyz, 0)
@@ -121,6 +125,23 @@
 /* ---- images: 1 texel record = (first pixel texel, width, height, 0); pixels are RGBA
  * float bits, one texel each, rows top to bottom, after all the records */
 #define PACKED_IMAGE_STRIDE 1
+
+/* ---- lights: 4 texels (what next-event estimation samples, chosen by power)
+ *   texel 0 = (type tag, primitive slot (area lights), 0, 0)
+ *   texel 1 = (position.xyz (point, spot) or direction towards the light (sun), cdf)
+ *             cdf: the probability of choosing this light or any before it
+ *   texel 2 = (intensity colour.rgb (point, spot: per steradian; sun: irradiance), 0)
+ *   texel 3 = reserved (spot cone, falloff: issue "variable light")
+ * Area lights are emissive world primitives (spheres, quads, triangles): their radiance is
+ * their material's emission. */
+#define PACKED_LIGHT_STRIDE 4
+#define LIGHT_SPHERE 0
+#define LIGHT_QUAD 1
+#define LIGHT_TRIANGLE 2
+#define LIGHT_POINT 3
+#define LIGHT_SPOT 4
+#define LIGHT_SUN 5
+#define LIGHT_TYPE_COUNT 6
 
 /* Deepest BVH per level (the builder never exceeds it; deeper nodes become leaves). The
  * shader's stack holds a top-level path, one leaf's instances and a bottom-level path:

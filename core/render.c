@@ -74,6 +74,7 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     p->russian_roulette_depth = options->russian_roulette_depth ? options->russian_roulette_depth
                                                                 : DEFAULT_RUSSIAN_ROULETTE_DEPTH;
     p->pass_work_budget = options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET;
+    p->light_sampling = !options->no_light_sampling;
 }
 
 /* Reads the tracer's accumulation into a new width x height image of means (R, G, B) and
@@ -182,7 +183,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     hash = hash_bytes(hash, &s->sky.rotation_degrees, sizeof s->sky.rotation_degrees);
     hash = hash_bytes(hash, &s->camera.shutter_open, sizeof s->camera.shutter_open);
     hash = hash_bytes(hash, &s->camera.shutter_close, sizeof s->camera.shutter_close);
-    int shape[3] = {s->render.width, s->render.height, s->render.max_depth};
+    int shape[4] = {s->render.width, s->render.height, s->render.max_depth, options->no_light_sampling};
     hash = hash_bytes(hash, shape, sizeof shape);
     result->scene_hash = hash;
     if (options->resume != NULL && options->resume_scene_hash != 0 && options->resume_scene_hash != hash) {

@@ -16,6 +16,8 @@
  *     hard cap per traversal is 60,000, under llvmpipe's 65,535). A non-zero value is
  *     used for every pass. The image does not depend on it, only the time per pass.
  *   target_pass_seconds 0.25 (short passes keep progress, Ctrl-C and GPU watchdogs happy),
+ *   light sampling on (next-event estimation with MIS; the image's expectation is the
+ *     same without it, only the noise differs),
  *   russian_roulette_depth 4 (paths may end at random from the 5th segment on),
  *   sample_start 0, the whole image, no progress callback, no stop flag.
  *
@@ -43,6 +45,7 @@ typedef struct render_progress {
 typedef struct render_options {
     uint32_t pass_work_budget;
     double target_pass_seconds;
+    bool no_light_sampling;      /* true: BSDF sampling only (to compare the estimators) */
     uint32_t russian_roulette_depth;
     uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */
     int region[4];               /* x0, y0, x1, y1 (row 0 at the top, x1/y1 exclusive) of the

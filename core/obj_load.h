@@ -1,0 +1,84 @@
+/* obj_load.h: reading a Wavefront OBJ file (and its MTL files) into a flat triangle mesh,
+ * through tinyobjloader (a thin C shim over C++, like image_io.cpp).
+ *
+ * What comes back:
+ *   - one vertex per distinct (position, normal, uv) corner of the file, so that a
+ *     position used with two normals (a hard edge) becomes two vertices;
+ *   - triangles: tinyobjloader triangulates quads along their shorter diagonal and larger
+ *     polygons by ear clipping; faces it cannot triangulate (collinear corners) give fewer
+ *     triangles;
+ *   - per triangle, the material named by the last `usemtl` before it (or -1), as an index
+ *     into materials: every name a `usemtl` uses and every material the MTL files define.
+ *
+ * Normals: NULL when no face corner of the file names one (the renderer shades flat).
+ * When some corners name normals and others do not, the others get their triangle's
+ * geometric normal. Normals are made unit length (a zero normal in the file stays zero).
+ * UVs: NULL when no corner names one; otherwise corners without one get (0, 0). UVs are
+ * as in the file (v upwards, the OBJ convention).
+ *
+ * MTL files: every file of every `mtllib` line is looked up relative to the OBJ file's
+ * directory (absolute paths as they are) and all are loaded, wherever the `mtllib` line
+ * stands. A missing MTL file is not an error: the mesh loads, the names its `usemtl`
+ * lines use are still listed (defined = false), and warning says which file is missing.
+ *
+ * Errors (RT_ERROR_INPUT, the message "OBJ: cannot read 'PATH': REASON", with "line N: "
+ * in REASON where there is a line): a missing or unreadable file, a number that is not a
+ * number or not finite (NaN, inf, beyond the float range) in v/vn/vt lines, a face with
+ * fewer than 3 corners, a face index that is 0, malformed or out of range (relative
+ * indices are checked against the elements before the line, positive ones against the
+ * whole file), a NUL byte, no faces at all ("has no faces"), more than 2^31 - 1 vertices,
+ * a non-finite value in an MTL colour. Out of memory: RT_ERROR_RUNTIME. No C++ exception
+ * crosses into C.
+ */
+#ifndef RT_OBJ_LOAD_H
+#define RT_OBJ_LOAD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define OBJ_NAME_MAX 256
+
+/* One material: from an MTL file (defined), or only named by a `usemtl` (not defined:
+ * no MTL file defines it; the colours are then tinyobjloader's defaults and meaningless). */
+typedef struct obj_material {
+    char name[OBJ_NAME_MAX];     /* as in the file, cut to OBJ_NAME_MAX - 1 bytes */
+    bool defined;
+    float diffuse[3];            /* Kd */
+    float specular[3];           /* Ks */
+    float emission[3];           /* Ke */
+    float shininess;             /* Ns (tinyobjloader's default when missing: 1) */
+    float index_of_refraction;   /* Ni (default when missing: 1, like an explicit "Ni 1") */
+    float dissolve;              /* d, or 1 - Tr; 1 is opaque (the default) */
+} obj_material;
+
+/* A triangle mesh. Arrays are malloc'd (free() each, or obj_mesh_free()), so a caller
+ * may take them over by copying the pointer and setting the field to NULL. */
+typedef struct obj_mesh {
+    float *positions;            /* 3 per vertex */
+    float *normals;              /* 3 per vertex, or NULL */
+    float *uvs;                  /* 2 per vertex, or NULL */
+    uint32_t *indices;           /* 3 per triangle, counter-clockwise as in the file */
+    int *triangle_materials;     /* per triangle: index into materials, or -1 (no usemtl) */
+    int vertex_count, triangle_count;   /* both >= 1 after a successful load */
+    obj_material *materials;     /* NULL when material_count is 0 */
+    int material_count;
+    char warning[256];           /* "" or the first thing worth a warning (a missing MTL) */
+} obj_mesh;
+
+/* Reads the OBJ file at path into *out (zeroed first; on failure left zeroed). */
+rt_status obj_load(const char *path, obj_mesh *out, rt_error *error);
+
+/* Frees the arrays of *mesh (not mesh itself) and zeroes it. NULL is allowed. */
+void obj_mesh_free(obj_mesh *mesh);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
