@@ -122,11 +122,24 @@ typedef struct progress_state {
     bool tty;
     double last_draw;
     const char *label;
+    double command_start;        /* monotonic seconds when the command started */
+    double first_pass;           /* seconds from the command's start to the first pass's end */
 } progress_state;
+
+static double monotonic_seconds(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return now.tv_sec + now.tv_nsec * 1e-9;
+}
+
+static double command_start_seconds;
 
 static void draw_progress(void *context, const render_progress *progress)
 {
     progress_state *state = context;
+    if (progress->passes == 1)
+        state->first_pass = monotonic_seconds() - state->command_start;
     if (!state->tty || progress->samples_total == 0)
         return;
     double fraction = (double)progress->samples_done / (double)progress->samples_total;
@@ -685,7 +698,8 @@ static int render_frame(gpu_context *context, const render_request *request, int
     char label[64] = "";
     if (frame >= 0)
         snprintf(label, sizeof label, "frame %d ", frame);
-    progress_state progress = {.tty = !request->quiet && isatty(STDERR_FILENO), .last_draw = -1, .label = label};
+    progress_state progress = {.tty = !request->quiet && isatty(STDERR_FILENO), .last_draw = -1, .label = label,
+                               .command_start = command_start_seconds};
     options.progress = draw_progress;
     options.progress_context = &progress;
     options.stop_requested = &stop_requested;
@@ -720,6 +734,17 @@ static int render_frame(gpu_context *context, const render_request *request, int
         } else {
             /* The checkpoint is ours and now superseded by the complete image. */
             unlink(partial_path);
+            if (request->verbose) {
+                uint64_t geometry_bytes = result.packed_bytes - result.image_bytes;
+                fprintf(stderr,
+                        "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights; BVH depth %d, "
+                        "built in %.3f s; packed %llu bytes (%.1f per triangle without images); first pass done "
+                        "%.3f s after start (context, parse, BVH, upload, compile)\n",
+                        result.primitive_count, result.triangle_count, result.instance_count, result.light_count,
+                        result.bvh_depth, result.bvh_build_seconds, (unsigned long long)result.packed_bytes,
+                        result.triangle_count ? (double)geometry_bytes / result.triangle_count : 0.0,
+                        progress.first_pass);
+            }
             if (!request->quiet)
                 fprintf(stderr,
                         "rtspheres: %s -> %s: %dx%d, %d spp in %.2f s (%.3g samples/s, %.3g path segments/s, %d pass%s)\n",
@@ -736,6 +761,7 @@ static int render_frame(gpu_context *context, const render_request *request, int
 
 int command_render(int argc, char **argv)
 {
+    command_start_seconds = monotonic_seconds();
     render_request request = {.seed = -1, .device = -1};
     bool help_shown = false;
     int exit_code = parse_arguments(argc, argv, &request, &help_shown);

@@ -172,7 +172,13 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         return status;
     result->bvh_depth = packed.bvh_depth;
     result->bvh_build_seconds = packed.bvh_build_seconds;
-    result->packed_bytes = packed.texel_count * 16u;
+    result->packed_bytes = (uint64_t)packed.texel_count * 16u;
+    for (int i = 0; i < s->image_count; i++)
+        result->image_bytes += (uint64_t)s->images[i].width * s->images[i].height * 16u;
+    result->triangle_count = packed.triangle_count;
+    result->primitive_count = packed.primitive_count;
+    result->instance_count = packed.instance_count;
+    result->light_count = packed.light_count;
     uint64_t hash = 0xcbf29ce484222325ull;
     hash = hash_bytes(hash, packed.texels, (size_t)packed.texel_count * 16u);
     hash = hash_bytes(hash, &frame, sizeof frame);

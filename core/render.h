@@ -78,7 +78,10 @@ typedef struct render_result {
     int passes;
     int bvh_depth;
     double bvh_build_seconds;
-    uint32_t packed_bytes;
+    uint64_t packed_bytes;       /* the whole packed scene, images included */
+    uint64_t image_bytes;        /* of which image pixels */
+    uint32_t triangle_count;     /* triangles stored (a mesh once however often placed) */
+    uint32_t primitive_count, instance_count, light_count;
     uint64_t scene_hash;         /* FNV-1a of what decides the image apart from the samples:
                                   * packed scene, camera, sky, full size, max depth. Parts of
                                   * one render share it; `merge` refuses mixed hashes. */
