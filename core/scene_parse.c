@@ -31,6 +31,11 @@
 
 #define DEFAULT_MAX_INCLUDE_DEPTH 16
 
+/* The largest scene file read: far more than any real scene, and a clean error (EFBIG)
+ * for a mistake such as include "/dev/zero", which would otherwise be read until memory
+ * runs out. */
+#define MAX_SCENE_FILE_BYTES ((size_t)256 << 20)
+
 /* How much of a bad token a message quotes; enough to recognise it, not a whole line. */
 #define QUOTE_LIMIT 40
 #define QUOTE_BUFFER (QUOTE_LIMIT + 8)
@@ -433,6 +438,10 @@ static int read_whole_file(const char *path, char **text, size_t *length, struct
         close(descriptor);
         return EISDIR;
     }
+    if (S_ISREG(info->st_mode) && (uintmax_t)info->st_size > MAX_SCENE_FILE_BYTES) {
+        close(descriptor);
+        return EFBIG;
+    }
     /* st_size is only a hint: pipes report 0 and files may grow while being read. */
     size_t capacity = S_ISREG(info->st_mode) && info->st_size > 0 ? (size_t)info->st_size + 1 : 4096;
     size_t used = 0;
@@ -464,6 +473,11 @@ static int read_whole_file(const char *path, char **text, size_t *length, struct
         if (got == 0)
             break;
         used += (size_t)got;
+        if (used > MAX_SCENE_FILE_BYTES) {
+            free(buffer);
+            close(descriptor);
+            return EFBIG;
+        }
     }
     close(descriptor);
     buffer[used] = '\0';
@@ -1617,13 +1631,279 @@ static bool statement_sky(parser *p, source_line *line, const token *keyword)
     return true;
 }
 
-/* Reads the optional clauses of a material, in any order: a number (fuzz, strength) into
- * *value (offset into *value_offset), or normal_map "FILE" into material->normal_map.
- * statement names the material type for messages ("metal material"). */
-static bool read_material_clauses(parser *p, source_line *line, const char *statement, const char *const *names,
-                                  int count, scene_material *material, double *value, size_t *value_offset)
+/* ambient R G B: the Whitted integrator's ambient term (each >= 0); the last one wins. */
+static bool statement_ambient(parser *p, source_line *line, const token *keyword)
 {
-    size_t first_offsets[2] = {SIZE_MAX, SIZE_MAX};
+    (void)keyword;
+    float ambient[3];
+    if (!read_colour(p, line, "the ambient colour", ambient) || !expect_end_of_line(p, line, "the ambient colour"))
+        return false;
+    memcpy(p->scene->ambient, ambient, sizeof ambient);
+    return true;
+}
+
+/* Scales the vector v (not zero) to unit length in double, dividing by its largest
+ * component first so that tiny vectors do not underflow; stores it as float. */
+static void normalise_into(const double v[3], float out[3])
+{
+    double largest = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+    double unit[3], length = 0;
+    for (int i = 0; i < 3; i++) {
+        unit[i] = v[i] / largest;
+        length += unit[i] * unit[i];
+    }
+    length = sqrt(length);
+    for (int i = 0; i < 3; i++)
+        out[i] = (float)(unit[i] / length);
+}
+
+/* Reads an angle in degrees for what (a cone half-angle, the sun's diameter): 0 <= angle < 90. */
+static bool read_light_angle(parser *p, source_line *line, const char *what, double *value, size_t *offset)
+{
+    if (!read_number(p, line, what, value, offset))
+        return false;
+    if (!(*value >= 0 && *value < 90)) {
+        char number[40];
+        return fail_at(p, line, *offset, "%s must be from 0 up to (not including) 90 degrees, found %s", what,
+                       format_number(number, sizeof number, *value));
+    }
+    return true;
+}
+
+/* Reads the falloff clause of owner ("the point light"): inverse_square, or polynomial
+ * C L Q (each >= 0, not all 0), into light. */
+static bool read_light_falloff(parser *p, source_line *line, const char *owner, scene_light *light)
+{
+    static const char *const terms[3] = {"constant", "linear", "quadratic"};
+    token kind = {.kind = TOKEN_END};
+    if (!next_token(p, line, &kind))
+        return false;
+    if (token_is(line, &kind, "inverse_square")) {
+        light->falloff = FALLOFF_INVERSE_SQUARE;
+        return true;
+    }
+    char found[QUOTE_BUFFER + 16];
+    if (!token_is(line, &kind, "polynomial"))
+        return fail_at(p, line, kind.offset, "expected a falloff for %s (inverse_square, or polynomial C L Q), "
+                       "found %s", owner, describe_token(line, &kind, found, sizeof found));
+    float attenuation[3];
+    for (int i = 0; i < 3; i++) {
+        char what[DESCRIPTION_BUFFER];
+        snprintf(what, sizeof what, "the %s term of %s's polynomial falloff", terms[i], owner);
+        double value = 0;
+        size_t offset = 0;
+        char number[40];
+        if (!read_number(p, line, what, &value, &offset))
+            return false;
+        if (value < 0)
+            return fail_at(p, line, offset, "%s must be >= 0, found %s", what,
+                           format_number(number, sizeof number, value));
+        if (!to_float(p, line, offset, what, value, &attenuation[i]))
+            return false;
+    }
+    /* Compared as floats: a term that rounds to 0 does not help the renderer either. */
+    if (attenuation[0] == 0 && attenuation[1] == 0 && attenuation[2] == 0)
+        return fail_at(p, line, kind.offset, "the terms of %s's polynomial falloff must not all be 0 (the light "
+                       "would be infinitely bright at every distance)", owner);
+    light->falloff = FALLOFF_POLYNOMIAL;
+    memcpy(light->attenuation, attenuation, sizeof attenuation);
+    return true;
+}
+
+/* light point X Y Z [color R G B] [intensity I] [falloff inverse_square | falloff polynomial C L Q]
+ * light spot X Y Z at X Y Z [color R G B] [intensity I] [cone INNER OUTER] [falloff ...]
+ * light sun DX DY DZ [color R G B] [intensity I] [angle DEGREES]
+ * Only at the top level. scene_light.color is colour x intensity; the sun's direction is
+ * the one its light travels. */
+static bool statement_light(parser *p, source_line *line, const token *keyword)
+{
+    if (p->block_count > 1) {
+        const block *b = current_block(p);
+        return fail_at(p, line, keyword->offset, "lights go at the top level of a scene, not inside a group (this "
+                       "light is inside the %s opened at %s:%d:%zu)", block_noun(b->kind), b->opened.path,
+                       b->opened.line, b->opened.column);
+    }
+    token type = {.kind = TOKEN_END};
+    if (!next_token(p, line, &type))
+        return false;
+    char found[QUOTE_BUFFER + 16];
+    scene_light_type kind;
+    const char *owner, *statement;
+    if (token_is(line, &type, "point"))
+        kind = SCENE_LIGHT_POINT, owner = "the point light", statement = "point light";
+    else if (token_is(line, &type, "spot"))
+        kind = SCENE_LIGHT_SPOT, owner = "the spot light", statement = "spot light";
+    else if (token_is(line, &type, "sun"))
+        kind = SCENE_LIGHT_SUN, owner = "the sun", statement = "sun light";
+    else
+        return fail_at(p, line, type.offset, "expected a light type (point, spot or sun), found %s",
+                       describe_token(line, &type, found, sizeof found));
+    scene_light light = scene_light_defaults(kind);
+
+    char what[DESCRIPTION_BUFFER];
+    if (kind == SCENE_LIGHT_SUN) {
+        double direction[3];
+        size_t offsets[3];
+        if (!read_point(p, line, "the sun's direction", direction, offsets))
+            return false;
+        if (direction[0] == 0 && direction[1] == 0 && direction[2] == 0)
+            return fail_at(p, line, offsets[0], "the sun's direction (0 0 0) has zero length, so it has no "
+                           "direction (it is the direction the light travels, e.g. 0 -1 0 shines straight down)");
+        normalise_into(direction, light.direction);
+    } else {
+        snprintf(what, sizeof what, "%s's position", owner);
+        if (!read_vector(p, line, what, light.position, NULL))
+            return false;
+    }
+    if (kind == SCENE_LIGHT_SPOT) {
+        token at = {.kind = TOKEN_END};
+        if (!next_token(p, line, &at))
+            return false;
+        if (!token_is(line, &at, "at"))
+            return fail_at(p, line, at.offset, "expected 'at' and the point the spot light shines at after its "
+                           "position, found %s", describe_token(line, &at, found, sizeof found));
+        float target[3];
+        size_t offsets[3];
+        if (!read_vector(p, line, "the spot light's at", target, offsets))
+            return false;
+        double direction[3];
+        for (int i = 0; i < 3; i++)
+            direction[i] = (double)target[i] - light.position[i];
+        if (direction[0] == 0 && direction[1] == 0 && direction[2] == 0)
+            return fail_at(p, line, offsets[0], "the spot light's at is its position (%g %g %g), so it has no "
+                           "direction", target[0], target[1], target[2]);
+        normalise_into(direction, light.direction);
+    }
+
+    /* The clauses each type takes; the index into all_clauses is what the switch uses. */
+    static const char *const all_clauses[] = {"color", "intensity", "falloff", "cone", "angle"};
+    static const char *const point_clauses[] = {"color", "intensity", "falloff"};
+    static const char *const spot_clauses[] = {"color", "intensity", "cone", "falloff"};
+    static const char *const sun_clauses[] = {"color", "intensity", "angle"};
+    const char *const *names = kind == SCENE_LIGHT_POINT ? point_clauses
+                               : kind == SCENE_LIGHT_SPOT ? spot_clauses : sun_clauses;
+    int count = kind == SCENE_LIGHT_SPOT ? 4 : 3;
+    size_t first_offsets[4] = {SIZE_MAX, SIZE_MAX, SIZE_MAX, SIZE_MAX};
+    float colour[3] = {1, 1, 1};
+    double intensity = 1;
+    size_t intensity_offset = SIZE_MAX;
+    char number[40], second[40];
+    for (;;) {
+        token t = {.kind = TOKEN_END};
+        if (!next_token(p, line, &t))
+            return false;
+        if (t.kind == TOKEN_END)
+            break;
+        int index = -1;
+        if (!match_clause(p, line, &t, statement, names, count, first_offsets, &index))
+            return false;
+        int clause = 0;
+        while (strcmp(all_clauses[clause], names[index]) != 0)
+            clause++;
+        switch (clause) {
+        case 0:
+            snprintf(what, sizeof what, "%s's color", owner);
+            if (!read_colour(p, line, what, colour))
+                return false;
+            break;
+        case 1:
+            snprintf(what, sizeof what, "%s's intensity", owner);
+            if (!read_number(p, line, what, &intensity, &intensity_offset))
+                return false;
+            if (!(intensity >= 0))
+                return fail_at(p, line, intensity_offset, "%s must be >= 0, found %s", what,
+                               format_number(number, sizeof number, intensity));
+            break;
+        case 2:
+            if (!read_light_falloff(p, line, owner, &light))
+                return false;
+            break;
+        case 3: {
+            double inner = 0, outer = 0;
+            size_t inner_offset = 0, outer_offset = 0;
+            if (!read_light_angle(p, line, "the spot light's inner cone angle", &inner, &inner_offset) ||
+                !read_light_angle(p, line, "the spot light's outer cone angle", &outer, &outer_offset))
+                return false;
+            if (inner > outer)
+                return fail_at(p, line, outer_offset, "the spot light's cone must have 0 <= inner <= outer < 90 "
+                               "degrees, found inner %s and outer %s", format_number(number, sizeof number, inner),
+                               format_number(second, sizeof second, outer));
+            light.spot_inner_degrees = (float)inner;
+            light.spot_outer_degrees = (float)outer;
+            break;
+        }
+        default: {
+            double angle = 0;
+            size_t offset = 0;
+            if (!read_light_angle(p, line, "the sun's angle", &angle, &offset))
+                return false;
+            light.sun_angle_degrees = (float)angle;
+            break;
+        }
+        }
+    }
+    for (int i = 0; i < 3; i++) {
+        snprintf(what, sizeof what, "%s's color x intensity", owner);
+        /* Only a given intensity can take a (float) colour out of range. */
+        if (!to_float(p, line, intensity_offset != SIZE_MAX ? intensity_offset : keyword->offset, what,
+                      colour[i] * intensity, &light.color[i]))
+            return false;
+    }
+    return scene_add_light(p->scene, &light) >= 0 || fail_out_of_memory(p);
+}
+
+/* Reads specular R G B for owner (e.g. "material 'm'"): each component from 0 to 1. */
+static bool read_specular(parser *p, source_line *line, const char *owner, float out[3])
+{
+    static const char *const channels[3] = {"red", "green", "blue"};
+    for (int i = 0; i < 3; i++) {
+        char what[DESCRIPTION_BUFFER];
+        snprintf(what, sizeof what, "the %s component of the specular colour of %s", channels[i], owner);
+        size_t offset = 0;
+        double value = 0;
+        if (!read_number(p, line, what, &value, &offset))
+            return false;
+        if (!(value >= 0 && value <= 1)) {
+            char number[40];
+            return fail_at(p, line, offset, "%s must be between 0 and 1, found %s", what,
+                           format_number(number, sizeof number, value));
+        }
+        out[i] = (float)value;
+    }
+    return true;
+}
+
+/* Reads the phong exponent of owner: > 0, and not 0 as a float either (0 means "the
+ * default" in scene_material). */
+static bool read_phong_exponent(parser *p, source_line *line, const char *owner, float *out)
+{
+    char what[DESCRIPTION_BUFFER];
+    snprintf(what, sizeof what, "the phong exponent of %s", owner);
+    double value = 0;
+    size_t offset = 0;
+    char number[40];
+    if (!read_number(p, line, what, &value, &offset))
+        return false;
+    if (!(value > 0))
+        return fail_at(p, line, offset, "%s must be > 0, found %s", what, format_number(number, sizeof number, value));
+    if (!to_float(p, line, offset, what, value, out))
+        return false;
+    if (*out == 0)
+        return fail_at(p, line, offset, "%s %s is too small for the renderer's 32-bit floats", what,
+                       format_number(number, sizeof number, value));
+    return true;
+}
+
+/* Reads the optional clauses of a material, in any order: a number (fuzz, strength) into
+ * *value (offset into *value_offset), normal_map "FILE" into material->normal_map, phong
+ * EXPONENT and specular R G B (lambertian and metal) into the Whitted fields. statement
+ * names the material type for messages ("metal material"), owner the material
+ * ("material 'm'"). */
+static bool read_material_clauses(parser *p, source_line *line, const char *statement, const char *owner,
+                                  const char *const *names, int count, scene_material *material, double *value,
+                                  size_t *value_offset)
+{
+    size_t first_offsets[8] = {SIZE_MAX, SIZE_MAX, SIZE_MAX, SIZE_MAX, SIZE_MAX, SIZE_MAX, SIZE_MAX, SIZE_MAX};
     for (;;) {
         token t = {.kind = TOKEN_END};
         if (!next_token(p, line, &t))
@@ -1640,13 +1920,21 @@ static bool read_material_clauses(parser *p, source_line *line, const char *stat
                 return false;
             /* A normal map holds vectors: the loader must not sRGB-decode it. */
             p->scene->images[material->normal_map].data = true;
+        } else if (strcmp(names[index], "phong") == 0) {
+            if (!read_phong_exponent(p, line, owner, &material->phong_exponent))
+                return false;
+        } else if (strcmp(names[index], "specular") == 0) {
+            if (!read_specular(p, line, owner, material->specular))
+                return false;
+            material->specular_set = true;
         } else if (!read_number(p, line, description, value, value_offset)) {
             return false;
         }
     }
 }
 
-/* material NAME lambertian COLOR [normal_map "F"] | metal COLOR [fuzz F] [normal_map "F"] |
+/* material NAME lambertian COLOR [normal_map "F"] [phong E] [specular R G B] |
+ * metal COLOR [fuzz F] [normal_map "F"] [phong E] [specular R G B] |
  * dielectric IOR [normal_map "F"] | emissive COLOR [strength S], COLOR being R G B or
  * @TEXTURE. Remembers where NAME was defined for duplicate errors. */
 static bool statement_material(parser *p, source_line *line, const token *keyword)
@@ -1675,16 +1963,17 @@ static bool statement_material(parser *p, source_line *line, const token *keywor
     char found[QUOTE_BUFFER + 16];
     static const char *const normal_map_only[] = {"normal_map"};
     if (token_is(line, &type, "lambertian")) {
+        static const char *const clauses[] = {"normal_map", "phong", "specular"};
         material.type = MATERIAL_LAMBERTIAN;
         if (!read_colour_or_texture(p, line, owner, material.albedo, &material.albedo_texture) ||
-            !read_material_clauses(p, line, "lambertian material", normal_map_only, 1, &material, NULL, NULL))
+            !read_material_clauses(p, line, "lambertian material", owner, clauses, 3, &material, NULL, NULL))
             return false;
     } else if (token_is(line, &type, "metal")) {
-        static const char *const clauses[] = {"fuzz", "normal_map"};
+        static const char *const clauses[] = {"fuzz", "normal_map", "phong", "specular"};
         material.type = MATERIAL_METAL;
         value = 0;
         if (!read_colour_or_texture(p, line, owner, material.albedo, &material.albedo_texture) ||
-            !read_material_clauses(p, line, "metal material", clauses, 2, &material, &value, &offset))
+            !read_material_clauses(p, line, "metal material", owner, clauses, 4, &material, &value, &offset))
             return false;
         if (!(value >= 0 && value <= 1))
             return fail_at(p, line, offset, "the fuzz of %s must be between 0 and 1, found %s", owner,
@@ -1704,7 +1993,7 @@ static bool statement_material(parser *p, source_line *line, const token *keywor
         if (material.index_of_refraction == 0)
             return fail_at(p, line, offset, "%s %s is too small for the renderer's 32-bit floats", what,
                            format_number(number, sizeof number, value));
-        if (!read_material_clauses(p, line, "dielectric material", normal_map_only, 1, &material, NULL, NULL))
+        if (!read_material_clauses(p, line, "dielectric material", owner, normal_map_only, 1, &material, NULL, NULL))
             return false;
     } else if (token_is(line, &type, "emissive")) {
         static const char *const clauses[] = {"strength"};
@@ -1712,7 +2001,7 @@ static bool statement_material(parser *p, source_line *line, const token *keywor
         float colour[3];
         value = 1;
         if (!read_colour_or_texture(p, line, owner, colour, &material.emission_texture) ||
-            !read_material_clauses(p, line, "emissive material", clauses, 1, &material, &value, &offset))
+            !read_material_clauses(p, line, "emissive material", owner, clauses, 1, &material, &value, &offset))
             return false;
         if (!(value >= 0))
             return fail_at(p, line, offset, "the strength of %s must be >= 0, found %s", owner,
@@ -2340,6 +2629,8 @@ static const struct {
     {"camera", statement_camera, true},
     {"render", statement_render, true},
     {"sky", statement_sky, true},
+    {"ambient", statement_ambient, true},
+    {"light", statement_light, false},          /* top level only: it checks that itself */
     {"texture", statement_texture, true},
     {"material", statement_material, true},
     {"sphere", statement_sphere, true},
@@ -2380,8 +2671,9 @@ static bool parse_statement(parser *p, source_line *line)
     }
     char found[QUOTE_BUFFER + 16];
     return fail_at(p, line, keyword.offset, "unknown statement %s (expected include, set, camera, render, sky, "
-                   "texture, material, sphere, moving_sphere, triangle, quad, box, mesh, group, instance, volume, "
-                   "translate, rotate, scale or matrix)", describe_token(line, &keyword, found, sizeof found));
+                   "ambient, light, texture, material, sphere, moving_sphere, triangle, quad, box, mesh, group, "
+                   "instance, volume, translate, rotate, scale or matrix)",
+                   describe_token(line, &keyword, found, sizeof found));
 }
 
 /* Parses every line of file in order; the file must close every block it opens. */

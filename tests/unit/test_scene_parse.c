@@ -584,9 +584,9 @@ static void test_unknown_statement(void **state)
 {
     (void)state;
     assert_parse_error("spere 0 0 0 1 m", "s.txt:1:1: ",
-                       "unknown statement 'spere' (expected include, set, camera, render, sky, texture, material, "
-                       "sphere, moving_sphere, triangle, quad, box, mesh, group, instance, volume, translate, "
-                       "rotate, scale or matrix)");
+                       "unknown statement 'spere' (expected include, set, camera, render, sky, ambient, light, "
+                       "texture, material, sphere, moving_sphere, triangle, quad, box, mesh, group, instance, "
+                       "volume, translate, rotate, scale or matrix)");
     assert_parse_error("\n\n   Camera fov 30", "s.txt:3:4: ", "unknown statement 'Camera'");
     assert_parse_error("\"camera\"", "s.txt:1:1: ", "unknown statement the string \"camera\"");
     assert_parse_error("42", "s.txt:1:1: ", "unknown statement '42'");
@@ -601,7 +601,7 @@ static void test_unknown_clause(void **state)
                        "unknown render clause 'quality' (expected size, spp, depth or seed)");
     assert_parse_error("camera from 0 0 1 2", "s.txt:1:19: ", "unknown camera clause '2'");
     assert_parse_error("material m metal 1 1 1 shine 2", "s.txt:1:24: ",
-                       "unknown metal material clause 'shine' (expected fuzz or normal_map)");
+                       "unknown metal material clause 'shine' (expected fuzz, normal_map, phong or specular)");
     assert_parse_error("material m emissive 1 1 1 fuzz 2", "s.txt:1:27: ",
                        "unknown emissive material clause 'fuzz' (expected strength)");
     assert_parse_error("sky rainbow 1 1 1", "s.txt:1:5: ",
@@ -663,7 +663,7 @@ static void test_extra_tokens(void **state)
     assert_parse_error("material g dielectric 1.5 2", "s.txt:1:27: ",
                        "unknown dielectric material clause '2' (expected normal_map)");
     assert_parse_error("material g lambertian 1 1 1 fuzz 0.5", "s.txt:1:29: ",
-                       "unknown lambertian material clause 'fuzz' (expected normal_map)");
+                       "unknown lambertian material clause 'fuzz' (expected normal_map, phong or specular)");
     assert_parse_error("include \"a.txt\" more", "s.txt:1:17: ", "unexpected 'more' after the included path");
 }
 
@@ -1008,6 +1008,26 @@ static void test_missing_include(void **state)
     write_text(state, "unquoted.txt", "include other.txt\n");
     assert_file_error(state, "unquoted.txt", NULL, "%s/unquoted.txt:1:9: ",
                       "expected a quoted path after include (e.g. include \"common.txt\"), found 'other.txt'");
+}
+
+/* A file that never ends (a device) or is absurdly large fails with a message instead
+ * of being read until memory runs out. The large one is sparse: it takes no disk space. */
+static void test_oversized_files(void **state)
+{
+    write_text(state, "zero.txt", "include \"/dev/zero\"\n");
+    assert_file_error(state, "zero.txt", NULL, "%s/zero.txt:1:1: ",
+                      "cannot read included file '/dev/zero': File too large");
+
+    const char *directory = ((temporary_directory *)*state)->path;
+    char path[256], expected[512];
+    write_text(state, "huge.txt", "");
+    assert_int_equal(truncate(path_in(state, "huge.txt", path, sizeof path), (off_t)300 << 20), 0);
+    scene s;
+    rt_error error = {{0}};
+    assert_int_equal(scene_load_file(path, NULL, &s, &error), RT_ERROR_INPUT);
+    snprintf(expected, sizeof expected, "SCENE: cannot read '%s/huge.txt': File too large", directory);
+    assert_string_equal(error.message, expected);
+    assert_true(scene_is_default(&s));
 }
 
 static void test_include_cycles(void **state)
@@ -2026,6 +2046,402 @@ static void test_include_inside_a_block(void **state)
     assert_file_error(state, "bad-instanced.txt", NULL, "%s/parts/shapes.txt:1:1: ", "inside an instance block");
 }
 
+/* ------------------------------------------------------------------ lights, ambient, phong */
+
+static void test_lights_defaults(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("", NULL, &s);
+    assert_int_equal(s.light_count, 0);
+    assert_null(s.lights);
+    assert_vector_equal(s.ambient, 0.03, 0.03, 0.03);
+    scene_free(&s);
+
+    parse_ok("light point 1 2 3\n"
+             "light spot 1 1 1 at 1 1 -3\n"
+             "light sun 0 -1 0\n", NULL, &s);
+    assert_int_equal(s.light_count, 3);
+    const scene_light *point = &s.lights[0], *spot = &s.lights[1], *sun = &s.lights[2];
+    assert_int_equal(point->type, SCENE_LIGHT_POINT);
+    assert_vector_equal(point->position, 1, 2, 3);
+    assert_vector_equal(point->color, 1, 1, 1);                 /* white, intensity 1 */
+    assert_int_equal(point->falloff, FALLOFF_INVERSE_SQUARE);
+    assert_vector_equal(point->attenuation, 1, 0, 0);           /* unused, as scene_light_defaults */
+    assert_int_equal(spot->type, SCENE_LIGHT_SPOT);
+    assert_vector_equal(spot->position, 1, 1, 1);
+    assert_vector_equal(spot->direction, 0, 0, -1);             /* normalize(at - position) */
+    assert_double_equal(spot->spot_inner_degrees, 25, 0);
+    assert_double_equal(spot->spot_outer_degrees, 30, 0);
+    assert_int_equal(spot->falloff, FALLOFF_INVERSE_SQUARE);
+    assert_vector_equal(spot->color, 1, 1, 1);
+    assert_int_equal(sun->type, SCENE_LIGHT_SUN);
+    assert_vector_equal(sun->direction, 0, -1, 0);              /* the direction light travels */
+    assert_vector_equal(sun->position, 0, 0, 0);
+    assert_double_equal(sun->sun_angle_degrees, 0.53, 1e-7);
+    assert_vector_equal(sun->color, 1, 1, 1);
+    /* Every default is scene_light_defaults' own. */
+    scene_light expected = scene_light_defaults(SCENE_LIGHT_SUN);
+    assert_memory_equal(sun, &expected, sizeof expected);
+    expected = scene_light_defaults(SCENE_LIGHT_POINT);
+    memcpy(expected.position, point->position, sizeof expected.position);
+    assert_memory_equal(point, &expected, sizeof expected);
+    scene_free(&s);
+}
+
+static void test_light_clauses(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("light point 1 2 3 color 1 0.5 0.25 intensity 4 falloff polynomial 1 0.09 0.032\n"
+             "light spot 0 5 0 at 0 0 0 cone 10 20 falloff inverse_square intensity 2\n"
+             "light sun 1 -1 0 angle 2 color 0.5 0.5 0.5   # any order\n"
+             "light sun 3 -4 0 intensity 0 angle 0\n"
+             "light spot 0 1 0 at 0 0 0 cone 0 0\n"
+             "light spot 0 1 0 at 2 1 0 cone 89.5 89.5 color 2 0 0\n"
+             "light point 0 0 0 falloff polynomial 0 0 1 color 0 0 0\n"
+             "light point 0 0 0 falloff polynomial 1e-3 0 0\n"
+             "light sun 0 -1e-30 0\n", NULL, &s);
+    assert_int_equal(s.light_count, 9);
+    const scene_light *l = s.lights;
+    /* color x intensity is what the scene stores. */
+    assert_vector_equal(l[0].color, 4, 2, 1);
+    assert_int_equal(l[0].falloff, FALLOFF_POLYNOMIAL);
+    assert_vector_equal(l[0].attenuation, 1, 0.09, 0.032);
+    assert_vector_equal(l[1].direction, 0, -1, 0);
+    assert_double_equal(l[1].spot_inner_degrees, 10, 0);
+    assert_double_equal(l[1].spot_outer_degrees, 20, 0);
+    assert_int_equal(l[1].falloff, FALLOFF_INVERSE_SQUARE);
+    assert_vector_equal(l[1].color, 2, 2, 2);
+    assert_vector_equal(l[2].direction, sqrt(0.5), -sqrt(0.5), 0);   /* normalised */
+    assert_double_equal(l[2].sun_angle_degrees, 2, 0);
+    assert_vector_equal(l[2].color, 0.5, 0.5, 0.5);
+    assert_vector_equal(l[3].direction, 0.6, -0.8, 0);
+    assert_vector_equal(l[3].color, 0, 0, 0);                  /* intensity 0 is allowed */
+    assert_double_equal(l[3].sun_angle_degrees, 0, 0);
+    assert_double_equal(l[4].spot_inner_degrees, 0, 0);
+    assert_double_equal(l[4].spot_outer_degrees, 0, 0);
+    assert_double_equal(l[5].spot_outer_degrees, 89.5, 0);
+    assert_vector_equal(l[5].direction, 1, 0, 0);
+    assert_vector_equal(l[5].color, 2, 0, 0);
+    assert_vector_equal(l[6].attenuation, 0, 0, 1);
+    assert_vector_equal(l[6].color, 0, 0, 0);
+    assert_int_equal(l[7].falloff, FALLOFF_POLYNOMIAL);
+    assert_double_equal(l[7].attenuation[0], 1e-3, 1e-10);
+    assert_vector_equal(l[8].direction, 0, -1, 0);             /* tiny but not zero */
+    scene_free(&s);
+}
+
+static void test_light_expressions_and_sweep(void **state)
+{
+    (void)state;
+    const char *text = "set t 0\n"
+                       "set cone 15\n"
+                       "light point (4*cos($t)) 5 (4*sin($t)) intensity ($t + 1)\n"
+                       "light spot 0 $cone 0 at (2*$cone) 0 0 cone ($cone/3) $cone color (0.5) 1 ($t)\n";
+    scene s;
+    parse_ok(text, NULL, &s);
+    assert_vector_equal(s.lights[0].position, 4, 5, 0);
+    assert_vector_equal(s.lights[0].color, 1, 1, 1);
+    assert_vector_equal(s.lights[1].position, 0, 15, 0);
+    assert_vector_equal(s.lights[1].direction, 30 / sqrt(30 * 30 + 15 * 15), -15 / sqrt(30 * 30 + 15 * 15), 0);
+    assert_double_equal(s.lights[1].spot_inner_degrees, 5, 1e-6);
+    assert_double_equal(s.lights[1].spot_outer_degrees, 15, 0);
+    assert_vector_equal(s.lights[1].color, 0.5, 1, 0);
+    scene_free(&s);
+
+    /* A sweep: -D moves the light a quarter turn, and the intensity with it. */
+    const scene_define defines[] = {{.name = "t", .value = "pi/2"}};
+    scene_parse_options options = options_with_defines(defines, 1);
+    parse_ok(text, &options, &s);
+    assert_vector_equal(s.lights[0].position, 0, 5, 4);
+    double intensity = 3.14159265358979323846 / 2 + 1;
+    assert_vector_equal(s.lights[0].color, intensity, intensity, intensity);
+    assert_vector_equal(s.lights[1].color, 0.5, 1, 3.14159265358979323846 / 2);
+    scene_free(&s);
+
+    const scene_define half[] = {{.name = "t", .value = "pi"}};
+    options = options_with_defines(half, 1);
+    parse_ok(text, &options, &s);
+    assert_vector_equal(s.lights[0].position, -4, 5, 0);
+    scene_free(&s);
+
+    assert_parse_error("light point $x 0 0", "s.txt:1:13: ", "undefined variable $x");
+    assert_parse_error("light point (1/0) 0 0", "s.txt:1:15: ", "division by zero");
+    assert_parse_error("light point 0 0 0 intensity 2*3", "s.txt:1:29: ", "write an expression in parentheses");
+}
+
+static void test_light_errors(void **state)
+{
+    (void)state;
+    /* The type and the required arguments. */
+    assert_parse_error("light", "s.txt:1:6: ", "expected a light type (point, spot or sun), found end of line");
+    assert_parse_error("light area 0 0 0", "s.txt:1:7: ", "expected a light type (point, spot or sun), found 'area'");
+    assert_parse_error("light Point 0 0 0", "s.txt:1:7: ", "found 'Point'");
+    assert_parse_error("light point 0 0", "s.txt:1:16: ",
+                       "expected a number for the point light's position z, found end of line");
+    assert_parse_error("light spot", "s.txt:1:11: ", "expected a number for the spot light's position x");
+    assert_parse_error("light spot 0 5 0", "s.txt:1:17: ",
+                       "expected 'at' and the point the spot light shines at after its position, found end of line");
+    assert_parse_error("light spot 0 5 0 color 1 1 1", "s.txt:1:18: ", "expected 'at' and the point the spot light "
+                       "shines at after its position, found 'color'");
+    assert_parse_error("light spot 0 5 0 at 0 0", "s.txt:1:24: ",
+                       "expected a number for the spot light's at z, found end of line");
+    assert_parse_error("light spot 0 5 0 at 0 5 0", "s.txt:1:21: ",
+                       "the spot light's at is its position (0 5 0), so it has no direction");
+    assert_parse_error("light sun", "s.txt:1:10: ", "expected a number for the sun's direction x, found end of line");
+    assert_parse_error("light sun 0 0 0", "s.txt:1:11: ", "the sun's direction (0 0 0) has zero length");
+    assert_parse_error("light sun (0) (1-1) -0", "s.txt:1:11: ", "has zero length");
+    assert_parse_error("light point nan 0 0", "s.txt:1:13: ", "NaN and infinity are not allowed");
+    assert_parse_error("light point 1e39 0 0", "s.txt:1:13: ", "too large for the renderer's 32-bit floats");
+    assert_parse_error("light sun 0 -1e39 0", "s.txt:1:13: ", "too large for the renderer's 32-bit floats");
+
+    /* Colour and intensity. */
+    assert_parse_error("light point 0 0 0 color 1 -1 1", "s.txt:1:27: ",
+                       "the green component of the point light's color must be >= 0, found -1$");
+    assert_parse_error("light sun 0 -1 0 color 1 1", "s.txt:1:27: ",
+                       "expected a number for the blue component of the sun's color, found end of line");
+    assert_parse_error("light point 0 0 0 intensity -2", "s.txt:1:29: ",
+                       "the point light's intensity must be >= 0, found -2$");
+    assert_parse_error("light spot 0 1 0 at 0 0 0 intensity", "s.txt:1:36: ",
+                       "expected a number for the spot light's intensity, found end of line");
+    assert_parse_error("light point 0 0 0 color 10 1 1 intensity 1e38", "s.txt:1:42: ",
+                       "the point light's color x intensity is 1e+39, too large for the renderer's 32-bit floats");
+
+    /* Spot cone and sun angle. */
+    assert_parse_error("light spot 0 5 0 at 0 0 0 cone -1 20", "s.txt:1:32: ",
+                       "the spot light's inner cone angle must be from 0 up to (not including) 90 degrees, found -1$");
+    assert_parse_error("light spot 0 5 0 at 0 0 0 cone 10 90", "s.txt:1:35: ",
+                       "the spot light's outer cone angle must be from 0 up to (not including) 90 degrees, found 90$");
+    assert_parse_error("light spot 0 5 0 at 0 0 0 cone 90 95", "s.txt:1:32: ", "inner cone angle must be from 0");
+    assert_parse_error("light spot 0 5 0 at 0 0 0 cone 40 30", "s.txt:1:35: ",
+                       "the spot light's cone must have 0 <= inner <= outer < 90 degrees, found inner 40 and outer 30$");
+    assert_parse_error("light spot 0 5 0 at 0 0 0 cone 10", "s.txt:1:34: ",
+                       "expected a number for the spot light's outer cone angle, found end of line");
+    assert_parse_error("light sun 0 -1 0 angle 90", "s.txt:1:24: ",
+                       "the sun's angle must be from 0 up to (not including) 90 degrees, found 90$");
+    assert_parse_error("light sun 0 -1 0 angle -0.5", "s.txt:1:24: ", "found -0.5$");
+    assert_parse_error("light sun 0 -1 0 angle", "s.txt:1:23: ", "expected a number for the sun's angle, found end of line");
+
+    /* Falloff. */
+    assert_parse_error("light point 0 0 0 falloff linear", "s.txt:1:27: ",
+                       "expected a falloff for the point light (inverse_square, or polynomial C L Q), found 'linear'");
+    assert_parse_error("light point 0 0 0 falloff", "s.txt:1:26: ", "expected a falloff for the point light");
+    assert_parse_error("light point 0 0 0 falloff 2", "s.txt:1:27: ", "found '2'");
+    assert_parse_error("light point 0 0 0 falloff polynomial 0 0 0", "s.txt:1:27: ",
+                       "the terms of the point light's polynomial falloff must not all be 0");
+    assert_parse_error("light spot 0 1 0 at 0 0 0 falloff polynomial 1e-50 0 0", "s.txt:1:35: ", "must not all be 0");
+    assert_parse_error("light point 0 0 0 falloff polynomial 1 -1 0", "s.txt:1:40: ",
+                       "the linear term of the point light's polynomial falloff must be >= 0, found -1$");
+    assert_parse_error("light point 0 0 0 falloff polynomial 1 0", "s.txt:1:41: ",
+                       "expected a number for the quadratic term of the point light's polynomial falloff, found end "
+                       "of line");
+    assert_parse_error("light point 0 0 0 falloff polynomial 1e39 0 0", "s.txt:1:38: ", "too large");
+
+    /* Clauses that the type does not take, unknown and repeated clauses, extra tokens. */
+    assert_parse_error("light point 0 0 0 cone 10 20", "s.txt:1:19: ",
+                       "unknown point light clause 'cone' (expected color, intensity or falloff)");
+    assert_parse_error("light point 0 0 0 angle 1", "s.txt:1:19: ", "unknown point light clause 'angle'");
+    assert_parse_error("light sun 0 -1 0 falloff inverse_square", "s.txt:1:18: ",
+                       "unknown sun light clause 'falloff' (expected color, intensity or angle)");
+    assert_parse_error("light sun 0 -1 0 cone 1 2", "s.txt:1:18: ", "unknown sun light clause 'cone'");
+    assert_parse_error("light spot 0 5 0 at 0 0 0 angle 1", "s.txt:1:27: ",
+                       "unknown spot light clause 'angle' (expected color, intensity, cone or falloff)");
+    assert_parse_error("light spot 0 5 0 at 0 0 0 at 1 1 1", "s.txt:1:27: ", "unknown spot light clause 'at'");
+    assert_parse_error("light point 0 0 0 2", "s.txt:1:19: ", "unknown point light clause '2'");
+    assert_parse_error("light point 0 0 0 colour 1 1 1", "s.txt:1:19: ", "unknown point light clause 'colour'");
+    assert_parse_error("light point 0 0 0 intensity 1 intensity 2", "s.txt:1:31: ",
+                       "point light clause 'intensity' given twice in one statement (first at column 19)");
+    assert_parse_error("light point 0 0 0 color 1 1 1 falloff inverse_square color 1 1 1", "s.txt:1:54: ",
+                       "clause 'color' given twice");
+    assert_parse_error("light spot 0 5 0 at 0 0 0 cone 1 2 cone 3 4", "s.txt:1:36: ", "clause 'cone' given twice");
+    assert_parse_error("light sun 0 -1 0 angle 1 angle 1", "s.txt:1:26: ", "clause 'angle' given twice");
+    assert_parse_error("light point 0 0 0 falloff inverse_square falloff inverse_square", "s.txt:1:42: ",
+                       "clause 'falloff' given twice");
+}
+
+static void test_lights_only_at_the_top_level(void **state)
+{
+    (void)state;
+    assert_parse_error("group {\n    light point 0 0 0\n}\n", "s.txt:2:5: ",
+                       "lights go at the top level of a scene, not inside a group (this light is inside the group "
+                       "opened at s.txt:1:1)");
+    assert_parse_error("material m lambertian 1 1 1\ngroup g material m {\n  group {\n    light sun 0 -1 0\n  }\n}\n",
+                       "s.txt:4:5: ", "lights go at the top level of a scene, not inside a group");
+    assert_parse_error("volume 1 1 1 1 {\n  light sun 0 -1 0\n}\n", "s.txt:2:3: ",
+                       "lights go at the top level of a scene, not inside a group (this light is inside the volume "
+                       "opened at s.txt:1:1)");
+    assert_parse_error("material m lambertian 1 1 1\ngroup g {\n  sphere 0 0 0 1 m\n}\ninstance g {\n\tlight point 0 0 0\n}\n",
+                       "s.txt:6:2: ", "lights go at the top level of a scene, not inside a group (this light is "
+                       "inside the instance block opened at s.txt:5:1)");
+    /* Even a broken light statement says where lights go first. */
+    assert_parse_error("group {\n light\n}\n", "s.txt:2:2: ", "lights go at the top level");
+
+    /* After a block closes, the top level takes lights again; they do not end a block's
+     * transforms because they are never in one. */
+    scene s;
+    parse_ok("material m lambertian 1 1 1\nlight point 0 9 0\ngroup {\n  sphere 0 0 0 1 m\n}\nlight sun 0 -1 0\n",
+             NULL, &s);
+    assert_int_equal(s.light_count, 2);
+    assert_int_equal(s.lights[1].type, SCENE_LIGHT_SUN);
+    scene_free(&s);
+}
+
+static void test_light_in_an_included_file(void **state)
+{
+    write_text(state, "lights.txt", "light point 0 5 0 intensity 10\n");
+    write_text(state, "top.txt", "include \"lights.txt\"\nlight sun 0 -1 0\n");
+    scene s;
+    load_file_ok(state, "top.txt", NULL, &s);
+    assert_int_equal(s.light_count, 2);
+    assert_vector_equal(s.lights[0].color, 10, 10, 10);
+    scene_free(&s);
+    /* Included inside a group, the light is inside the group. */
+    write_text(state, "in-group.txt", "group {\n  include \"lights.txt\"\n}\n");
+    assert_file_error(state, "in-group.txt", NULL, "%s/lights.txt:1:1: ",
+                      "lights go at the top level of a scene, not inside a group (this light is inside the group "
+                      "opened at %s/in-group.txt:1:1)");
+}
+
+static void test_ambient(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("ambient 0.1 0.2 0.3", NULL, &s);
+    assert_vector_equal(s.ambient, 0.1, 0.2, 0.3);
+    scene_free(&s);
+
+    /* The last one wins; numbers are expressions; 0 and more than 1 are fine; it may stand
+     * in a block (it is global, like camera). */
+    parse_ok("set a 0.25\nambient 1 1 1\nambient (2*$a) $a 0   # dim\n", NULL, &s);
+    assert_vector_equal(s.ambient, 0.5, 0.25, 0);
+    scene_free(&s);
+    parse_ok("group {\n  ambient 2 0 0\n}\n", NULL, &s);
+    assert_vector_equal(s.ambient, 2, 0, 0);
+    scene_free(&s);
+
+    assert_parse_error("ambient", "s.txt:1:8: ",
+                       "expected a number for the red component of the ambient colour, found end of line");
+    assert_parse_error("ambient 0.1 0.2", "s.txt:1:16: ",
+                       "expected a number for the blue component of the ambient colour, found end of line");
+    assert_parse_error("ambient 0 -1 0", "s.txt:1:11: ", "the green component of the ambient colour must be >= 0, "
+                       "found -1$");
+    assert_parse_error("ambient 1 1 1 1", "s.txt:1:15: ", "unexpected '1' after the ambient colour (expected end of line)");
+    assert_parse_error("ambient 1 1 1 intensity 2", "s.txt:1:15: ", "unexpected 'intensity' after the ambient colour");
+    assert_parse_error("ambient nan 0 0", "s.txt:1:9: ", "NaN and infinity are not allowed");
+    assert_parse_error("ambient 1e39 0 0", "s.txt:1:9: ", "too large for the renderer's 32-bit floats");
+    assert_parse_error("ambient @tex 0 0", "s.txt:1:9: ", "expected a number for the red component of the ambient");
+    /* A transform may not follow it in a block: it counts as content. */
+    assert_parse_error("group {\n  ambient 0 0 0\n  translate 1 0 0\n}\n", "s.txt:3:3: ", "transforms come first");
+}
+
+static void test_material_phong_and_specular(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("texture t noise 2\n"
+             "material a lambertian 0.5 0.5 0.5 phong 64 specular 0.1 0.2 0.3\n"
+             "material b metal 0.9 0.8 0.7 specular 1 1 1 fuzz 0.1 phong 8 normal_map \"n.png\"\n"
+             "material c lambertian 0.5 0.5 0.5\n"
+             "material d metal 1 1 1 phong (2^4)\n"
+             "material e lambertian @t specular 0 0 0\n"
+             "material f metal @t normal_map \"n.png\" specular 0.5 0.5 0.5\n"
+             "material g lambertian 1 1 1 phong 1e-3\n"
+             "material h dielectric 1.5\n"
+             "material i emissive 1 1 1\n", NULL, &s);
+    assert_int_equal(s.material_count, 9);
+    const scene_material *m = s.materials;
+    assert_double_equal(m[0].phong_exponent, 64, 0);
+    assert_vector_equal(m[0].specular, 0.1, 0.2, 0.3);
+    assert_true(m[0].specular_set);
+    assert_int_equal(m[1].type, MATERIAL_METAL);
+    assert_double_equal(m[1].phong_exponent, 8, 0);
+    assert_vector_equal(m[1].specular, 1, 1, 1);
+    assert_true(m[1].specular_set);
+    assert_double_equal(m[1].fuzz, 0.1, 1e-7);
+    assert_int_equal(m[1].normal_map, 0);
+    /* Left out: phong 0 (the renderer's default 32) and no specular (its per-type default). */
+    assert_double_equal(m[2].phong_exponent, 0, 0);
+    assert_false(m[2].specular_set);
+    assert_vector_equal(m[2].specular, 0, 0, 0);
+    assert_double_equal(m[3].phong_exponent, 16, 0);
+    assert_false(m[3].specular_set);
+    assert_int_equal(m[4].albedo_texture, 0);
+    assert_true(m[4].specular_set);                            /* explicitly black */
+    assert_vector_equal(m[4].specular, 0, 0, 0);
+    assert_int_equal(m[5].normal_map, 0);
+    assert_vector_equal(m[5].specular, 0.5, 0.5, 0.5);
+    assert_double_equal(m[6].phong_exponent, 1e-3, 1e-10);
+    for (int i = 7; i < 9; i++) {
+        assert_double_equal(m[i].phong_exponent, 0, 0);
+        assert_false(m[i].specular_set);
+    }
+    scene_free(&s);
+
+    assert_parse_error("material m lambertian 1 1 1 phong 0", "s.txt:1:35: ",
+                       "the phong exponent of material 'm' must be > 0, found 0$");
+    assert_parse_error("material m metal 1 1 1 phong -1", "s.txt:1:30: ", "must be > 0, found -1$");
+    assert_parse_error("material m lambertian 1 1 1 phong 1e-50", "s.txt:1:35: ",
+                       "the phong exponent of material 'm' 1e-50 is too small for the renderer's 32-bit floats");
+    assert_parse_error("material m lambertian 1 1 1 phong 1e39", "s.txt:1:35: ", "too large");
+    assert_parse_error("material m lambertian 1 1 1 phong", "s.txt:1:34: ",
+                       "expected a number for the phong exponent of material 'm', found end of line");
+    assert_parse_error("material m lambertian 1 1 1 phong shiny", "s.txt:1:35: ", "found 'shiny'");
+    assert_parse_error("material m metal 1 1 1 specular 0.5 1.5 0", "s.txt:1:37: ",
+                       "the green component of the specular colour of material 'm' must be between 0 and 1, found 1.5$");
+    assert_parse_error("material m lambertian 1 1 1 specular -0.1 0 0", "s.txt:1:38: ",
+                       "the red component of the specular colour of material 'm' must be between 0 and 1");
+    assert_parse_error("material m metal 1 1 1 specular 0.5 0.5", "s.txt:1:40: ",
+                       "expected a number for the blue component of the specular colour of material 'm', found end "
+                       "of line");
+    assert_parse_error("material m metal 1 1 1 specular @t", "s.txt:1:33: ", "expected a number for the red component");
+    assert_parse_error("material m lambertian 1 1 1 phong 2 phong 3", "s.txt:1:37: ",
+                       "lambertian material clause 'phong' given twice in one statement (first at column 29)");
+    assert_parse_error("material m metal 1 1 1 specular 1 1 1 specular 0 0 0", "s.txt:1:39: ",
+                       "metal material clause 'specular' given twice");
+    /* Dielectric and emissive materials take neither. */
+    assert_parse_error("material g dielectric 1.5 phong 8", "s.txt:1:27: ",
+                       "unknown dielectric material clause 'phong' (expected normal_map)");
+    assert_parse_error("material l emissive 1 1 1 specular 1 1 1", "s.txt:1:27: ",
+                       "unknown emissive material clause 'specular' (expected strength)");
+}
+
+/* The example in docs/scene-format.md's light section, exactly. */
+static void test_documented_light_example(void **state)
+{
+    (void)state;
+    const char *text =
+        "set t 0                                  # sweep with -D t=...\n"
+        "ambient 0.02 0.02 0.03\n"
+        "light sun 1 -2 -1 color 1 0.95 0.9 intensity 3 angle 0.53\n"
+        "light point (4*cos($t)) 5 (4*sin($t)) color 1 0.8 0.6 intensity 60\n"
+        "light spot 0 4 0 at 0 0 0 intensity 40 cone 20 30 falloff polynomial 1 0.09 0.032\n"
+        "material red lambertian 0.8 0.2 0.1 phong 64 specular 0.2 0.2 0.2\n"
+        "material gold metal 0.9 0.7 0.3 fuzz 0.1 phong 200\n"
+        "sphere 0 0.5 0 0.5 red\n";
+    scene s;
+    parse_ok(text, NULL, &s);
+    assert_int_equal(s.light_count, 3);
+    assert_vector_equal(s.ambient, 0.02, 0.02, 0.03);
+    assert_vector_equal(s.lights[0].direction, 1 / sqrt(6), -2 / sqrt(6), -1 / sqrt(6));
+    assert_vector_equal(s.lights[0].color, 3, 2.85, 2.7);
+    assert_vector_equal(s.lights[1].position, 4, 5, 0);
+    assert_vector_equal(s.lights[1].color, 60, 48, 36);
+    assert_int_equal(s.lights[2].falloff, FALLOFF_POLYNOMIAL);
+    assert_vector_equal(s.lights[2].direction, 0, -1, 0);
+    assert_double_equal(s.materials[0].phong_exponent, 64, 0);
+    assert_true(s.materials[0].specular_set);
+    assert_false(s.materials[1].specular_set);
+    scene_free(&s);
+
+    /* "-D t=pi/2 moves the point light a quarter turn, from (4, 5, 0) to (0, 5, 4)." */
+    const scene_define defines[] = {{.name = "t", .value = "pi/2"}};
+    scene_parse_options options = options_with_defines(defines, 1);
+    parse_ok(text, &options, &s);
+    assert_vector_equal(s.lights[1].position, 0, 5, 4);
+    scene_free(&s);
+}
+
 /* ------------------------------------------------------------------ the documented scene-model example */
 
 static void test_documented_scene_model_example(void **state)
@@ -2149,6 +2565,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_include_from_string_and_absolute_path, create_directory, remove_directory),
         cmocka_unit_test_setup_teardown(test_include_camera_position, create_directory, remove_directory),
         cmocka_unit_test_setup_teardown(test_missing_include, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_oversized_files, create_directory, remove_directory),
         cmocka_unit_test_setup_teardown(test_include_cycles, create_directory, remove_directory),
         cmocka_unit_test_setup_teardown(test_include_depth_limit, create_directory, remove_directory),
         cmocka_unit_test_setup_teardown(test_define_applies_across_includes, create_directory, remove_directory),
@@ -2174,6 +2591,15 @@ int main(void)
         cmocka_unit_test(test_nesting_limit),
         cmocka_unit_test_setup_teardown(test_include_inside_a_block, create_directory, remove_directory),
         cmocka_unit_test(test_documented_scene_model_example),
+        cmocka_unit_test(test_lights_defaults),
+        cmocka_unit_test(test_light_clauses),
+        cmocka_unit_test(test_light_expressions_and_sweep),
+        cmocka_unit_test(test_light_errors),
+        cmocka_unit_test(test_lights_only_at_the_top_level),
+        cmocka_unit_test_setup_teardown(test_light_in_an_included_file, create_directory, remove_directory),
+        cmocka_unit_test(test_ambient),
+        cmocka_unit_test(test_material_phong_and_specular),
+        cmocka_unit_test(test_documented_light_example),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
