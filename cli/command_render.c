@@ -59,6 +59,11 @@ static void print_help(FILE *stream)
             "      --resume PARTIAL   continue a partial render (a checkpoint, or what Ctrl-C\n"
             "                         wrote); the result equals an uninterrupted render\n"
             "      --exposure STOPS   brighten 8-bit outputs by 2^STOPS (default 0)\n"
+            "      --integrator path|whitted  path tracing (default), or Whitted recursive ray\n"
+            "                         tracing with Phong shading, shadow rays to every light and\n"
+            "                         soft shadows from area lights: fast, nearly noise-free\n"
+            "      --aovs             add layers to the EXR: albedo, normal, depth (first hit) and\n"
+            "                         per-pixel variance of luminance, next to R, G, B, samples\n"
             "      --light-sampling on|off  sample lights at diffuse hits (next-event\n"
             "                         estimation with MIS; default on): less noise, same image\n"
             "      --roulette-depth N paths may end at random (Russian roulette, unbiased)\n"
@@ -103,6 +108,8 @@ typedef struct render_request {
     const char *shard_by;
     double checkpoint_seconds;   /* 0: no checkpoints */
     bool no_light_sampling;
+    render_integrator integrator;
+    bool aovs;
     const char *resume_path;     /* NULL: start afresh */
 } render_request;
 
@@ -219,7 +226,7 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
     enum {
         OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
         OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
-        OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING,
+        OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
     };
     static const struct option long_options[] = {
         {"output", required_argument, NULL, 'o'},
@@ -241,6 +248,8 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         {"checkpoint", required_argument, NULL, OPTION_CHECKPOINT},
         {"resume", required_argument, NULL, OPTION_RESUME},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
+        {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
+        {"aovs", no_argument, NULL, OPTION_AOVS},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -314,6 +323,17 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         }
         case OPTION_RESUME:
             request->resume_path = optarg;
+            break;
+        case OPTION_AOVS:
+            request->aovs = true;
+            break;
+        case OPTION_INTEGRATOR:
+            if (strcmp(optarg, "path") == 0)
+                request->integrator = INTEGRATOR_PATH;
+            else if (strcmp(optarg, "whitted") == 0)
+                request->integrator = INTEGRATOR_WHITTED;
+            else
+                complaint = "--integrator wants path or whitted";
             break;
         case OPTION_LIGHT_SAMPLING:
             if (strcmp(optarg, "on") != 0 && strcmp(optarg, "off") != 0)
@@ -447,6 +467,10 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         fprintf(stderr, "rtspheres render: %s\n", error.message);
         return EXIT_BAD_INPUT;
     }
+    if (request->aovs && strcasecmp(extension_of(output), ".exr") != 0) {
+        fprintf(stderr, "rtspheres render: --aovs writes extra layers, which only .exr keeps; not '%s'\n", output);
+        return EXIT_BAD_INPUT;
+    }
     if (request->resume_path != NULL && request->frames.count > 1) {
         fprintf(stderr, "rtspheres render: --resume continues one image; render the frames one at a time\n");
         return EXIT_BAD_INPUT;
@@ -497,7 +521,13 @@ static rt_status write_render(const render_job *job, const rt_image *image, cons
     const scene *s = job->scene;
     rt_image colour = *image;
     rt_image rgb = {0};
-    if (!keeps_sample_counts(path)) {
+    if (keeps_sample_counts(path) && result->aovs.pixels != NULL) {
+        /* EXR with AOVs: the colour and sample count, then the AOV layers. */
+        rt_status status = image_append_channels(image, &result->aovs, &rgb, error);
+        if (status != RT_OK)
+            return status;
+        colour = rgb;
+    } else if (!keeps_sample_counts(path)) {
         rt_status status = image_create(&rgb, image->width, image->height, 3, error);
         if (status != RT_OK)
             return status;
@@ -670,6 +700,8 @@ static int render_frame(gpu_context *context, const render_request *request, int
     options.pass_work_budget = (uint32_t)request->pass_budget;
     options.russian_roulette_depth = (uint32_t)request->roulette_depth;
     options.no_light_sampling = request->no_light_sampling;
+    options.integrator = request->integrator;
+    options.aovs = request->aovs;
 
     int region[4] = {0, 0, s.render.width, s.render.height};
     if (options.region[2] > 0)

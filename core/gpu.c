@@ -39,6 +39,7 @@ struct gpu_tracer {
     GLuint framebuffers[2];
     GLuint counter_buffer;
     int current;                 /* which state set holds the latest pass */
+    gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
 };
 
 gpu_options gpu_options_defaults(void)
@@ -362,22 +363,29 @@ static GLuint link_program(GLuint vertex, GLuint fragment, rt_error *error)
     return program;
 }
 
-/* Builds the tracer program: "#version 450 core" + packed_layout.h + random.glsl + tracer.frag. */
-static rt_status build_program(gpu_tracer *tracer, rt_error *error)
+/* Builds a tracer program: "#version 450 core" + defines + packed_layout.h + random.glsl +
+ * tracer.frag. defines selects the variant ("" the path tracer, the AOV pass otherwise).
+ * Returns the program or 0 with error set. */
+static GLuint build_tracer_program(const char *defines, rt_error *error)
 {
     const char *version = "#version 450 core\n";
     const char *vertex_parts[] = {version, shader_source_fullscreen_vertex};
-    const char *fragment_parts[] = {version, shader_source_packed_layout, shader_source_random, "#line 1 1\n",
-                                    shader_source_tracer_fragment};
+    const char *fragment_parts[] = {version, defines, shader_source_packed_layout, shader_source_random,
+                                    "#line 1 1\n", shader_source_tracer_fragment};
     GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
     if (vertex == 0)
-        return RT_ERROR_RUNTIME;
-    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 5, error);
+        return 0;
+    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 6, error);
     if (fragment == 0) {
         glDeleteShader(vertex);
-        return RT_ERROR_RUNTIME;
+        return 0;
     }
-    tracer->program = link_program(vertex, fragment, error);
+    return link_program(vertex, fragment, error);
+}
+
+static rt_status build_program(gpu_tracer *tracer, rt_error *error)
+{
+    tracer->program = build_tracer_program("", error);
     return tracer->program ? RT_OK : RT_ERROR_RUNTIME;
 }
 
@@ -499,9 +507,8 @@ static void set_vec3(GLuint program, const char *name, const float value[3])
 }
 
 /* Sets every uniform of the tracer from the parameters. */
-static void set_parameters(gpu_tracer *tracer, const gpu_tracer_parameters *p)
+static void set_parameters(gpu_tracer *tracer, GLuint program, const gpu_tracer_parameters *p)
 {
-    GLuint program = tracer->program;
     glUseProgram(program);
     glUniform2i(glGetUniformLocation(program, "image_size"), p->width, p->height);
     glUniform2i(glGetUniformLocation(program, "region_origin"), p->region_x, p->region_y);
@@ -531,6 +538,8 @@ static void set_parameters(gpu_tracer *tracer, const gpu_tracer_parameters *p)
     glUniform1ui(glGetUniformLocation(program, "russian_roulette_depth"), p->russian_roulette_depth);
     glUniform1i(glGetUniformLocation(program, "pass_work_budget"), (GLint)p->pass_work_budget);
     glUniform1i(glGetUniformLocation(program, "light_sampling"), p->light_sampling ? 1 : 0);
+    glUniform1i(glGetUniformLocation(program, "integrator"), p->integrator);
+    glUniform3f(glGetUniformLocation(program, "ambient"), p->ambient[0], p->ambient[1], p->ambient[2]);
     glUniform1i(glGetUniformLocation(program, "packed_width_log2"), tracer->packed_width_log2);
     glUniform1i(glGetUniformLocation(program, "packed_scene"), STATE_TARGET_COUNT);
     for (int target = 0; target < STATE_TARGET_COUNT; target++)
@@ -563,7 +572,9 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
     glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), NULL, GL_DYNAMIC_READ);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, tracer->counter_buffer);
-    set_parameters(tracer, parameters);
+    set_parameters(tracer, tracer->program, parameters);
+    tracer->parameters = *parameters;
+    tracer->parameters.resume = NULL;
     status = check_gl("setting up the tracer", error);
     if (status != RT_OK) {
         gpu_tracer_destroy(tracer);
@@ -621,25 +632,82 @@ static void read_state(gpu_tracer *tracer, int state, float *rgba)
     free(bottom_up);
 }
 
-rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, gpu_tracer_totals *totals, rt_error *error)
+rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
+                          rt_error *error)
 {
     glActiveTexture(GL_TEXTURE0);
     read_state(tracer, STATE_ACCUMULATED, rgba);
-    if (totals != NULL) {
+    if (totals != NULL || luminance_squares != NULL) {
         size_t count = (size_t)tracer->width * tracer->height;
         float *statistics = malloc(count * 4 * sizeof(float));
         if (statistics == NULL)
             return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading statistics");
         read_state(tracer, STATE_STATISTICS, statistics);
-        totals->path_segments = 0;
-        totals->traversal_overflows = 0;
+        gpu_tracer_totals sums = {0};
         for (size_t i = 0; i < count; i++) {
-            totals->path_segments += statistics[i * 4 + 0];
-            totals->traversal_overflows += statistics[i * 4 + 1];
+            sums.path_segments += statistics[i * 4 + 0];
+            sums.traversal_overflows += statistics[i * 4 + 1];
+            if (luminance_squares != NULL)
+                luminance_squares[i] = statistics[i * 4 + 2];
         }
+        if (totals != NULL)
+            *totals = sums;
         free(statistics);
     }
     return check_gl("reading the result", error);
+}
+
+rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_depth, float *normal_coverage,
+                                 rt_error *error)
+{
+    GLuint program = build_tracer_program("#define RTSPHERES_AOV_PASS 1\n", error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    int width = tracer->width, height = tracer->height;
+    GLuint textures[2], framebuffer;
+    glGenTextures(2, textures);
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    for (int k = 0; k < 2; k++) {
+        glBindTexture(GL_TEXTURE_2D, textures[k]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, GL_TEXTURE_2D, textures[k], 0);
+    }
+    const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, draw_buffers);
+    rt_status status = RT_OK;
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the AOV framebuffer is incomplete");
+    if (status == RT_OK) {
+        set_parameters(tracer, program, &tracer->parameters);
+        glUniform1i(glGetUniformLocation(program, "aov_samples"), samples);
+        glViewport(0, 0, width, height);
+        glActiveTexture(GL_TEXTURE0 + STATE_TARGET_COUNT);
+        glBindTexture(GL_TEXTURE_2D, tracer->packed_texture);
+        glBindVertexArray(tracer->vertex_array);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        float *outputs[2] = {albedo_depth, normal_coverage};
+        size_t row_floats = (size_t)width * 4;
+        float *bottom_up = malloc(row_floats * (size_t)height * sizeof(float));
+        if (bottom_up == NULL)
+            status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the AOVs");
+        for (int k = 0; k < 2 && status == RT_OK; k++) {
+            glReadBuffer(GL_COLOR_ATTACHMENT0 + k);
+            glPixelStorei(GL_PACK_ALIGNMENT, 4);
+            glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, bottom_up);
+            for (int row = 0; row < height; row++)
+                memcpy(outputs[k] + (size_t)row * row_floats, bottom_up + (size_t)(height - 1 - row) * row_floats,
+                       row_floats * sizeof(float));
+        }
+        free(bottom_up);
+    }
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(2, textures);
+    glDeleteProgram(program);
+    glUseProgram(tracer->program);
+    if (status != RT_OK)
+        return status;
+    return check_gl("the AOV pass", error);
 }
 
 void gpu_tracer_destroy(gpu_tracer *tracer)

@@ -87,6 +87,8 @@ typedef struct gpu_tracer_parameters {
     uint32_t russian_roulette_depth;      /* first bounce at which paths may end at random */
     uint32_t pass_work_budget;            /* work units a pixel may start in one pass */
     bool light_sampling;                  /* next-event estimation with MIS at diffuse hits */
+    int integrator;                       /* 0: path tracing; 1: Whitted with Phong shading */
+    float ambient[3];                     /* Whitted's ambient light */
     const float *resume;                  /* NULL, or width*height*4 floats, rows top to bottom:
                                            * (sum r, g, b, finished samples) to continue from;
                                            * a pixel with n finished samples goes on with
@@ -124,9 +126,19 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
 
 /* Reads the accumulated result: rgba receives width*height*4 floats, rows top to bottom,
- * (sum of finished samples' radiance r, g, b, number of finished samples).
- * totals may be NULL. */
-rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, gpu_tracer_totals *totals, rt_error *error);
+ * (sum of finished samples' radiance r, g, b, number of finished samples);
+ * luminance_squares (may be NULL) width*height floats: the sum of each finished sample's
+ * squared luminance (for the variance). totals may be NULL. */
+rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
+                          rt_error *error);
+
+/* Renders the first-hit AOVs with samples jittered camera rays per pixel (the same camera
+ * rays as the render's first samples): albedo_depth receives width*height*4 floats (albedo
+ * r, g, b; distance to the first hit, 0 where nothing was hit), normal_coverage
+ * width*height*4 (world shading normal facing the camera, the share of rays that hit),
+ * rows top to bottom. */
+rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_depth, float *normal_coverage,
+                                 rt_error *error);
 
 /* Frees the tracer's GL objects. NULL is ignored. */
 void gpu_tracer_destroy(gpu_tracer *tracer);

@@ -587,6 +587,36 @@ rt_status image_create(rt_image *image, int width, int height, int channels, rt_
     return RT_OK;
 }
 
+rt_status image_append_channels(const rt_image *a, const rt_image *b, rt_image *out, rt_error *error)
+{
+    memset(out, 0, sizeof *out);
+    if (a->width != b->width || a->height != b->height)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: cannot join a %dx%d and a %dx%d image", a->width,
+                            a->height, b->width, b->height);
+    rt_status status = image_create(out, a->width, a->height, a->channels + b->channels, error);
+    if (status != RT_OK)
+        return status;
+    static const char *const default_names[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < out->channels; c++) {
+        const rt_image *from = c < a->channels ? a : b;
+        int channel = c < a->channels ? c : c - a->channels;
+        const char *name = from->channel_names[channel][0] ? from->channel_names[channel]
+                           : channel < 4 ? default_names[channel] : "";
+        snprintf(out->channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", name);
+    }
+    size_t pixels = (size_t)a->width * (size_t)a->height;
+    for (size_t i = 0; i < pixels; i++) {
+        memcpy(out->pixels + i * out->channels, a->pixels + i * a->channels, (size_t)a->channels * sizeof(float));
+        memcpy(out->pixels + i * out->channels + a->channels, b->pixels + i * b->channels,
+               (size_t)b->channels * sizeof(float));
+    }
+    out->x = a->x;
+    out->y = a->y;
+    out->full_width = a->full_width;
+    out->full_height = a->full_height;
+    return RT_OK;
+}
+
 void image_free(rt_image *image)
 {
     if (image == nullptr)

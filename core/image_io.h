@@ -70,6 +70,11 @@ image_write_options image_write_options_defaults(void);
  * names. Returns RT_ERROR_RUNTIME when memory runs out. Free with image_free(). */
 rt_status image_create(rt_image *image, int width, int height, int channels, rt_error *error);
 
+/* Makes *out (allocated; free with image_free()) holding a's channels then b's, with their
+ * names, and a's place (x, y, full size). Different sizes: RT_ERROR_INPUT; more than
+ * IMAGE_MAX_CHANNELS together: RT_ERROR_INPUT. */
+rt_status image_append_channels(const rt_image *a, const rt_image *b, rt_image *out, rt_error *error);
+
 /* Frees image->pixels and zeroes *image. */
 void image_free(rt_image *image);
 

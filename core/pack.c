@@ -453,6 +453,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             && s->materials[material].type == MATERIAL_EMISSIVE)
             light_count++;
     }
+    light_count += (uint32_t)s->light_count;
     uint64_t light_offset = image_offset + (uint64_t)s->image_count * PACKED_IMAGE_STRIDE;
     uint64_t pixel_offset = light_offset + (uint64_t)light_count * PACKED_LIGHT_STRIDE;
     uint64_t texel_count = pixel_offset + image_pixels;
@@ -494,6 +495,15 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
                   m.albedo_texture >= 0 ? (uint32_t)m.albedo_texture : PACKED_NONE,
                   m.emission_texture >= 0 ? (uint32_t)m.emission_texture : PACKED_NONE,
                   m.normal_map >= 0 ? (uint32_t)m.normal_map : PACKED_NONE);
+        /* Phong terms of the Whitted integrator: a dim white highlight on diffuse
+         * surfaces and the metal's own colour on metals, unless the scene says. */
+        float specular[3] = {0.04f, 0.04f, 0.04f};
+        if (m.specular_set)
+            memcpy(specular, m.specular, sizeof specular);
+        else if (m.type == MATERIAL_METAL)
+            memcpy(specular, m.albedo, sizeof specular);
+        put_texel(texels, base + 3, float_bits(m.phong_exponent > 0 ? m.phong_exponent : 32.0f),
+                  float_bits(specular[0]), float_bits(specular[1]), float_bits(specular[2]));
     }
 
     /* Primitives, attributes and nodes of every BVH. */
@@ -570,11 +580,52 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             texels[4 * (primitive_offset + (uint64_t)slot * PACKED_PRIMITIVE_STRIDE) + 3] = light;
             light++;
         }
+        /* Point, spot and sun lights after the area lights. A sun's power is its
+         * irradiance over the scene's cross-section (the top-level box). */
+        double scene_radius = 1;
+        if (p.top.primitives.count > 0) {
+            const bvh_box *box = &p.top.tree.nodes[0].box;
+            double extent[3] = {box->max[0] - box->min[0], box->max[1] - box->min[1], box->max[2] - box->min[2]};
+            scene_radius = 0.5 * sqrt(extent[0] * extent[0] + extent[1] * extent[1] + extent[2] * extent[2]);
+            if (!(scene_radius > 0) || !isfinite(scene_radius))
+                scene_radius = 1;
+        }
+        for (int k = 0; k < s->light_count; k++, light++) {
+            const scene_light *source = &s->lights[k];
+            const float *c = source->color;
+            double luminance = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            uint32_t type = source->type == SCENE_LIGHT_POINT ? LIGHT_POINT
+                            : source->type == SCENE_LIGHT_SPOT ? LIGHT_SPOT : LIGHT_SUN;
+            double cos_outer = cos(source->spot_outer_degrees * M_PI / 180);
+            double cos_inner = cos(source->spot_inner_degrees * M_PI / 180);
+            double cos_sun = cos(0.5 * source->sun_angle_degrees * M_PI / 180);
+            if (type == LIGHT_POINT)
+                power[light] = 4 * M_PI * luminance;
+            else if (type == LIGHT_SPOT)
+                power[light] = 2 * M_PI * (1 - 0.5 * (cos_outer + cos_inner)) * luminance;
+            else
+                power[light] = M_PI * scene_radius * scene_radius * luminance;
+            total += power[light];
+            bool polynomial = source->falloff == FALLOFF_POLYNOMIAL;
+            uint64_t base = light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
+            put_texel(texels, base, type, polynomial ? float_bits(source->attenuation[0]) : 0,
+                      polynomial ? float_bits(source->attenuation[1]) : 0,
+                      polynomial ? float_bits(source->attenuation[2]) : 0);
+            /* The sun is stored as the direction towards it. */
+            float where[3];
+            for (int i = 0; i < 3; i++)
+                where[i] = type == LIGHT_SUN ? -source->direction[i] : source->position[i];
+            put_texel(texels, base + 1, float_bits(where[0]), float_bits(where[1]), float_bits(where[2]), 0);
+            put_texel(texels, base + 2, float_bits(c[0]), float_bits(c[1]), float_bits(c[2]),
+                      float_bits((float)(type == LIGHT_SUN ? cos_sun : cos_outer)));
+            put_texel(texels, base + 3, float_bits(source->direction[0]), float_bits(source->direction[1]),
+                      float_bits(source->direction[2]), float_bits((float)cos_inner));
+        }
         double cumulative = 0;
         for (uint32_t l = 0; l < light_count; l++) {
             cumulative += total > 0 ? power[l] / total : 1.0 / light_count;
             uint64_t base = light_offset + (uint64_t)l * PACKED_LIGHT_STRIDE;
-            put_texel(texels, base + 1, 0, 0, 0, float_bits(l + 1 == light_count ? 1.0f : (float)cumulative));
+            texels[4 * (base + 1) + 3] = float_bits(l + 1 == light_count ? 1.0f : (float)cumulative);
         }
         free(power);
     }

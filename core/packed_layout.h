@@ -64,7 +64,7 @@
  *   texel 1 = (emission.r, emission.g, emission.b, fuzz)        emission is colour x strength
  *   texel 2 = (index of refraction, albedo texture, emission texture, normal map image)
  *             (texture and image indices, or PACKED_NONE)
- *   texel 3 = reserved (Phong exponent: issue "variable light") */
+ *   texel 3 = (Phong exponent, Phong specular colour.rgb)      Whitted integrator only */
 #define PACKED_MATERIAL_STRIDE 4
 #define MATERIAL_LAMBERTIAN 0
 #define MATERIAL_METAL 1
@@ -127,11 +127,14 @@
 #define PACKED_IMAGE_STRIDE 1
 
 /* ---- lights: 4 texels (what next-event estimation samples, chosen by power)
- *   texel 0 = (type tag, primitive slot (area lights), 0, 0)
+ *   texel 0 = (type tag, primitive slot (area lights), 0, 0) -- see below for the others
  *   texel 1 = (position.xyz (point, spot) or direction towards the light (sun), cdf)
  *             cdf: the probability of choosing this light or any before it
  *   texel 2 = (intensity colour.rgb (point, spot: per steradian; sun: irradiance), 0)
- *   texel 3 = reserved (spot cone, falloff: issue "variable light")
+ *   texel 3 = (spot direction.xyz, cos of the spot's inner half-angle)
+ *   point, spot, sun: texel 0 .yzw = polynomial attenuation c, l, q (all 0: inverse square),
+ *   texel 1 .xyz = position (point, spot) or the direction towards the sun, texel 2 .w = cos
+ *   of the spot's outer half-angle or of the sun's angular radius.
  * Area lights are emissive world primitives (spheres, quads, triangles): their radiance is
  * their material's emission. */
 #define PACKED_LIGHT_STRIDE 4

@@ -75,16 +75,18 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
                                                                 : DEFAULT_RUSSIAN_ROULETTE_DEPTH;
     p->pass_work_budget = options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET;
     p->light_sampling = !options->no_light_sampling;
+    p->integrator = options->integrator;
+    memcpy(p->ambient, s->ambient, sizeof p->ambient);
 }
 
 /* Reads the tracer's accumulation into a new width x height image of means (R, G, B) and
  * per-pixel finished samples; *samples receives their total. The caller frees image. */
-static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, gpu_tracer_totals *totals,
-                            uint64_t *samples, rt_error *error)
+static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, float *luminance_squares,
+                            gpu_tracer_totals *totals, uint64_t *samples, rt_error *error)
 {
     rt_status status = image_create(image, width, height, 4, error);
     if (status == RT_OK)
-        status = gpu_tracer_read(tracer, image->pixels, totals, error);
+        status = gpu_tracer_read(tracer, image->pixels, luminance_squares, totals, error);
     if (status != RT_OK) {
         image_free(image);
         return status;
@@ -101,6 +103,45 @@ static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image 
     }
     snprintf(image->channel_names[3], IMAGE_CHANNEL_NAME_MAX, "samples");
     return RT_OK;
+}
+
+#define AOV_SAMPLES 8
+
+/* Builds the AOV image: albedo, normal and depth of the first hit (averaged over
+ * AOV_SAMPLES camera rays) and each pixel's sample variance of luminance
+ * (E[L^2] - E[L]^2 over its finished samples). The caller frees aovs. */
+static rt_status render_aovs(gpu_tracer *tracer, int width, int height, const rt_image *colour,
+                             const float *luminance_squares, rt_image *aovs, rt_error *error)
+{
+    size_t pixel_count = (size_t)width * height;
+    float *albedo_depth = malloc(pixel_count * 4 * sizeof(float));
+    float *normal = malloc(pixel_count * 4 * sizeof(float));
+    rt_status status = albedo_depth && normal ? RT_OK : rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
+    if (status == RT_OK)
+        status = gpu_tracer_render_aovs(tracer, AOV_SAMPLES, albedo_depth, normal, error);
+    if (status == RT_OK)
+        status = image_create(aovs, width, height, 8, error);
+    if (status == RT_OK) {
+        static const char *const names[8] = {"albedo.R", "albedo.G", "albedo.B", "normal.X",
+                                             "normal.Y", "normal.Z", "depth.Z", "variance.Y"};
+        for (int c = 0; c < 8; c++)
+            snprintf(aovs->channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", names[c]);
+        for (size_t i = 0; i < pixel_count; i++) {
+            float *out = aovs->pixels + 8 * i;
+            for (int c = 0; c < 3; c++) {
+                out[c] = albedo_depth[4 * i + c];
+                out[3 + c] = normal[4 * i + c];
+            }
+            out[6] = albedo_depth[4 * i + 3];
+            const float *pixel = colour->pixels + 4 * i;
+            float count = pixel[3];
+            float mean = 0.2126f * pixel[0] + 0.7152f * pixel[1] + 0.0722f * pixel[2];
+            out[7] = count > 0 ? fmaxf(0.0f, luminance_squares[i] / count - mean * mean) : 0.0f;
+        }
+    }
+    free(albedo_depth);
+    free(normal);
+    return status;
 }
 
 /* Turns a partial result (R, G, B means and a samples channel, region-sized) back into the
@@ -189,7 +230,9 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     hash = hash_bytes(hash, &s->sky.rotation_degrees, sizeof s->sky.rotation_degrees);
     hash = hash_bytes(hash, &s->camera.shutter_open, sizeof s->camera.shutter_open);
     hash = hash_bytes(hash, &s->camera.shutter_close, sizeof s->camera.shutter_close);
-    int shape[4] = {s->render.width, s->render.height, s->render.max_depth, options->no_light_sampling};
+    hash = hash_bytes(hash, s->ambient, sizeof s->ambient);
+    int shape[5] = {s->render.width, s->render.height, s->render.max_depth, options->no_light_sampling,
+                    (int)options->integrator};
     hash = hash_bytes(hash, shape, sizeof shape);
     result->scene_hash = hash;
     if (options->resume != NULL && options->resume_scene_hash != 0 && options->resume_scene_hash != hash) {
@@ -265,7 +308,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
             && seconds_now() - last_checkpoint >= options->checkpoint_seconds) {
             rt_image partial;
             uint64_t partial_samples;
-            status = read_image(tracer, width, height, &partial, NULL, &partial_samples, error);
+            status = read_image(tracer, width, height, &partial, NULL, NULL, &partial_samples, error);
             if (status != RT_OK)
                 break;
             status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, result->scene_hash,
@@ -278,11 +321,23 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     }
 
     gpu_tracer_totals totals = {0};
+    float *luminance_squares = NULL;
+    if (status == RT_OK && options->aovs) {
+        luminance_squares = malloc((size_t)width * height * sizeof *luminance_squares);
+        if (luminance_squares == NULL)
+            status = rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
+    }
     if (status == RT_OK)
-        status = read_image(tracer, width, height, &result->image, &totals, &result->samples, error);
+        status = read_image(tracer, width, height, &result->image, luminance_squares, &totals, &result->samples, error);
+    if (status == RT_OK && options->aovs)
+        status = render_aovs(tracer, width, height, &result->image, luminance_squares, &result->aovs, error);
+    free(luminance_squares);
     gpu_tracer_destroy(tracer);
-    if (status != RT_OK)
+    if (status != RT_OK) {
+        image_free(&result->image);
+        image_free(&result->aovs);
         return status;
+    }
     if (totals.traversal_overflows > 0) {
         image_free(&result->image);
         return rt_error_set(error, RT_ERROR_RUNTIME,

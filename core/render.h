@@ -35,6 +35,11 @@
 #include "scene.h"
 #include "status.h"
 
+typedef enum render_integrator {
+    INTEGRATOR_PATH = 0,         /* unbiased path tracing with light sampling (default) */
+    INTEGRATOR_WHITTED = 1,      /* Whitted recursive ray tracing with Phong shading */
+} render_integrator;
+
 typedef struct render_progress {
     uint64_t samples_done;
     uint64_t samples_total;
@@ -46,6 +51,8 @@ typedef struct render_options {
     uint32_t pass_work_budget;
     double target_pass_seconds;
     bool no_light_sampling;      /* true: BSDF sampling only (to compare the estimators) */
+    render_integrator integrator;
+    bool aovs;                   /* also render the AOV image (see render_result.aovs) */
     uint32_t russian_roulette_depth;
     uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */
     int region[4];               /* x0, y0, x1, y1 (row 0 at the top, x1/y1 exclusive) of the
@@ -71,6 +78,9 @@ typedef struct render_options {
 typedef struct render_result {
     rt_image image;              /* R, G, B, samples; free with image_free() */
     int region[4];               /* the region image covers (x0, y0, x1, y1) */
+    rt_image aovs;               /* with options.aovs: albedo.R/G/B, normal.X/Y/Z (world,
+                                  * first hit), depth.Z (0: no hit), variance.Y (per-pixel
+                                  * sample variance of luminance); free with image_free() */
     uint64_t samples;            /* samples finished over all pixels */
     double seconds;              /* whole render, including set-up */
     double first_pass_seconds;   /* from the start until the first pass finished */

@@ -15,6 +15,7 @@ void scene_defaults(scene *s)
     s->render = (scene_render_settings){
         .width = 640, .height = 360, .samples_per_pixel = 64, .max_depth = 16, .seed = 1,
     };
+    s->ambient[0] = s->ambient[1] = s->ambient[2] = 0.03f;
     s->sky = (scene_sky){
         .type = SKY_GRADIENT, .bottom = {1, 1, 1}, .top = {0.5f, 0.7f, 1.0f},
         .faces = {-1, -1, -1, -1, -1, -1}, .environment = -1, .intensity = 1, .rotation_degrees = 0,
@@ -37,6 +38,7 @@ void scene_free(scene *s)
     }
     free(s->meshes);
     free(s->textures);
+    free(s->lights);
     for (int i = 0; i < s->image_count; i++)
         free(s->images[i].pixels);
     free(s->images);
@@ -120,6 +122,29 @@ int scene_add_image(scene *s, const scene_image *image)
         return -1;
     s->images[s->image_count] = *image;
     return s->image_count++;
+}
+
+int scene_add_light(scene *s, const scene_light *light)
+{
+    if (grow((void **)&s->lights, s->light_count, &s->light_capacity, sizeof *light))
+        return -1;
+    s->lights[s->light_count] = *light;
+    return s->light_count++;
+}
+
+scene_light scene_light_defaults(scene_light_type type)
+{
+    scene_light light;
+    memset(&light, 0, sizeof light);
+    light.type = type;
+    light.direction[1] = -1;
+    light.color[0] = light.color[1] = light.color[2] = 1;
+    light.spot_outer_degrees = 30;
+    light.spot_inner_degrees = 25;
+    light.sun_angle_degrees = 0.53f;
+    light.falloff = FALLOFF_INVERSE_SQUARE;
+    light.attenuation[0] = 1;
+    return light;
 }
 
 scene_material scene_material_defaults(void)

@@ -84,6 +84,30 @@ typedef struct scene_texture {
     int image;                   /* image: index into scene.images */
 } scene_texture;
 
+/* A light that is not a surface: point, spot or sun (area lights are emissive shapes). */
+typedef enum scene_light_type {
+    SCENE_LIGHT_POINT = 0,
+    SCENE_LIGHT_SPOT = 1,
+    SCENE_LIGHT_SUN = 2,
+} scene_light_type;
+
+typedef enum scene_falloff {
+    FALLOFF_INVERSE_SQUARE = 0,  /* physical: intensity / d^2 */
+    FALLOFF_POLYNOMIAL = 1,      /* the seed report's: intensity / (c + l d + q d^2) */
+} scene_falloff;
+
+typedef struct scene_light {
+    scene_light_type type;
+    float position[3];           /* point, spot */
+    float direction[3];          /* spot: where it points; sun: the direction light travels */
+    float color[3];              /* colour x intensity: point/spot W/sr-like, sun irradiance */
+    float spot_outer_degrees;    /* spot: half-angle where it ends (default 30) */
+    float spot_inner_degrees;    /* spot: half-angle of full intensity (default 25) */
+    float sun_angle_degrees;     /* sun: angular diameter, soft shadows (default 0.53) */
+    scene_falloff falloff;
+    float attenuation[3];        /* polynomial falloff: constant, linear, quadratic */
+} scene_light;
+
 /* One named material. type is a MATERIAL_* tag of packed_layout.h; fields that the
  * type does not use are ignored (and left at zero by the parser). */
 typedef struct scene_material {
@@ -96,6 +120,10 @@ typedef struct scene_material {
     int albedo_texture;          /* -1: albedo is the colour above; else index into scene.textures */
     int emission_texture;        /* -1, or a texture whose colour x strength is the emission */
     int normal_map;              /* -1, or index into scene.images: a tangent-space normal map */
+    float phong_exponent;        /* Whitted/Phong specular exponent; 0: the default (32) */
+    float specular[3];           /* Whitted/Phong specular colour; default (0.04, 0.04, 0.04)
+                                  * for lambertian, the albedo for metal */
+    bool specular_set;           /* false: use the default above */
 } scene_material;
 
 typedef struct scene_sphere {
@@ -183,6 +211,9 @@ typedef struct scene {
     int texture_count, texture_capacity;
     scene_image *images;
     int image_count, image_capacity;
+    scene_light *lights;
+    int light_count, light_capacity;
+    float ambient[3];            /* Whitted integrator's ambient term; default 0.03 0.03 0.03 */
 } scene;
 
 /* Fills *s with the defaults above and empty arrays. Never fails; frees nothing. */
@@ -207,6 +238,11 @@ int scene_add_instance(scene *s, const scene_instance *instance);
 int scene_add_mesh(scene *s, const scene_mesh *mesh);
 int scene_add_texture(scene *s, const scene_texture *texture);
 int scene_add_image(scene *s, const scene_image *image);
+int scene_add_light(scene *s, const scene_light *light);
+
+/* Returns a light of the given type with every default set (white, intensity 1,
+ * inverse-square falloff, spot cone 25/30 degrees, sun 0.53 degrees, pointing down). */
+scene_light scene_light_defaults(scene_light_type type);
 
 /* Sets m to the identity placement (object_to_world = [I | 0]). */
 void scene_identity_transform(float m[3][4]);

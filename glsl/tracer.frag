@@ -14,6 +14,7 @@
 // Random numbers are a pure function of (pixel, sample index, seed, bounce): the same
 // sample renders the same whatever the pass split or the machine.
 
+#ifndef RTSPHERES_AOV_PASS
 layout(location = 0) out vec4 out_origin;       // ray origin of the path in flight
 layout(location = 1) out vec4 out_direction;    // ray direction (unit)
 layout(location = 2) out vec4 out_throughput;   // path throughput so far
@@ -22,8 +23,17 @@ layout(location = 4) out uvec4 out_counters;    // x: samples started, y: bounce
                                                 // flight), z: media the path is in (two 16-bit
                                                 // volume instance numbers + 1, inner low)
 layout(location = 5) out vec4 out_accumulated;  // rgb: sum over finished samples, a: finished samples
-layout(location = 6) out vec4 out_statistics;   // x: path segments traced, y: traversal overflows
+layout(location = 6) out vec4 out_statistics;   // x: path segments traced, y: traversal overflows,
+                                                // z: sum of squared luminance of finished samples
 
+#else
+// The AOV pass (compiled with RTSPHERES_AOV_PASS defined): first-hit albedo, normal and
+// depth, averaged over a few jittered camera rays, to guide the denoiser.
+layout(location = 0) out vec4 out_albedo_depth;  // rgb: albedo, a: distance to the first hit (0: none)
+layout(location = 1) out vec4 out_normal;        // xyz: world shading normal, w: share of rays that hit
+uniform int aov_samples;
+#endif
+#ifndef RTSPHERES_AOV_PASS
 uniform sampler2D state_origin;
 uniform sampler2D state_direction;
 uniform sampler2D state_throughput;
@@ -31,6 +41,7 @@ uniform sampler2D state_radiance;
 uniform usampler2D state_counters;
 uniform sampler2D state_accumulated;
 uniform sampler2D state_statistics;
+#endif
 
 uniform usampler2D packed_scene;
 uniform int packed_width_log2;
@@ -62,6 +73,8 @@ uniform uint max_depth;
 uniform uint russian_roulette_depth;
 uniform int pass_work_budget;
 uniform int light_sampling;     // 0: BSDF sampling only (for tests of the estimators)
+uniform int integrator;         // 0: path tracing, 1: Whitted with Phong shading
+uniform vec3 ambient;           // Whitted: ambient light
 
 layout(binding = 0, offset = 0) uniform atomic_uint unfinished_pixels;
 layout(binding = 0, offset = 4) uniform atomic_uint samples_finished;
@@ -715,6 +728,46 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
     return true;
 }
 
+// Point, spot and sun lights seen from p: the direction to the light, its distance
+// (INFINITY for the sun) and the light arriving, per unit area facing it (irradiance):
+// point and spot: intensity / falloff(distance) (inverse square, or the seed report's
+// c + l d + q d^2), the spot shaped by a smooth edge between its inner and outer cones;
+// sun: its irradiance, from a direction drawn in its disc (soft shadows).
+bool sample_delta_light(uint light, vec3 p, vec2 u, out vec3 direction, out float distance, out vec3 incident)
+{
+    uint base = light_offset + light * uint(PACKED_LIGHT_STRIDE);
+    uvec4 head = packed_texel(base);
+    vec4 where = packed_vec4(base + 1u);
+    vec4 colour = packed_vec4(base + 2u);
+    incident = colour.rgb;
+    if (head.x == uint(LIGHT_SUN)) {
+        vec3 axis = normalize(where.xyz);
+        float cos_theta = 1.0 - u.x * (1.0 - colour.w);
+        float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+        float phi = 2.0 * PI * u.y;
+        vec3 helper = abs(axis.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+        vec3 tangent = normalize(cross(helper, axis));
+        vec3 bitangent = cross(axis, tangent);
+        direction = normalize(sin_theta * cos(phi) * tangent + sin_theta * sin(phi) * bitangent + cos_theta * axis);
+        distance = INFINITY;
+        return true;
+    }
+    vec3 to_light = where.xyz - p;
+    distance = length(to_light);
+    if (distance < 1e-12)
+        return false;
+    direction = to_light / distance;
+    vec3 attenuation = uintBitsToFloat(head.yzw);
+    float falloff = attenuation == vec3(0.0) ? distance * distance
+                  : attenuation.x + attenuation.y * distance + attenuation.z * distance * distance;
+    incident /= max(falloff, 1e-12);
+    if (head.x == uint(LIGHT_SPOT)) {
+        vec4 spot = packed_vec4(base + 3u);
+        incident *= smoothstep(colour.w, max(spot.w, colour.w + 1e-6), dot(-direction, spot.xyz));
+    }
+    return true;
+}
+
 // The fraction of light that gets from p to the light primitive at distance along
 // direction: 0 behind an opaque surface; through volume boundaries it goes on, losing
 // exp(-density * length) in each medium, as the path itself would.
@@ -774,8 +827,16 @@ vec3 next_event(vec3 p, vec3 normal, vec3 shading, vec3 albedo, bool is_phase, u
     vec3 direction;
     float distance, pdf;
     vec3 emitted;
-    if (!sample_light(light, p, u.yz, direction, distance, emitted, pdf))
+    bool delta = false;   // point, spot and sun: BSDF sampling never finds them (no MIS)
+    uvec4 light_head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
+    if (light_head.x >= uint(LIGHT_POINT)) {
+        if (!sample_delta_light(light, p, u.yz, direction, distance, emitted))
+            return vec3(0.0);
+        delta = true;
+        pdf = 1.0;
+    } else if (!sample_light(light, p, u.yz, direction, distance, emitted, pdf)) {
         return vec3(0.0);
+    }
     float bsdf_pdf;
     vec3 value;
     vec3 origin = p;
@@ -790,12 +851,129 @@ vec3 next_event(vec3 p, vec3 normal, vec3 shading, vec3 albedo, bool is_phase, u
         value = albedo * (cosine / PI);
         origin = p + ray_offset(p) * normal;
     }
-    uint light_slot = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE)).y;
+    uint light_slot = delta ? NONE : light_head.y;
     vec3 transmittance = shadow_transmittance(origin, direction, distance, light_slot, media, time, work, overflow);
+    if (delta)
+        return transmittance * value * emitted / choice;
     float light_pdf = choice * pdf;
     return transmittance * value * emitted * power_heuristic(light_pdf, bsdf_pdf) / light_pdf;
 }
 
+// ---- Whitted integrator ----------------------------------------------------------
+
+// Phong shading at a diffuse or metal surface point: ambient plus, for every light (one
+// light chosen by power when there are more than WHITTED_ALL_LIGHTS), diffuse and
+// normalised-Phong specular terms, each light shadow-tested. Area lights are lit from a
+// random point each sample, which averages to soft shadows (the seed report's 4.3).
+const uint WHITTED_ALL_LIGHTS = 16u;
+
+vec3 whitted_direct(vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 albedo, uint material, uint media, float time,
+                    uint bounce, inout int work, inout bool overflow)
+{
+    vec4 phong = packed_vec4(material_offset + material * uint(PACKED_MATERIAL_STRIDE) + 3u);
+    vec3 result = ambient * albedo;
+    uint all_lights = light_count;
+    bool choose = all_lights > WHITTED_ALL_LIGHTS;
+    uint count = choose ? 1u : all_lights;
+    for (uint k = 0u; k < count; k++) {
+        vec4 u = random4(bounce, 6u + (k & 1u)) ;
+        u = fract(u + float(k >> 1u) * 0.6180339887);   // further lights: shifted streams
+        uint light = choose ? choose_light(u.x) : k;
+        float weight = choose ? 1.0 / max(light_probability(light), 1e-12) : 1.0;
+        vec3 direction;
+        float distance, pdf;
+        vec3 arriving;
+        uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
+        if (head.x >= uint(LIGHT_POINT)) {
+            if (!sample_delta_light(light, p, u.yz, direction, distance, arriving))
+                continue;
+        } else {
+            if (!sample_light(light, p, u.yz, direction, distance, arriving, pdf) || pdf <= 0.0)
+                continue;
+            arriving /= pdf;     // radiance over the light's solid angle: irradiance
+        }
+        float cosine = dot(shading, direction);
+        if (cosine <= 0.0 || dot(normal, direction) <= 0.0)
+            continue;
+        vec3 reflected = reflect(-direction, shading);
+        float highlight = pow(max(dot(reflected, view), 0.0), phong.x) * (phong.x + 2.0) / (2.0 * PI);
+        vec3 shade = (albedo / PI + phong.yzw * highlight) * cosine;
+        uint slot = head.x >= uint(LIGHT_POINT) ? NONE : head.y;
+        vec3 transmittance = shadow_transmittance(p + ray_offset(p) * normal, direction, distance, slot, media, time,
+                                                  work, overflow);
+        result += weight * transmittance * shade * arriving;
+    }
+    return result;
+}
+
+
+#ifdef RTSPHERES_AOV_PASS
+// Reads the packed scene's header into the globals every function uses.
+void read_header()
+{
+    uvec4 header0 = packed_texel(0u), header1 = packed_texel(1u), header2 = packed_texel(2u),
+          header3 = packed_texel(3u), header4 = packed_texel(4u);
+    material_offset = header0.z;
+    primitive_offset = header1.x;
+    node_offset = header1.z;
+    node_count = header1.w;
+    instance_offset = header2.x;
+    attribute_offset = header2.z;
+    default_material = header2.w;
+    texture_offset = header3.x;
+    image_offset = header3.z;
+    light_offset = header4.x;
+    light_count = 0u;
+}
+
+void main()
+{
+    read_header();
+    ivec2 frag_pixel = ivec2(gl_FragCoord.xy);
+    ivec2 image_pixel = ivec2(region_origin.x + frag_pixel.x, region_origin.y + (image_size.y - 1 - frag_pixel.y));
+    vec2 film_pixel = vec2(float(image_pixel.x), float(full_size.y - 1 - image_pixel.y));
+    rng_pixel = uvec2(image_pixel);
+    rng_seed_hash = random_seed_hash(seed);
+    vec3 albedo_sum = vec3(0.0), normal_sum = vec3(0.0);
+    float depth_sum = 0.0, hits = 0.0;
+    int work = 0;
+    bool overflow = false;
+    for (int k = 0; k < aov_samples; k++) {
+        rng_sample = sample_start + uint(k);
+        vec4 u = random4(0u, 0u);
+        vec2 film = (film_pixel + u.xy) / vec2(full_size);
+        vec2 lens = lens_radius * random_in_unit_disk(u.zw);
+        vec3 origin = camera_origin + lens.x * camera_u + lens.y * camera_v;
+        vec3 direction = normalize(camera_lower_left + film.x * camera_horizontal + film.y * camera_vertical - origin);
+        float time = mix(shutter_open, shutter_close, random4(0u, 3u).x);
+        work = 0;
+        Hit hit;
+        if (!trace(origin, direction, time, hit, work, overflow)) {
+            albedo_sum += clamp(sky_radiance(direction), 0.0, 1.0);
+            continue;
+        }
+        Surface surface = surface_at(hit, origin, direction, time);
+        uint material = material_offset + surface.material * uint(PACKED_MATERIAL_STRIDE);
+        uvec4 material0 = packed_texel(material);
+        uvec4 material2 = packed_texel(material + 2u);
+        vec3 albedo = uintBitsToFloat(material0.yzw);
+        if (material0.x == uint(MATERIAL_DIELECTRIC))
+            albedo = vec3(1.0);
+        else if (material0.x == uint(MATERIAL_EMISSIVE))
+            albedo = clamp(uintBitsToFloat(packed_texel(material + 1u).xyz), 0.0, 1.0);
+        else if (material2.y != NONE)
+            albedo *= texture_value(material2.y, surface.position, surface.uv);
+        albedo_sum += albedo;
+        normal_sum += dot(direction, surface.shading) < 0.0 ? surface.shading : -surface.shading;
+        depth_sum += hit.t;
+        hits += 1.0;
+    }
+    float n = float(max(aov_samples, 1));
+    out_albedo_depth = vec4(albedo_sum / n, hits > 0.0 ? depth_sum / hits : 0.0);
+    vec3 normal = hits > 0.0 ? normal_sum / hits : vec3(0.0);
+    out_normal = vec4(dot(normal, normal) > 0.0 ? normalize(normal) : vec3(0.0), hits / n);
+}
+#else
 // ---- main ------------------------------------------------------------------------
 
 void main()
@@ -833,7 +1011,7 @@ void main()
     image_offset = header3.z;
     uvec4 header4 = packed_texel(4u);
     light_offset = header4.x;
-    light_count = light_sampling != 0 ? header4.y : 0u;
+    light_count = light_sampling != 0 || integrator == 1 ? header4.y : 0u;
 
     // Full-image pixel, row 0 at the top: a crop or tile renders exactly the pixels
     // (and random numbers) of the full render.
@@ -898,6 +1076,8 @@ void main()
                     path_done = true;
                 if (path_done) {
                     accumulated += vec4(radiance, 1.0);
+                    float luminance = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
+                    statistics.z += luminance * luminance;
                     bounce = 0u;
                     finished_here++;
                 }
@@ -931,7 +1111,20 @@ void main()
                 vec3 albedo = uintBitsToFloat(material0.yzw);
                 if (material2.y != NONE)
                     albedo *= texture_value(material2.y, p, surface.uv);
-                if (material_type == uint(MATERIAL_EMISSIVE)) {
+                if (integrator == 1 && material_type != uint(MATERIAL_EMISSIVE)
+                    && material_type != uint(MATERIAL_DIELECTRIC)) {
+                    // Whitted: local Phong shading; metals also reflect, diffuse ends here.
+                    radiance += throughput * whitted_direct(p, normal, shading, -direction, albedo, surface.material,
+                                                            media, time, bounce, work, overflow);
+                    if (material_type == uint(MATERIAL_METAL)) {
+                        next_direction = reflect(direction, shading);
+                        throughput *= albedo;
+                        if (dot(next_direction, normal) <= 0.0)
+                            path_done = true;
+                    } else {
+                        path_done = true;
+                    }
+                } else if (material_type == uint(MATERIAL_EMISSIVE)) {
                     vec3 emission = uintBitsToFloat(material1.xyz);
                     if (material2.z != NONE)
                         emission *= texture_value(material2.z, p, surface.uv);
@@ -983,7 +1176,7 @@ void main()
                 bounce++;
                 if (bounce > max_depth) {
                     path_done = true;
-                } else if (bounce > russian_roulette_depth) {
+                } else if (bounce > russian_roulette_depth && integrator == 0) {
                     // Unbiased: survivors carry the weight of the paths that ended.
                     float survival = clamp(max(throughput.r, max(throughput.g, throughput.b)), 0.05, 1.0);
                     if (random4(bounce, 2u).x >= survival)
@@ -995,6 +1188,8 @@ void main()
         }
         if (path_done) {
             accumulated += vec4(radiance, 1.0);
+            float luminance = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
+            statistics.z += luminance * luminance;
             bounce = 0u;
             finished_here++;
         }
@@ -1018,3 +1213,4 @@ void main()
     out_accumulated = accumulated;
     out_statistics = statistics;
 }
+#endif

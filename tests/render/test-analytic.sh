@@ -93,4 +93,43 @@ if "$program" render scenes/three-balls.txt -o "$a" --size 64x36 --spp 512 --lig
 else
     fail "light sampling estimators" "render failed"
 fi
+
+# Point, spot and sun lights on a diffuse plane (albedo 0.5, black sky: no other light):
+# radiance = albedo / pi * E with E = I cos(theta) / r^2 for a point light (inverse
+# square), I cos / (c + l r + q r^2) for the polynomial falloff, the sun's irradiance times
+# cos for the sun. A camera with a tiny field of view looks at one point of the plane.
+# Both integrators must agree (Whitted with no ambient and no specular highlight).
+plane_light() {
+    name=$1 target=$2 light=$3 expected=$4 integrator=$5
+    cat >"$scratch/$name.txt" <<SCENE
+render size 8 8 spp 4 depth 4 seed 1
+camera from 1 3 2 at $target up 0 1 0 fov 0.2
+sky constant 0 0 0
+ambient 0 0 0
+material floor lambertian 0.5 0.5 0.5 specular 0 0 0
+quad -50 0 -50  100 0 0  0 0 100 floor
+$light
+SCENE
+    if "$program" render "$scratch/$name.txt" -o "$scratch/$name.exr" --integrator "$integrator" --quiet; then
+        mean=$(channel_mean "$scratch/$name.exr" G)
+        if within "$mean" "$expected" 0.01; then pass "$name ($integrator): $mean, analytic $expected"
+        else fail "$name ($integrator)" "$mean, analytic $expected"; fi
+    else
+        fail "$name ($integrator)" "render failed"
+    fi
+}
+for integrator in path whitted; do
+    # 0.5 * 10 / (pi * 2^2)
+    plane_light point-below "0 0 0" "light point 0 2 0 intensity 10" 0.397887 $integrator
+    # r^2 = 8, cos = 2 / sqrt(8): 0.5 * 10 * 0.707107 / (pi * 8)
+    plane_light point-aside "2 0 0" "light point 0 2 0 intensity 10" 0.140683 $integrator
+    # 0.5 * 10 / (pi * (1 + 0 * 2 + 1 * 4))
+    plane_light point-polynomial "0 0 0" "light point 0 2 0 intensity 10 falloff polynomial 1 0 1" 0.318310 $integrator
+    # Inside the spot's inner cone it is the point light; outside its outer cone, dark.
+    plane_light spot-inside "0 0 0" "light spot 0 2 0 at 0 0 0 intensity 10 cone 20 30" 0.397887 $integrator
+    plane_light spot-outside "3 0 0" "light spot 0 2 0 at 0 0 0 intensity 10 cone 20 30" 0 $integrator
+    # Sun straight down, irradiance 3: 0.5 * 3 / pi; tilted 60 degrees: times cos 60.
+    plane_light sun-down "0 0 0" "light sun 0 -1 0 intensity 3 angle 0" 0.477465 $integrator
+    plane_light sun-tilted "0 0 0" "light sun 0.866025 -0.5 0 intensity 3 angle 0" 0.238732 $integrator
+done
 finish
