@@ -13,6 +13,7 @@ int command_diff(int argc, char **argv);
 int command_info(int argc, char **argv);
 int command_stats(int argc, char **argv);
 int command_merge(int argc, char **argv);
+int command_montage(int argc, char **argv);
 
 /* Exit codes shared by all commands. */
 #define EXIT_OK 0

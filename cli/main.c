@@ -18,6 +18,7 @@ static void print_usage(FILE *stream)
             "  info                     show the EGL device and OpenGL renderer that would be used\n"
             "  stats IMAGE              per-channel mean/min/max of an image and its rtspheres metadata\n"
             "  merge PARTS... -o OUT    merge EXR parts of one render (sample ranges, tiles, shards)\n"
+            "  montage IMAGES... -o OUT lay equal-size images out as a contact sheet\n"
             "\n"
             "Run 'rtspheres COMMAND --help' for a command's options.\n");
 }
@@ -51,6 +52,8 @@ int main(int argc, char **argv)
         return command_stats(argc - 1, argv + 1);
     if (strcmp(command, "merge") == 0)
         return command_merge(argc - 1, argv + 1);
+    if (strcmp(command, "montage") == 0)
+        return command_montage(argc - 1, argv + 1);
     if (strcmp(command, "--help") == 0 || strcmp(command, "-h") == 0 || strcmp(command, "help") == 0) {
         print_usage(stdout);
         return EXIT_OK;

@@ -1,0 +1,175 @@
+/* command_montage.c: `rtspheres montage IMAGES... -o SHEET [--columns N] [--gap PIXELS]`:
+ * lays equal-size images out as a contact sheet (core/postprocess.h), e.g. the frames of a
+ * light sweep. Inputs are read as linear light (8-bit sRGB files are decoded) so that the
+ * writer's sRGB encoding gives PNG tiles back as they were. Exit codes: 0 ok, 1 runtime
+ * failure (write failed, out of memory), 2 bad input (usage, unreadable or mismatched
+ * images, -o naming an input). */
+#include <errno.h>
+#include <getopt.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "commands.h"
+#include "image_io.h"
+#include "postprocess.h"
+
+#define DEFAULT_GAP 2
+#define MAX_GAP 4096
+#define MAX_COLUMNS 4096
+
+static void print_help(FILE *stream)
+{
+    fprintf(stream,
+            "usage: rtspheres montage IMAGES... -o SHEET [options]\n"
+            "\n"
+            "Lays the images out as a contact sheet: a grid filled row by row, left to right,\n"
+            "in the order given, on black. All images must have the same size; the sheet holds\n"
+            "their colour (R, G, B). PNG/JPEG inputs are decoded from sRGB and the sheet is\n"
+            "encoded like a render, so 8-bit tiles come out as they went in.\n"
+            "\n"
+            "options:\n"
+            "  -o, --output FILE   the sheet (.png, .jpg, .tif, .exr, .hdr); never one of the inputs\n"
+            "      --columns N     images per row (default: ceil(sqrt(count)), so 12 make 4x3)\n"
+            "      --gap PIXELS    black space between images (default %d; none around the outside)\n"
+            "  -q, --quiet         no summary line\n"
+            "  -h, --help          this text\n"
+            "\n"
+            "exit status: 0 ok, 1 runtime failure (write failed), 2 bad input (usage, unreadable\n"
+            "or differently sized images)\n",
+            DEFAULT_GAP);
+}
+
+/* True when the two paths name the same existing file. */
+static bool same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+/* Returns path's extension including the dot, or "" when its last component has none. */
+static const char *extension_of(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    return dot != NULL && strchr(dot, '/') == NULL ? dot : "";
+}
+
+/* True for the formats image_write knows, so a bad -o is refused before any image is read. */
+static bool known_output(const char *path)
+{
+    static const char *const extensions[] = {".exr", ".hdr", ".png", ".jpg", ".jpeg", ".tif", ".tiff"};
+    for (size_t i = 0; i < sizeof extensions / sizeof extensions[0]; i++)
+        if (strcasecmp(extension_of(path), extensions[i]) == 0)
+            return true;
+    return false;
+}
+
+/* Parses text as a whole number in [0, maximum] into *value. Returns false when it is not. */
+static bool parse_count(const char *text, int maximum, int *value)
+{
+    char *end;
+    errno = 0;
+    long parsed = strtol(text, &end, 10);
+    if (errno != 0 || end == text || *end != '\0' || parsed < 0 || parsed > maximum)
+        return false;
+    *value = (int)parsed;
+    return true;
+}
+
+int command_montage(int argc, char **argv)
+{
+    enum { OPTION_COLUMNS = 256, OPTION_GAP };
+    static const struct option long_options[] = {
+        {"output", required_argument, NULL, 'o'},
+        {"columns", required_argument, NULL, OPTION_COLUMNS},
+        {"gap", required_argument, NULL, OPTION_GAP},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+    };
+    const char *output = NULL;
+    int columns = 0, gap = DEFAULT_GAP;
+    bool quiet = false;
+    optind = 1;
+    int option;
+    while ((option = getopt_long(argc, argv, "o:qh", long_options, NULL)) != -1) {
+        switch (option) {
+        case 'o': output = optarg; break;
+        case OPTION_COLUMNS:
+            if (!parse_count(optarg, MAX_COLUMNS, &columns) || columns == 0) {
+                fprintf(stderr, "rtspheres montage: --columns wants a whole number from 1 to %d, not '%s'\n",
+                        MAX_COLUMNS, optarg);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case OPTION_GAP:
+            if (!parse_count(optarg, MAX_GAP, &gap)) {
+                fprintf(stderr, "rtspheres montage: --gap wants a whole number of pixels from 0 to %d, not '%s'\n",
+                        MAX_GAP, optarg);
+                return EXIT_BAD_INPUT;
+            }
+            break;
+        case 'q': quiet = true; break;
+        case 'h': print_help(stdout); return EXIT_OK;
+        default: print_help(stderr); return EXIT_BAD_INPUT;
+        }
+    }
+    if (output == NULL) {
+        fprintf(stderr, "rtspheres montage: no output; give -o SHEET.png\n");
+        return EXIT_BAD_INPUT;
+    }
+    if (!known_output(output)) {
+        fprintf(stderr, "rtspheres montage: cannot tell the format of '%s'; use .png, .jpg, .tif, .exr or .hdr\n",
+                output);
+        return EXIT_BAD_INPUT;
+    }
+    if (optind >= argc) {
+        fprintf(stderr, "rtspheres montage: no images; give the images before or after -o\n");
+        return EXIT_BAD_INPUT;
+    }
+    char **paths = argv + optind;
+    int count = argc - optind;
+    for (int i = 0; i < count; i++)
+        if (strcmp(paths[i], output) == 0 || same_file(paths[i], output)) {
+            fprintf(stderr, "rtspheres montage: the output '%s' is one of the inputs; refusing to overwrite it\n",
+                    output);
+            return EXIT_BAD_INPUT;
+        }
+
+    rt_image *images = calloc((size_t)count, sizeof *images);
+    if (images == NULL) {
+        fprintf(stderr, "rtspheres montage: out of memory for %d images\n", count);
+        return EXIT_RUNTIME;
+    }
+    rt_error error = {{0}};
+    rt_status status = RT_OK;
+    for (int i = 0; i < count && status == RT_OK; i++)
+        status = image_read_linear(paths[i], POSTPROCESS_MAX_MONTAGE_SIDE, &images[i], &error);
+    /* The core would refuse too; here the message can name the files. */
+    for (int i = 1; i < count && status == RT_OK; i++)
+        if (images[i].width != images[0].width || images[i].height != images[0].height)
+            status = rt_error_set(&error, RT_ERROR_INPUT, "'%s' is %dx%d but '%s' is %dx%d; all images must have one size",
+                                  paths[i], images[i].width, images[i].height, paths[0], images[0].width,
+                                  images[0].height);
+    rt_image sheet = {0};
+    if (status == RT_OK)
+        status = postprocess_montage(images, count, columns, gap, &sheet, &error);
+    for (int i = 0; i < count; i++)
+        image_free(&images[i]);
+    free(images);
+    if (status == RT_OK)
+        status = image_write(output, &sheet, NULL, &error);
+    if (status != RT_OK) {
+        image_free(&sheet);
+        fprintf(stderr, "rtspheres montage: %s\n", error.message);
+        return exit_code_for_status(status);
+    }
+    if (!quiet)
+        fprintf(stderr, "rtspheres montage: %d image%s -> %s: %dx%d\n", count, count == 1 ? "" : "s", output,
+                sheet.width, sheet.height);
+    image_free(&sheet);
+    return EXIT_OK;
+}

@@ -1,0 +1,787 @@
+/* test_postprocess.c: blur, denoiser, tone mapping and montage on small hand-made images
+ * whose right answers are known: constant and noisy flat regions, hard edges between
+ * regions of different normals or depths, a checker texture, grey ramps and labelled tiles.
+ * The denoiser tests print what they measured (variance ratios, side means). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdbool.h>
+#include <string.h>
+
+#include "postprocess.h"
+
+#define assert_close(actual, expected, tolerance) \
+    assert_close_at((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
+
+static void assert_close_at(double actual, double expected, double tolerance, const char *what, const char *file,
+                            int line)
+{
+    if (actual == expected || fabs(actual - expected) <= tolerance)
+        return;
+    print_error("%s is %.9g, expected %.9g (within %g)\n", what, actual, expected, tolerance);
+    _fail(file, line);
+}
+
+/* Fails unless actual is within relative (a fraction) of expected. */
+#define assert_relative(actual, expected, relative) \
+    assert_close_at((actual), (expected), (relative) * fabs((double)(expected)), #actual, __FILE__, __LINE__)
+
+/* ---------------------------------------------------------------------------------- */
+/* Helpers                                                                              */
+
+static rt_image make_image(int width, int height, int channels, float value)
+{
+    rt_image image;
+    rt_error error;
+    assert_int_equal(image_create(&image, width, height, channels, &error), RT_OK);
+    for (size_t i = 0; i < (size_t)width * height * channels; i++)
+        image.pixels[i] = value;
+    return image;
+}
+
+static float *at(const rt_image *image, int x, int y, int c)
+{
+    return &image->pixels[((size_t)y * image->width + x) * image->channels + c];
+}
+
+/* A small deterministic generator (xorshift64*), so every run sees the same noise. */
+typedef struct random_state {
+    uint64_t state;
+} random_state;
+
+static double random_uniform(random_state *random)
+{
+    random->state ^= random->state >> 12;
+    random->state ^= random->state << 25;
+    random->state ^= random->state >> 27;
+    return ((random->state * 0x2545F4914F6CDD1DULL) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* A standard normal sample (Box-Muller). */
+static double random_normal(random_state *random)
+{
+    double u = random_uniform(random), v = random_uniform(random);
+    return sqrt(-2.0 * log(1.0 - u)) * cos(2.0 * M_PI * v);
+}
+
+/* Mean and variance of channel c over the region x0 <= x < x1, y0 <= y < y1. */
+static void region_statistics(const rt_image *image, int c, int x0, int y0, int x1, int y1, double *mean,
+                              double *variance)
+{
+    double sum = 0, square_sum = 0;
+    int n = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) {
+            double v = *at(image, x, y, c);
+            sum += v;
+            square_sum += v * v;
+            n++;
+        }
+    *mean = sum / n;
+    if (variance != NULL)
+        *variance = square_sum / n - *mean * *mean;
+}
+
+static double region_mean(const rt_image *image, int c, int x0, int y0, int x1, int y1)
+{
+    double mean;
+    region_statistics(image, c, x0, y0, x1, y1, &mean, NULL);
+    return mean;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Gaussian blur                                                                        */
+
+static void test_blur_keeps_a_constant_image(void **state)
+{
+    (void)state;
+    rt_image image = make_image(19, 7, 4, 0.25f);
+    for (int y = 0; y < 7; y++)
+        for (int x = 0; x < 19; x++)
+            *at(&image, x, y, 3) = (float)(x + y);  /* alpha: must not be touched */
+    rt_error error;
+    assert_int_equal(postprocess_gaussian_blur(&image, 3.0f, 2, &error), RT_OK);
+    for (int y = 0; y < 7; y++)
+        for (int x = 0; x < 19; x++) {
+            for (int c = 0; c < 3; c++)
+                assert_close(*at(&image, x, y, c), 0.25, 1e-6);
+            assert_close(*at(&image, x, y, 3), x + y, 0);
+        }
+    image_free(&image);
+}
+
+static void test_blur_keeps_the_mean_and_reduces_noise(void **state)
+{
+    (void)state;
+    rt_image image = make_image(37, 23, 3, 0.0f);
+    random_state random = {12345};
+    for (size_t i = 0; i < 37 * 23 * 3; i++)
+        image.pixels[i] = (float)(0.5 + 0.2 * random_normal(&random));
+    double means[3], variances[3];
+    for (int c = 0; c < 3; c++)
+        region_statistics(&image, c, 0, 0, 37, 23, &means[c], &variances[c]);
+    rt_error error;
+    assert_int_equal(postprocess_gaussian_blur(&image, 2.0f, 3, &error), RT_OK);
+    for (int c = 0; c < 3; c++) {
+        double mean, variance;
+        region_statistics(&image, c, 0, 0, 37, 23, &mean, &variance);
+        assert_close(mean, means[c], 1e-5);
+        /* Three passes of sigma 2 are one of sigma 3.46: white noise keeps about
+         * 1 / (4 pi sigma^2) = 1/150 of its variance. */
+        assert_true(variance < variances[c] / 50);
+        print_message("blur: channel %d mean %.7f -> %.7f, variance %.5f -> %.6f (%.0fx lower)\n", c, means[c], mean,
+                      variances[c], variance, variances[c] / variance);
+    }
+    image_free(&image);
+}
+
+static void test_blur_wider_than_the_image_keeps_the_mean(void **state)
+{
+    (void)state;
+    rt_image image = make_image(5, 3, 3, 0.0f);
+    *at(&image, 0, 0, 0) = 15.0f;  /* mean of channel 0: 1 */
+    rt_error error;
+    assert_int_equal(postprocess_gaussian_blur(&image, 40.0f, 1, &error), RT_OK);
+    assert_close(region_mean(&image, 0, 0, 0, 5, 3), 1.0, 1e-5);
+    /* A kernel this wide spreads the spike evenly. */
+    assert_close(*at(&image, 4, 2, 0), 1.0, 0.01);
+    image_free(&image);
+}
+
+static void test_blur_zero_sigma_or_passes_is_a_no_op(void **state)
+{
+    (void)state;
+    rt_image image = make_image(4, 4, 3, 0.0f);
+    *at(&image, 1, 1, 0) = 1.0f;
+    rt_error error;
+    assert_int_equal(postprocess_gaussian_blur(&image, 0.0f, 3, &error), RT_OK);
+    assert_int_equal(postprocess_gaussian_blur(&image, 2.0f, 0, &error), RT_OK);
+    assert_close(*at(&image, 1, 1, 0), 1.0, 0);
+    assert_close(*at(&image, 0, 0, 0), 0.0, 0);
+    image_free(&image);
+}
+
+static void test_blur_rejects_bad_arguments(void **state)
+{
+    (void)state;
+    rt_image image = make_image(4, 4, 3, 0.5f);
+    rt_error error;
+    assert_int_equal(postprocess_gaussian_blur(&image, -1.0f, 1, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "sigma"));
+    assert_int_equal(postprocess_gaussian_blur(&image, NAN, 1, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_gaussian_blur(&image, 1e9f, 1, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_gaussian_blur(&image, 1.0f, -1, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "passes"));
+    rt_image empty = {0};
+    assert_int_equal(postprocess_gaussian_blur(&empty, 1.0f, 1, &error), RT_ERROR_INPUT);
+    image_free(&image);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Denoiser                                                                             */
+
+#define SIZE 64
+#define HALF (SIZE / 2)
+
+/* A synthetic render: colour, albedo, normal and depth buffers of one size. */
+typedef struct buffers {
+    rt_image colour, albedo, normal, depth;
+} buffers;
+
+/* A flat grey world: colour value + noise of standard deviation noise_sd (3 channels
+ * independent), albedo 1, normal +z, depth 2. */
+static buffers make_flat(float value, float noise_sd, uint64_t seed)
+{
+    buffers b = {
+        .colour = make_image(SIZE, SIZE, 3, value),
+        .albedo = make_image(SIZE, SIZE, 3, 1.0f),
+        .normal = make_image(SIZE, SIZE, 3, 0.0f),
+        .depth = make_image(SIZE, SIZE, 1, 2.0f),
+    };
+    random_state random = {seed};
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            *at(&b.normal, x, y, 2) = 1.0f;
+            for (int c = 0; c < 3; c++)
+                *at(&b.colour, x, y, c) += (float)(noise_sd * random_normal(&random));
+        }
+    return b;
+}
+
+/* Left half (x < HALF) at value left, right half at right, each with noise of sd
+ * noise_sd relative to its value; the halves differ in normal (+z against +x) when
+ * normals_differ, in depth (2 against 3) when depths_differ. */
+static buffers make_edge(float left, float right, float noise_sd, bool normals_differ, bool depths_differ)
+{
+    buffers b = make_flat(0.0f, 0.0f, 1);
+    random_state random = {777};
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            bool is_right = x >= HALF;
+            float value = is_right ? right : left;
+            for (int c = 0; c < 3; c++)
+                *at(&b.colour, x, y, c) = value * (float)(1.0 + noise_sd * random_normal(&random));
+            if (is_right && normals_differ) {
+                *at(&b.normal, x, y, 0) = 1.0f;
+                *at(&b.normal, x, y, 2) = 0.0f;
+            }
+            if (is_right && depths_differ)
+                *at(&b.depth, x, y, 0) = 3.0f;
+        }
+    return b;
+}
+
+static void free_buffers(buffers *b)
+{
+    image_free(&b->colour);
+    image_free(&b->albedo);
+    image_free(&b->normal);
+    image_free(&b->depth);
+}
+
+static rt_status denoise(buffers *b, const postprocess_denoise_options *options)
+{
+    rt_error error = {{0}};
+    rt_status status = postprocess_denoise(&b->colour, &b->albedo, &b->normal, &b->depth, options, &error);
+    if (status != RT_OK)
+        print_error("postprocess_denoise: %s\n", error.message);
+    return status;
+}
+
+static void test_denoise_smooths_a_flat_noisy_region(void **state)
+{
+    (void)state;
+    buffers b = make_flat(0.5f, 0.1f, 99);
+    double mean_before, variance_before, mean_after, variance_after;
+    region_statistics(&b.colour, 1, 0, 0, SIZE, SIZE, &mean_before, &variance_before);
+    assert_int_equal(denoise(&b, NULL), RT_OK);
+    region_statistics(&b.colour, 1, 0, 0, SIZE, SIZE, &mean_after, &variance_after);
+    print_message("denoise flat: variance %.6f -> %.8f (%.0fx lower), mean %.5f -> %.5f\n", variance_before,
+                  variance_after, variance_before / variance_after, mean_before, mean_after);
+    assert_true(variance_after * 5 <= variance_before);
+    assert_relative(mean_after, 0.5, 0.02);
+    free_buffers(&b);
+}
+
+static void test_denoise_without_guides_still_smooths(void **state)
+{
+    (void)state;
+    buffers b = make_flat(0.5f, 0.1f, 5);
+    double before, after, mean;
+    region_statistics(&b.colour, 0, 0, 0, SIZE, SIZE, &mean, &before);
+    rt_error error;
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, NULL, &error), RT_OK);
+    region_statistics(&b.colour, 0, 0, 0, SIZE, SIZE, &mean, &after);
+    print_message("denoise flat, no guides: variance %.0fx lower\n", before / after);
+    assert_true(after * 5 <= before);
+    free_buffers(&b);
+}
+
+/* Checks a denoised edge image: each side's mean within 2% of its noise-free value, the
+ * mean of the column on either side of the edge within 5% of its side's value (bleeding
+ * would pull it towards the other side), and each side's variance at least 5x lower. */
+static void check_edge(const char *what, const rt_image *before, const rt_image *after, float left, float right)
+{
+    double left_mean, right_mean, left_before, right_before, left_after, right_after;
+    region_statistics(before, 0, 0, 0, HALF, SIZE, &left_mean, &left_before);
+    region_statistics(before, 0, HALF, 0, SIZE, SIZE, &right_mean, &right_before);
+    region_statistics(after, 0, 0, 0, HALF, SIZE, &left_mean, &left_after);
+    region_statistics(after, 0, HALF, 0, SIZE, SIZE, &right_mean, &right_after);
+    double left_column = region_mean(after, 0, HALF - 1, 0, HALF, SIZE);
+    double right_column = region_mean(after, 0, HALF, 0, HALF + 1, SIZE);
+    print_message("denoise %s edge: side means %.4f | %.4f (true %.2f | %.2f), columns at the edge %.4f | %.4f, "
+                  "variance %.0fx | %.0fx lower\n",
+                  what, left_mean, right_mean, left, right, left_column, right_column, left_before / left_after,
+                  right_before / right_after);
+    assert_relative(left_mean, left, 0.02);
+    assert_relative(right_mean, right, 0.02);
+    assert_relative(left_column, left, 0.05);
+    assert_relative(right_column, right, 0.05);
+    assert_true(left_after * 5 <= left_before);
+    assert_true(right_after * 5 <= right_before);
+}
+
+static void test_denoise_keeps_an_edge_between_normals(void **state)
+{
+    (void)state;
+    buffers b = make_edge(0.2f, 0.8f, 0.2f, true, false);
+    rt_image before = make_image(SIZE, SIZE, 3, 0.0f);
+    memcpy(before.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
+    assert_int_equal(denoise(&b, NULL), RT_OK);
+    check_edge("normal", &before, &b.colour, 0.2f, 0.8f);
+    image_free(&before);
+    free_buffers(&b);
+}
+
+static void test_denoise_keeps_an_edge_between_depths(void **state)
+{
+    (void)state;
+    buffers b = make_edge(0.2f, 0.8f, 0.2f, false, true);
+    rt_image before = make_image(SIZE, SIZE, 3, 0.0f);
+    memcpy(before.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
+    assert_int_equal(denoise(&b, NULL), RT_OK);
+    check_edge("depth", &before, &b.colour, 0.2f, 0.8f);
+    image_free(&before);
+    free_buffers(&b);
+}
+
+/* With the colour weight switched off (a huge sigma), the guides alone must hold the
+ * edge: every pixel next to it stays within 5% of its side (noise-free input). */
+static void test_denoise_guides_alone_hold_an_edge(void **state)
+{
+    (void)state;
+    postprocess_denoise_options options = postprocess_denoise_options_defaults();
+    options.sigma_colour = 1e9f;
+    for (int guide = 0; guide < 2; guide++) {
+        buffers b = make_edge(0.2f, 0.8f, 0.0f, guide == 0, guide == 1);
+        assert_int_equal(denoise(&b, &options), RT_OK);
+        for (int y = 0; y < SIZE; y++) {
+            assert_relative(*at(&b.colour, HALF - 1, y, 0), 0.2, 0.05);
+            assert_relative(*at(&b.colour, HALF, y, 0), 0.8, 0.05);
+        }
+        free_buffers(&b);
+    }
+    /* And without any guide the same filter does blur it: the test can fail. */
+    buffers b = make_edge(0.2f, 0.8f, 0.0f, false, false);
+    assert_int_equal(denoise(&b, &options), RT_OK);
+    assert_true(*at(&b.colour, HALF - 1, 10, 0) > 0.2 * 1.05);
+    free_buffers(&b);
+}
+
+/* Pixels that hit nothing (depth 0 or infinite) never mix with pixels that hit. */
+static void test_denoise_keeps_sky_and_surface_apart(void **state)
+{
+    (void)state;
+    postprocess_denoise_options options = postprocess_denoise_options_defaults();
+    options.sigma_colour = 1e9f;
+    buffers b = make_edge(0.2f, 0.8f, 0.1f, false, false);
+    for (int y = 0; y < SIZE; y++)
+        for (int x = HALF; x < SIZE; x++)
+            *at(&b.depth, x, y, 0) = (y % 2) ? INFINITY : 0.0f;
+    assert_int_equal(denoise(&b, &options), RT_OK);
+    double left_column = region_mean(&b.colour, 0, HALF - 1, 0, HALF, SIZE);
+    double right_column = region_mean(&b.colour, 0, HALF, 0, HALF + 1, SIZE);
+    print_message("denoise sky edge: columns at the edge %.4f | %.4f (true 0.2 | 0.8)\n", left_column, right_column);
+    assert_relative(left_column, 0.2, 0.05);
+    assert_relative(right_column, 0.8, 0.05);
+    free_buffers(&b);
+}
+
+/* A tilted plane (depth growing linearly across the image, normals equal) is one surface:
+ * the depth weight measures the distance from the plane, so it smooths like a flat one. */
+static void test_denoise_smooths_a_tilted_plane(void **state)
+{
+    (void)state;
+    buffers b = make_flat(0.5f, 0.1f, 4242);
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++)
+            *at(&b.depth, x, y, 0) = 2.0f + 0.05f * (float)x + 0.02f * (float)y;
+    double before, after, mean;
+    region_statistics(&b.colour, 0, 0, 0, SIZE, SIZE, &mean, &before);
+    assert_int_equal(denoise(&b, NULL), RT_OK);
+    region_statistics(&b.colour, 0, 0, 0, SIZE, SIZE, &mean, &after);
+    print_message("denoise tilted plane: variance %.0fx lower\n", before / after);
+    assert_true(after * 5 <= before);
+    free_buffers(&b);
+}
+
+/* A checker texture (albedo 0.2 and 0.8 in 4x4 cells) under uniform light with 10%
+ * noise: demodulation filters the light, so the texture's contrast survives exactly. */
+static void test_denoise_demodulation_keeps_a_texture(void **state)
+{
+    (void)state;
+    postprocess_denoise_options options = postprocess_denoise_options_defaults();
+    buffers b = make_flat(0.0f, 0.0f, 1);
+    random_state random = {31337};
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            float albedo = ((x / 4 + y / 4) % 2) ? 0.8f : 0.2f;
+            for (int c = 0; c < 3; c++) {
+                *at(&b.albedo, x, y, c) = albedo;
+                *at(&b.colour, x, y, c) = albedo * (float)(1.0 + 0.1 * random_normal(&random));
+            }
+        }
+    /* Light cells against dark cells, and the noise of the light, before and after. */
+    double light_before = 0, dark_before = 0, light_after = 0, dark_after = 0, noise_before = 0, noise_after = 0;
+    double worst = 0;
+    rt_image before = make_image(SIZE, SIZE, 3, 0.0f);
+    memcpy(before.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
+    assert_int_equal(denoise(&b, &options), RT_OK);
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            float albedo = *at(&b.albedo, x, y, 0);
+            double v0 = *at(&before, x, y, 0), v1 = *at(&b.colour, x, y, 0);
+            if (albedo > 0.5f) {
+                light_before += v0;
+                light_after += v1;
+            } else {
+                dark_before += v0;
+                dark_after += v1;
+            }
+            noise_before += (v0 / albedo - 1) * (v0 / albedo - 1);
+            noise_after += (v1 / albedo - 1) * (v1 / albedo - 1);
+            worst = fmax(worst, fabs(v1 / albedo - 1));
+        }
+    double contrast_before = light_before / dark_before, contrast_after = light_after / dark_after;
+    print_message("denoise checker: contrast %.4f -> %.4f (true 4), lighting variance %.0fx lower, "
+                  "worst pixel %.2f%% off\n", contrast_before, contrast_after, noise_before / noise_after, 100 * worst);
+    assert_relative(contrast_after, 4.0, 0.02);
+    assert_true(noise_after * 5 <= noise_before);
+    /* Every pixel within 5% of its cell's true value: no cell bleeds into its neighbours. */
+    assert_true(worst < 0.05);
+    image_free(&before);
+
+    /* Without the albedo image the same noise blurs the checker: the test can fail. */
+    options.sigma_colour = 1e9f;
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, &b.normal, &b.depth, &options, NULL), RT_OK);
+    light_after = dark_after = 0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++)
+            *(((x / 4 + y / 4) % 2) ? &light_after : &dark_after) += *at(&b.colour, x, y, 0);
+    assert_true(light_after / dark_after < 3.0);
+    free_buffers(&b);
+}
+
+static void test_denoise_keeps_other_channels(void **state)
+{
+    (void)state;
+    buffers b = make_flat(0.5f, 0.1f, 8);
+    rt_image rgba = make_image(SIZE, SIZE, 4, 7.0f);
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++)
+            for (int c = 0; c < 3; c++)
+                *at(&rgba, x, y, c) = *at(&b.colour, x, y, c);
+    rt_error error;
+    assert_int_equal(postprocess_denoise(&rgba, &b.albedo, &b.normal, &b.depth, NULL, &error), RT_OK);
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++)
+            assert_close(*at(&rgba, x, y, 3), 7.0, 0);
+    image_free(&rgba);
+    free_buffers(&b);
+}
+
+static void test_denoise_rejects_bad_input(void **state)
+{
+    (void)state;
+    buffers b = make_flat(0.5f, 0.1f, 3);
+    rt_image small = make_image(SIZE, SIZE - 1, 3, 1.0f);
+    rt_image grey = make_image(SIZE, SIZE, 1, 1.0f);
+    rt_error error;
+    assert_int_equal(postprocess_denoise(&b.colour, &small, NULL, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "albedo"));
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, &small, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "normal"));
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, &small, NULL, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "depth"));
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, &grey, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_denoise(&grey, NULL, NULL, NULL, NULL, &error), RT_ERROR_INPUT);
+    postprocess_denoise_options options = postprocess_denoise_options_defaults();
+    options.sigma_normal = -1;
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, &options, &error), RT_ERROR_INPUT);
+    options = postprocess_denoise_options_defaults();
+    options.iterations = POSTPROCESS_MAX_DENOISE_ITERATIONS + 1;
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, &options, &error), RT_ERROR_INPUT);
+    *at(&b.colour, 3, 5, 1) = NAN;
+    rt_image copy = make_image(SIZE, SIZE, 3, 0.0f);
+    memcpy(copy.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "NaN at pixel (3, 5)"));
+    /* Nothing changed on failure. */
+    assert_memory_equal(copy.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
+    image_free(&copy);
+    image_free(&small);
+    image_free(&grey);
+    free_buffers(&b);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Tone mapping                                                                         */
+
+static void test_tonemap_reinhard_of_one_is_a_half(void **state)
+{
+    (void)state;
+    rt_image image = make_image(1, 1, 3, 1.0f);
+    rt_error error;
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_REINHARD, 0.0f, &error), RT_OK);
+    for (int c = 0; c < 3; c++)
+        assert_close(image.pixels[c], 0.5, 1e-6);
+    /* Exposure first: 0.5 at +1 stop is 1, then 0.5. */
+    image.pixels[0] = image.pixels[1] = image.pixels[2] = 0.5f;
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_REINHARD, 1.0f, &error), RT_OK);
+    assert_close(image.pixels[1], 0.5, 1e-6);
+    image_free(&image);
+}
+
+static void test_tonemap_curves_are_monotonic_and_bounded(void **state)
+{
+    (void)state;
+    enum { STEPS = 2001 };
+    postprocess_tonemap_operator operators[] = {TONEMAP_REINHARD, TONEMAP_ACES};
+    for (int o = 0; o < 2; o++) {
+        rt_image ramp = make_image(STEPS, 1, 3, 0.0f);
+        for (int i = 0; i < STEPS; i++)
+            for (int c = 0; c < 3; c++)
+                *at(&ramp, i, 0, c) = 1e-3f * (float)i * (float)i / 40.0f;  /* 0 .. 100, denser near 0 */
+        rt_error error;
+        assert_int_equal(postprocess_tonemap(&ramp, operators[o], 0.0f, &error), RT_OK);
+        for (int i = 0; i < STEPS; i++) {
+            float v = *at(&ramp, i, 0, 0);
+            assert_true(v >= 0.0f && v <= 1.0f);
+            if (i > 0)
+                assert_true(v >= *at(&ramp, i - 1, 0, 0));
+        }
+        /* Strictly rising over the highlights too (x 1.56 against 6.25), not flat from 1 on. */
+        assert_true(*at(&ramp, STEPS / 4, 0, 0) > *at(&ramp, STEPS / 8, 0, 0));
+        image_free(&ramp);
+    }
+}
+
+static void test_tonemap_aces_values(void **state)
+{
+    (void)state;
+    rt_image image = make_image(5, 1, 3, 0.0f);
+    float inputs[5] = {0.0f, 1.0f, 1e6f, -2.0f, INFINITY};
+    for (int x = 0; x < 5; x++)
+        for (int c = 0; c < 3; c++)
+            *at(&image, x, 0, c) = inputs[x];
+    *at(&image, 3, 0, 1) = NAN;
+    rt_error error;
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_ACES, 0.0f, &error), RT_OK);
+    assert_close(*at(&image, 0, 0, 0), 0.0, 1e-6);
+    assert_close(*at(&image, 1, 0, 0), 2.54 / 3.16, 1e-6);  /* 0.8038: the fit is pre-exposed */
+    assert_close(*at(&image, 2, 0, 0), 1.0, 1e-6);
+    assert_close(*at(&image, 3, 0, 0), 0.0, 0);
+    assert_close(*at(&image, 3, 0, 1), 0.0, 0);
+    assert_close(*at(&image, 4, 0, 2), 1.0, 0);
+    image_free(&image);
+}
+
+static void test_tonemap_reinhard_keeps_colour_ratios(void **state)
+{
+    (void)state;
+    rt_image image = make_image(2, 1, 4, 0.5f);
+    float *dim = at(&image, 0, 0, 0), *bright = at(&image, 1, 0, 0);
+    dim[0] = 0.4f, dim[1] = 0.2f, dim[2] = 0.1f;
+    bright[0] = 0.0f, bright[1] = 0.0f, bright[2] = 100.0f;  /* luminance 7.2: B would pass 1 */
+    rt_error error;
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_REINHARD, 0.0f, &error), RT_OK);
+    assert_close(dim[0] / dim[1], 2.0, 1e-5);
+    assert_close(dim[1] / dim[2], 2.0, 1e-5);
+    double luminance = 0.2126 * 0.4 + 0.7152 * 0.2 + 0.0722 * 0.1;
+    assert_close(0.2126 * dim[0] + 0.7152 * dim[1] + 0.0722 * dim[2], luminance / (1 + luminance), 1e-6);
+    assert_close(bright[2], 1.0, 1e-6);
+    assert_close(bright[0], 0.0, 0);
+    assert_close(*at(&image, 0, 0, 3), 0.5, 0);  /* alpha untouched */
+    image_free(&image);
+}
+
+static void test_tonemap_clamp_only_exposes(void **state)
+{
+    (void)state;
+    rt_image image = make_image(1, 1, 3, 3.0f);
+    rt_error error;
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_CLAMP, -1.0f, &error), RT_OK);
+    assert_close(image.pixels[0], 1.5, 1e-6);
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_CLAMP, 2.0f, &error), RT_OK);
+    assert_close(image.pixels[2], 6.0, 1e-6);  /* the 8-bit writer clamps, not this */
+    assert_int_equal(postprocess_tonemap(&image, (postprocess_tonemap_operator)7, 0.0f, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_ACES, NAN, &error), RT_ERROR_INPUT);
+    image_free(&image);
+}
+
+/* A two-channel image is grey + alpha: only the grey channel is blurred or tone-mapped. */
+static void test_grey_alpha_keeps_alpha(void **state)
+{
+    (void)state;
+    rt_image image = make_image(6, 5, 2, 0.0f);
+    for (int y = 0; y < 5; y++)
+        for (int x = 0; x < 6; x++) {
+            *at(&image, x, y, 0) = (x + y) % 2 ? 1.0f : 3.0f;
+            *at(&image, x, y, 1) = 0.1f * (float)x;
+        }
+    rt_error error;
+    assert_int_equal(postprocess_gaussian_blur(&image, 1.0f, 1, &error), RT_OK);
+    assert_close(region_mean(&image, 0, 0, 0, 6, 5), 2.0, 1e-5);
+    assert_true(*at(&image, 2, 2, 0) < 2.5f);
+    assert_int_equal(postprocess_tonemap(&image, TONEMAP_REINHARD, 0.0f, &error), RT_OK);
+    for (int y = 0; y < 5; y++)
+        for (int x = 0; x < 6; x++) {
+            float grey = *at(&image, x, y, 0);
+            assert_true(grey > 0.5f && grey < 0.75f);  /* 1/(1+1) .. 3/(1+3) */
+            assert_close(*at(&image, x, y, 1), 0.1f * (float)x, 0);
+        }
+    image_free(&image);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Montage                                                                              */
+
+/* count 3x2 tiles; tile i is filled with (i + 1, 10 (i + 1), 100 (i + 1)), plus an alpha
+ * channel that must not reach the sheet. */
+static void make_tiles(rt_image *tiles, int count)
+{
+    for (int i = 0; i < count; i++) {
+        tiles[i] = make_image(3, 2, 4, 0.0f);
+        for (int y = 0; y < 2; y++)
+            for (int x = 0; x < 3; x++) {
+                *at(&tiles[i], x, y, 0) = (float)(i + 1);
+                *at(&tiles[i], x, y, 1) = 10.0f * (i + 1);
+                *at(&tiles[i], x, y, 2) = 100.0f * (i + 1);
+                *at(&tiles[i], x, y, 3) = -1.0f;
+            }
+    }
+}
+
+/* The index of the tile whose colour (x, y) of sheet holds, -1 for black. */
+static int tile_at(const rt_image *sheet, int x, int y)
+{
+    float r = *at(sheet, x, y, 0);
+    if (r == 0.0f) {
+        assert_close(*at(sheet, x, y, 1), 0, 0);
+        assert_close(*at(sheet, x, y, 2), 0, 0);
+        return -1;
+    }
+    assert_close(*at(sheet, x, y, 1), 10 * r, 0);
+    assert_close(*at(sheet, x, y, 2), 100 * r, 0);
+    return (int)r - 1;
+}
+
+static void test_montage_layout(void **state)
+{
+    (void)state;
+    rt_image tiles[5];
+    make_tiles(tiles, 5);
+    rt_image sheet;
+    rt_error error;
+    /* 5 tiles in 2 columns with a 1-pixel gap: 3 rows; 2*3+1 = 7 wide, 3*2+2 = 8 high.
+     *   row 0: tiles 0 1     x 0..2 and 4..6, y 0..1
+     *   row 1: tiles 2 3     y 3..4
+     *   row 2: tile 4, then black
+     * Gaps: column x = 3, rows y = 2 and 5. */
+    assert_int_equal(postprocess_montage(tiles, 5, 2, 1, &sheet, &error), RT_OK);
+    assert_int_equal(sheet.width, 7);
+    assert_int_equal(sheet.height, 8);
+    assert_int_equal(sheet.channels, 3);
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 7; x++) {
+            int expected = -1;
+            if (x != 3 && y != 2 && y != 5)
+                expected = (y / 3) * 2 + (x / 4);
+            if (expected == 5)
+                expected = -1;  /* the empty last cell */
+            assert_int_equal(tile_at(&sheet, x, y), expected);
+        }
+    image_free(&sheet);
+
+    /* Default columns: ceil(sqrt(5)) = 3, no gap: 9x4, tiles 0 1 2 / 3 4 -. */
+    assert_int_equal(postprocess_montage(tiles, 5, 0, 0, &sheet, &error), RT_OK);
+    assert_int_equal(sheet.width, 9);
+    assert_int_equal(sheet.height, 4);
+    assert_int_equal(tile_at(&sheet, 8, 1), 2);
+    assert_int_equal(tile_at(&sheet, 2, 2), 3);
+    assert_int_equal(tile_at(&sheet, 3, 2), 4);
+    assert_int_equal(tile_at(&sheet, 6, 3), -1);
+    image_free(&sheet);
+
+    /* More columns than images: one row, no empty cells. */
+    assert_int_equal(postprocess_montage(tiles, 2, 10, 2, &sheet, &error), RT_OK);
+    assert_int_equal(sheet.width, 8);
+    assert_int_equal(sheet.height, 2);
+    assert_int_equal(tile_at(&sheet, 7, 1), 1);
+    image_free(&sheet);
+
+    /* One image: the image itself (colour channels). */
+    assert_int_equal(postprocess_montage(tiles, 1, 0, 5, &sheet, &error), RT_OK);
+    assert_int_equal(sheet.width, 3);
+    assert_int_equal(sheet.height, 2);
+    image_free(&sheet);
+    for (int i = 0; i < 5; i++)
+        image_free(&tiles[i]);
+}
+
+static void test_montage_grey_images(void **state)
+{
+    (void)state;
+    rt_image grey[2] = {make_image(2, 2, 1, 0.25f), make_image(2, 2, 1, 0.75f)};
+    rt_image sheet;
+    rt_error error;
+    assert_int_equal(postprocess_montage(grey, 2, 1, 0, &sheet, &error), RT_OK);
+    assert_int_equal(sheet.width, 2);
+    assert_int_equal(sheet.height, 4);
+    for (int c = 0; c < 3; c++) {
+        assert_close(*at(&sheet, 1, 1, c), 0.25, 0);
+        assert_close(*at(&sheet, 0, 2, c), 0.75, 0);
+    }
+    image_free(&sheet);
+    image_free(&grey[0]);
+    image_free(&grey[1]);
+}
+
+static void test_montage_rejects_bad_input(void **state)
+{
+    (void)state;
+    rt_image tiles[3];
+    make_tiles(tiles, 2);
+    tiles[2] = make_image(4, 2, 3, 1.0f);
+    rt_image sheet;
+    rt_error error;
+    assert_int_equal(postprocess_montage(tiles, 3, 0, 0, &sheet, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "image 3 is 4x2, image 1 is 3x2"));
+    assert_null(sheet.pixels);
+    assert_int_equal(postprocess_montage(tiles, 0, 0, 0, &sheet, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_montage(tiles, 2, -1, 0, &sheet, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_montage(tiles, 2, 0, -1, &sheet, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_montage(tiles, 2, 2, 1 << 30, &sheet, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "a side"));
+    for (int i = 0; i < 3; i++)
+        image_free(&tiles[i]);
+}
+
+static void test_defaults_are_zero(void **state)
+{
+    (void)state;
+    postprocess_denoise_options options = postprocess_denoise_options_defaults();
+    assert_int_equal(options.iterations, 0);
+    assert_close(options.sigma_colour, 0, 0);
+    assert_close(options.sigma_normal, 0, 0);
+    assert_close(options.sigma_depth, 0, 0);
+    assert_close(options.sigma_albedo, 0, 0);
+    assert_close(options.albedo_epsilon, 0, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_blur_keeps_a_constant_image),
+        cmocka_unit_test(test_blur_keeps_the_mean_and_reduces_noise),
+        cmocka_unit_test(test_blur_wider_than_the_image_keeps_the_mean),
+        cmocka_unit_test(test_blur_zero_sigma_or_passes_is_a_no_op),
+        cmocka_unit_test(test_blur_rejects_bad_arguments),
+        cmocka_unit_test(test_denoise_smooths_a_flat_noisy_region),
+        cmocka_unit_test(test_denoise_without_guides_still_smooths),
+        cmocka_unit_test(test_denoise_keeps_an_edge_between_normals),
+        cmocka_unit_test(test_denoise_keeps_an_edge_between_depths),
+        cmocka_unit_test(test_denoise_guides_alone_hold_an_edge),
+        cmocka_unit_test(test_denoise_keeps_sky_and_surface_apart),
+        cmocka_unit_test(test_denoise_smooths_a_tilted_plane),
+        cmocka_unit_test(test_denoise_demodulation_keeps_a_texture),
+        cmocka_unit_test(test_denoise_keeps_other_channels),
+        cmocka_unit_test(test_denoise_rejects_bad_input),
+        cmocka_unit_test(test_tonemap_reinhard_of_one_is_a_half),
+        cmocka_unit_test(test_tonemap_curves_are_monotonic_and_bounded),
+        cmocka_unit_test(test_tonemap_aces_values),
+        cmocka_unit_test(test_tonemap_reinhard_keeps_colour_ratios),
+        cmocka_unit_test(test_tonemap_clamp_only_exposes),
+        cmocka_unit_test(test_grey_alpha_keeps_alpha),
+        cmocka_unit_test(test_montage_layout),
+        cmocka_unit_test(test_montage_grey_images),
+        cmocka_unit_test(test_montage_rejects_bad_input),
+        cmocka_unit_test(test_defaults_are_zero),
+    };
+    return cmocka_run_group_tests_name("postprocess", tests, NULL, NULL);
+}
