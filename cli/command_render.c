@@ -19,6 +19,7 @@
 #include "commands.h"
 #include "gpu.h"
 #include "image_io.h"
+#include "postprocess.h"
 #include "render.h"
 #include "scene_assets.h"
 #include "scene_parse.h"
@@ -64,6 +65,11 @@ static void print_help(FILE *stream)
             "                         soft shadows from area lights: fast, nearly noise-free\n"
             "      --aovs             add layers to the EXR: albedo, normal, depth (first hit) and\n"
             "                         per-pixel variance of luminance, next to R, G, B, samples\n"
+            "      --denoise          edge-aware a-trous denoiser guided by albedo, normal and depth\n"
+            "                         (an EXR keeps the noisy image as noisy.R/G/B)\n"
+            "      --blur SIGMA[:N]   Gaussian blur of SIGMA pixels, N times (the seed's blurNum);\n"
+            "                         off by default\n"
+            "      --tonemap OP       for 8-bit outputs: clamp (default), reinhard or aces\n"
             "      --light-sampling on|off  sample lights at diffuse hits (next-event\n"
             "                         estimation with MIS; default on): less noise, same image\n"
             "      --roulette-depth N paths may end at random (Russian roulette, unbiased)\n"
@@ -110,6 +116,10 @@ typedef struct render_request {
     bool no_light_sampling;
     render_integrator integrator;
     bool aovs;
+    bool denoise;
+    float blur_sigma;            /* 0: no blur */
+    int blur_passes;
+    postprocess_tonemap_operator tonemap;
     const char *resume_path;     /* NULL: start afresh */
 } render_request;
 
@@ -227,6 +237,7 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
         OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
         OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
+        OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP,
     };
     static const struct option long_options[] = {
         {"output", required_argument, NULL, 'o'},
@@ -250,6 +261,9 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
         {"aovs", no_argument, NULL, OPTION_AOVS},
+        {"denoise", no_argument, NULL, OPTION_DENOISE},
+        {"blur", required_argument, NULL, OPTION_BLUR},
+        {"tonemap", required_argument, NULL, OPTION_TONEMAP},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -326,6 +340,31 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
             break;
         case OPTION_AOVS:
             request->aovs = true;
+            break;
+        case OPTION_DENOISE:
+            request->denoise = true;
+            break;
+        case OPTION_BLUR: {
+            char extra;
+            float sigma = 0;
+            int passes = 1;
+            int read = sscanf(optarg, "%f:%d%c", &sigma, &passes, &extra);
+            if ((read != 1 && read != 2) || !(sigma > 0) || sigma > POSTPROCESS_MAX_BLUR_SIGMA || passes < 1
+                || passes > 100)
+                complaint = "--blur wants SIGMA or SIGMA:PASSES, e.g. 1.5 or 1:3 (sigma in pixels, > 0)";
+            request->blur_sigma = sigma;
+            request->blur_passes = passes;
+            break;
+        }
+        case OPTION_TONEMAP:
+            if (strcmp(optarg, "clamp") == 0)
+                request->tonemap = TONEMAP_CLAMP;
+            else if (strcmp(optarg, "reinhard") == 0)
+                request->tonemap = TONEMAP_REINHARD;
+            else if (strcmp(optarg, "aces") == 0)
+                request->tonemap = TONEMAP_ACES;
+            else
+                complaint = "--tonemap wants clamp, reinhard or aces";
             break;
         case OPTION_INTEGRATOR:
             if (strcmp(optarg, "path") == 0)
@@ -564,7 +603,8 @@ static rt_status write_render(const render_job *job, const rt_image *image, cons
         {.name = "rtspheres:render_seconds", .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = result->seconds},
     };
     image_write_options write_options = image_write_options_defaults();
-    write_options.exposure = (float)job->request->exposure;
+    /* With a tone-mapping operator the exposure was applied before it. */
+    write_options.exposure = job->request->tonemap != TONEMAP_CLAMP ? 0.0f : (float)job->request->exposure;
     write_options.attributes = attributes;
     write_options.attribute_count = (int)(sizeof attributes / sizeof attributes[0]);
     rt_status status = image_write(path, &colour, &write_options, error);
@@ -629,6 +669,74 @@ static int load_resume(const char *path, const scene *s, long long sample_start,
     }
     *scene_hash = strtoull(hash, NULL, 16);
     return EXIT_OK;
+}
+
+/* Copies channels [first, first + count) of image into a new image (*out; the caller
+ * frees it). */
+static rt_status copy_channels(const rt_image *image, int first, int count, rt_image *out, rt_error *error)
+{
+    rt_status status = image_create(out, image->width, image->height, count, error);
+    if (status != RT_OK)
+        return status;
+    size_t pixels = (size_t)image->width * image->height;
+    for (size_t i = 0; i < pixels; i++)
+        for (int c = 0; c < count; c++)
+            out->pixels[i * count + c] = image->pixels[i * image->channels + first + c];
+    return RT_OK;
+}
+
+/* Applies --denoise, --blur and --tonemap to the result's colour (R, G, B of a
+ * 4-channel image), in that order. With --denoise the noisy colour joins the AOVs as
+ * noisy.R/G/B, so an EXR keeps it. Tone mapping applies to 8-bit outputs only. */
+static rt_status postprocess_result(const render_request *request, const char *output, render_result *result,
+                                    rt_error *error)
+{
+    bool eight_bit = strcasecmp(extension_of(output), ".exr") != 0 && strcasecmp(extension_of(output), ".hdr") != 0;
+    bool tonemap = eight_bit && request->tonemap != TONEMAP_CLAMP;
+    if (!request->denoise && request->blur_sigma <= 0 && !tonemap)
+        return RT_OK;
+    rt_image colour, albedo = {0}, normal = {0}, depth = {0}, noisy = {0}, joined = {0};
+    rt_status status = copy_channels(&result->image, 0, 3, &colour, error);
+    if (status == RT_OK && request->denoise) {
+        status = copy_channels(&result->image, 0, 3, &noisy, error);
+        if (status == RT_OK)
+            status = copy_channels(&result->aovs, 0, 3, &albedo, error);
+        if (status == RT_OK)
+            status = copy_channels(&result->aovs, 3, 3, &normal, error);
+        if (status == RT_OK)
+            status = copy_channels(&result->aovs, 6, 1, &depth, error);
+        if (status == RT_OK)
+            status = postprocess_denoise(&colour, &albedo, &normal, &depth, NULL, error);
+        if (status == RT_OK) {
+            static const char *const names[3] = {"noisy.R", "noisy.G", "noisy.B"};
+            for (int c = 0; c < 3; c++)
+                snprintf(noisy.channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", names[c]);
+            status = image_append_channels(&result->aovs, &noisy, &joined, error);
+        }
+        if (status == RT_OK) {
+            image_free(&result->aovs);
+            result->aovs = joined;
+            joined = (rt_image){0};
+        }
+    }
+    if (status == RT_OK && request->blur_sigma > 0)
+        status = postprocess_gaussian_blur(&colour, request->blur_sigma, request->blur_passes, error);
+    /* The writer's exposure would apply a second time after tone mapping: done here. */
+    if (status == RT_OK && tonemap)
+        status = postprocess_tonemap(&colour, request->tonemap, (float)request->exposure, error);
+    if (status == RT_OK) {
+        size_t pixels = (size_t)colour.width * colour.height;
+        for (size_t i = 0; i < pixels; i++)
+            for (int c = 0; c < 3; c++)
+                result->image.pixels[4 * i + c] = colour.pixels[3 * i + c];
+    }
+    image_free(&colour);
+    image_free(&albedo);
+    image_free(&normal);
+    image_free(&depth);
+    image_free(&noisy);
+    image_free(&joined);
+    return status;
 }
 
 /* Renders one image (one frame, or the only image) on context and writes it to output.
@@ -701,7 +809,7 @@ static int render_frame(gpu_context *context, const render_request *request, int
     options.russian_roulette_depth = (uint32_t)request->roulette_depth;
     options.no_light_sampling = request->no_light_sampling;
     options.integrator = request->integrator;
-    options.aovs = request->aovs;
+    options.aovs = request->aovs || request->denoise;
 
     int region[4] = {0, 0, s.render.width, s.render.height};
     if (options.region[2] > 0)
@@ -746,6 +854,15 @@ static int render_frame(gpu_context *context, const render_request *request, int
         return exit_code_for_status(status);
     }
     rt_status render_status = status;
+    status = postprocess_result(request, output, &result, &error);
+    if (status != RT_OK) {
+        fprintf(stderr, "rtspheres render: %s\n", error.message);
+        image_free(&result.image);
+        image_free(&result.aovs);
+        image_free(&resume_image);
+        scene_free(&s);
+        return exit_code_for_status(status);
+    }
 
     int exit_code = EXIT_OK;
     if (render_status == RT_ERROR_INTERRUPTED) {
@@ -770,12 +887,12 @@ static int render_frame(gpu_context *context, const render_request *request, int
                 uint64_t geometry_bytes = result.packed_bytes - result.image_bytes;
                 fprintf(stderr,
                         "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights; BVH depth %d, "
-                        "built in %.3f s; packed %llu bytes (%.1f per triangle without images); first pass done "
-                        "%.3f s after start (context, parse, BVH, upload, compile)\n",
+                        "built in %.3f s; packed %llu bytes (%.1f per triangle without images)%s; first pass "
+                        "done %.3f s after start (context, parse, BVH, upload, compile)\n",
                         result.primitive_count, result.triangle_count, result.instance_count, result.light_count,
                         result.bvh_depth, result.bvh_build_seconds, (unsigned long long)result.packed_bytes,
                         result.triangle_count ? (double)geometry_bytes / result.triangle_count : 0.0,
-                        progress.first_pass);
+                        result.reused_scene ? ", already on the device" : "", progress.first_pass);
             }
             if (!request->quiet)
                 fprintf(stderr,
@@ -786,6 +903,7 @@ static int render_frame(gpu_context *context, const render_request *request, int
         }
     }
     image_free(&result.image);
+    image_free(&result.aovs);
     image_free(&resume_image);
     scene_free(&s);
     return exit_code;

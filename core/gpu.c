@@ -26,6 +26,13 @@ struct gpu_context {
     EGLContext context;
     gpu_info info;
     gpu_options options;
+    /* Kept between renders on this context (frames of an animation, a sweep): the
+     * compiled tracer, and the last packed scene uploaded with its hash. */
+    GLuint tracer_program;
+    GLuint packed_texture;
+    int packed_width_log2;
+    uint64_t packed_hash;
+    uint32_t packed_texel_count;
 };
 
 struct gpu_tracer {
@@ -40,6 +47,7 @@ struct gpu_tracer {
     GLuint counter_buffer;
     int current;                 /* which state set holds the latest pass */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
+    bool reused_scene;           /* the packed scene was already on the device */
 };
 
 gpu_options gpu_options_defaults(void)
@@ -291,6 +299,10 @@ void gpu_destroy(gpu_context *context)
 {
     if (context == NULL)
         return;
+    if (context->tracer_program)
+        glDeleteProgram(context->tracer_program);
+    if (context->packed_texture)
+        glDeleteTextures(1, &context->packed_texture);
     eglMakeCurrent(context->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(context->display, context->context);
     eglTerminate(context->display);
@@ -383,10 +395,26 @@ static GLuint build_tracer_program(const char *defines, rt_error *error)
     return link_program(vertex, fragment, error);
 }
 
+/* The context's tracer program, compiled on first use and kept. */
 static rt_status build_program(gpu_tracer *tracer, rt_error *error)
 {
-    tracer->program = build_tracer_program("", error);
+    gpu_context *context = tracer->context;
+    if (context->tracer_program == 0)
+        context->tracer_program = build_tracer_program("", error);
+    tracer->program = context->tracer_program;
     return tracer->program ? RT_OK : RT_ERROR_RUNTIME;
+}
+
+/* FNV-1a over the packed texels: tells an unchanged scene between frames. */
+static uint64_t hash_texels(const uint32_t *texels, uint32_t texel_count)
+{
+    uint64_t hash = 0xcbf29ce484222325ull;
+    const uint32_t *end = texels + (size_t)texel_count * 4;
+    for (const uint32_t *p = texels; p < end; p++) {
+        hash ^= *p;
+        hash *= 0x100000001b3ull;
+    }
+    return hash;
 }
 
 /* Uploads the packed scene into a square-ish RGBA32UI texture whose width is a power of
@@ -557,8 +585,25 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->width = parameters->width;
     tracer->height = parameters->height;
     rt_status status = build_program(tracer, error);
-    if (status == RT_OK)
+    uint64_t hash = hash_texels(packed_texels, texel_count);
+    if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == hash
+        && context->packed_texel_count == texel_count) {
+        tracer->packed_texture = context->packed_texture;
+        tracer->packed_width_log2 = context->packed_width_log2;
+        tracer->reused_scene = true;
+    } else if (status == RT_OK) {
+        if (context->packed_texture != 0) {
+            glDeleteTextures(1, &context->packed_texture);
+            context->packed_texture = 0;
+        }
         status = upload_packed_scene(tracer, packed_texels, texel_count, error);
+        if (status == RT_OK) {
+            context->packed_texture = tracer->packed_texture;
+            context->packed_width_log2 = tracer->packed_width_log2;
+            context->packed_hash = hash;
+            context->packed_texel_count = texel_count;
+        }
+    }
     if (status == RT_OK)
         status = create_state(tracer, error);
     if (status == RT_OK && parameters->resume != NULL)
@@ -710,6 +755,11 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
     return check_gl("the AOV pass", error);
 }
 
+bool gpu_tracer_reused_scene(const gpu_tracer *tracer)
+{
+    return tracer->reused_scene;
+}
+
 void gpu_tracer_destroy(gpu_tracer *tracer)
 {
     if (tracer == NULL)
@@ -718,10 +768,11 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
         glDeleteTextures(STATE_TARGET_COUNT, tracer->state_textures[set]);
         glDeleteFramebuffers(1, &tracer->framebuffers[set]);
     }
-    glDeleteTextures(1, &tracer->packed_texture);
+    /* The program and the packed scene belong to the context (kept for the next frame). */
+    if (tracer->packed_texture != tracer->context->packed_texture)
+        glDeleteTextures(1, &tracer->packed_texture);
     glDeleteBuffers(1, &tracer->counter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);
-    glDeleteProgram(tracer->program);
     free(tracer);
 }
 

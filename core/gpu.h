@@ -109,7 +109,8 @@ typedef struct gpu_tracer_totals {
 
 typedef struct gpu_tracer gpu_tracer;
 
-/* Compiles the tracer, uploads the packed scene (texel_count texels of 4 uint32 each,
+/* Compiles the tracer (once per context), uploads the packed scene (unless the context
+ * already holds exactly these texels) (texel_count texels of 4 uint32 each,
  * see packed_layout.h) and creates the state textures for parameters->width x height.
  * Too large for the device (texture size, memory) is RT_ERROR_INPUT saying which limit.
  * Free with gpu_tracer_destroy(). */
@@ -140,7 +141,13 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
 rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_depth, float *normal_coverage,
                                  rt_error *error);
 
-/* Frees the tracer's GL objects. NULL is ignored. */
+/* True when gpu_tracer_create() found the same packed scene already uploaded on the
+ * context (frames of an animation whose scene did not change) and did not upload it. The
+ * compiled tracer program is always kept by the context between tracers. */
+bool gpu_tracer_reused_scene(const gpu_tracer *tracer);
+
+/* Frees the tracer's GL objects (not the context's program and packed scene). NULL is
+ * ignored. */
 void gpu_tracer_destroy(gpu_tracer *tracer);
 
 /* ---- tests ------------------------------------------------------------------------ */

@@ -263,6 +263,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     free(sums);
     if (status != RT_OK)
         return status;
+    result->reused_scene = gpu_tracer_reused_scene(tracer);
 
     render_progress progress = {
         .samples_total = (uint64_t)width * height * s->render.samples_per_pixel,

@@ -92,6 +92,7 @@ typedef struct render_result {
     uint64_t image_bytes;        /* of which image pixels */
     uint32_t triangle_count;     /* triangles stored (a mesh once however often placed) */
     uint32_t primitive_count, instance_count, light_count;
+    bool reused_scene;           /* the device already held this packed scene (frames) */
     uint64_t scene_hash;         /* FNV-1a of what decides the image apart from the samples:
                                   * packed scene, camera, sky, full size, max depth. Parts of
                                   * one render share it; `merge` refuses mixed hashes. */

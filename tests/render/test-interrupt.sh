@@ -104,7 +104,9 @@ wait "$pid" 2>/dev/null
 
 # A second signal ends the render at once (the default action): death by SIGINT.
 # shellcheck disable=SC2086
-"$program" render $scene -o "$scratch/twice.exr" --size 64x36 --spp 100000 --checkpoint 0.2 --quiet &
+# Long passes (a fixed large budget): the first signal must still be waiting for its pass
+# to end when the second one comes.
+"$program" render $scene -o "$scratch/twice.exr" --size 64x36 --spp 100000 --checkpoint 0.2 --pass-budget 50000 --quiet &
 pid=$!
 wait_for_file "$scratch/twice.partial.exr"
 kill -s INT "$pid"
