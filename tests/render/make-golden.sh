@@ -8,9 +8,9 @@ program=$1
 here=$(dirname "$0")
 . "$here/golden-options.sh"
 mkdir -p golden
-grep -v '^#' "$here/golden-scenes.txt" | while read -r name scene; do
+grep -v '^#' "$here/golden-scenes.txt" | while read -r name scene extra; do
     [ -n "$name" ] || continue
     # shellcheck disable=SC2086
-    "$program" render "$scene" -o "golden/$name.exr" $golden_render_options
+    "$program" render "$scene" -o "golden/$name.exr" $golden_render_options $extra
     echo "golden: golden/$name.exr from $scene"
 done

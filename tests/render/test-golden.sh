@@ -15,7 +15,7 @@ here=$(dirname "$0")
 diff_dir=${RTSPHERES_DIFF_DIR:-$scratch}
 mkdir -p "$diff_dir"
 grep -v '^#' "$here/golden-scenes.txt" | {
-    while read -r name scene; do
+    while read -r name scene extra; do
         [ -n "$name" ] || continue
         out="$scratch/$name.exr"
         if [ ! -f "golden/$name.exr" ]; then
@@ -23,7 +23,7 @@ grep -v '^#' "$here/golden-scenes.txt" | {
             continue
         fi
         # shellcheck disable=SC2086
-        if ! "$program" render "$scene" -o "$out" $golden_render_options; then
+        if ! "$program" render "$scene" -o "$out" $golden_render_options $extra; then
             fail "golden $name" "render of $scene failed"
             continue
         fi
