@@ -400,6 +400,10 @@ enum class transfer { linear, srgb, rec709, gamma };
  * image_read_linear() in image_io.h); *gamma is set for transfer::gamma. */
 transfer transfer_of(const OIIO::ImageSpec &spec, float *gamma)
 {
+    /* Floating-point pixels hold light itself, whatever the label: OpenImageIO calls
+     * every PFM "Rec709", and decoding a value of 2000 with a display curve gives 2e7. */
+    if (spec.format.is_floating_point())
+        return transfer::linear;
     std::string space = spec.get_string_attribute("oiio:ColorSpace");
     const char *name = space.c_str();
     if (strcasecmp(name, "sRGB") == 0)

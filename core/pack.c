@@ -344,8 +344,9 @@ static rt_status collect(packer *p, rt_error *error)
         if (instance->object < 0 || instance->object >= s->object_count)
             return rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d names object %d of %d", i, instance->object,
                                 s->object_count);
-        const scene_object *object = &s->objects[instance->object];
-        bool copy_in = !instance->volume && object->mesh < 0 && is_identity(instance->object_to_world);
+        /* Identity placements join the top level, meshes too: their emissive triangles
+         * then become lights (instanced ones are found by BSDF sampling only). */
+        bool copy_in = !instance->volume && is_identity(instance->object_to_world);
         p->instance_of_scene[i] = PACKED_NONE;
         if (copy_in) {
             rt_status status = add_object_primitives(p, instance->object, instance->material, &p->top.primitives, error);
@@ -454,8 +455,19 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             light_count++;
     }
     light_count += (uint32_t)s->light_count;
+    /* An equirectangular environment is a light too, importance-sampled by luminance. */
+    const scene_image *environment = NULL;
+    if (s->sky.type == SKY_ENVIRONMENT && s->sky.environment >= 0 && s->sky.environment < s->image_count
+        && s->images[s->sky.environment].pixels != NULL)
+        environment = &s->images[s->sky.environment];
+    uint64_t environment_texels = 0;
+    if (environment != NULL) {
+        light_count++;
+        environment_texels = (uint64_t)environment->height * (1 + (uint64_t)environment->width);
+    }
     uint64_t light_offset = image_offset + (uint64_t)s->image_count * PACKED_IMAGE_STRIDE;
-    uint64_t pixel_offset = light_offset + (uint64_t)light_count * PACKED_LIGHT_STRIDE;
+    uint64_t environment_offset = light_offset + (uint64_t)light_count * PACKED_LIGHT_STRIDE;
+    uint64_t pixel_offset = environment_offset + environment_texels;
     uint64_t texel_count = pixel_offset + image_pixels;
     if (texel_count > UINT32_MAX / 4) {
         status = rt_error_set(error, RT_ERROR_INPUT, "PACK: the scene needs %llu texels, more than 32-bit indices reach",
@@ -475,7 +487,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     put_texel(texels, 2, (uint32_t)instance_offset, p.packed_instances, (uint32_t)attribute_offset, default_material);
     put_texel(texels, 3, (uint32_t)texture_offset, (uint32_t)s->texture_count, (uint32_t)image_offset,
               (uint32_t)s->image_count);
-    put_texel(texels, 4, (uint32_t)light_offset, light_count, 0, 0);
+    put_texel(texels, 4, (uint32_t)light_offset, light_count, (uint32_t)environment_offset, 0);
 
     /* Materials, and the default grey one last. */
     for (uint64_t i = 0; i < material_count; i++) {
@@ -620,6 +632,53 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
                       float_bits((float)(type == LIGHT_SUN ? cos_sun : cos_outer)));
             put_texel(texels, base + 3, float_bits(source->direction[0]), float_bits(source->direction[1]),
                       float_bits(source->direction[2]), float_bits((float)cos_inner));
+        }
+        if (environment != NULL) {
+            /* Rows, then pixels in each row, weighted by luminance x sin(latitude) (the
+             * solid angle a pixel covers); a small floor keeps every pixel reachable. */
+            int width = environment->width, height = environment->height;
+            double *row_sums = calloc((size_t)height, sizeof *row_sums);
+            if (row_sums == NULL) {
+                free(power);
+                status = rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+                goto done;
+            }
+            double mean = 0;
+            for (size_t i = 0; i < (size_t)width * height; i++) {
+                const float *c = environment->pixels + 4 * i;
+                mean += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            }
+            mean /= (double)width * height;
+            double floor_weight = 1e-3 * mean + 1e-12, total_weight = 0;
+            for (int y = 0; y < height; y++) {
+                double sine = sin(M_PI * (y + 0.5) / height), row = 0;
+                uint64_t row_base = environment_offset + height + (uint64_t)y * width;
+                for (int x = 0; x < width; x++) {
+                    const float *c = environment->pixels + 4 * ((size_t)y * width + x);
+                    row += (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2] + floor_weight) * sine;
+                    put_texel(texels, row_base + x, float_bits((float)row), 0, 0, 0);
+                }
+                for (int x = 0; x < width; x++) {
+                    uint64_t at = row_base + x;
+                    float value = x + 1 == width ? 1.0f : bits_float(texels[4 * at]) / (float)row;
+                    texels[4 * at] = float_bits(value);
+                }
+                row_sums[y] = row;
+                total_weight += row;
+            }
+            double cumulative_rows = 0;
+            for (int y = 0; y < height; y++) {
+                cumulative_rows += row_sums[y];
+                put_texel(texels, environment_offset + y,
+                          float_bits(y + 1 == height ? 1.0f : (float)(cumulative_rows / total_weight)), 0, 0, 0);
+            }
+            free(row_sums);
+            /* Its power: the mean radiance on the scene's cross-section from all around. */
+            power[light] = 4 * M_PI * scene_radius * scene_radius * mean * s->sky.intensity;
+            total += power[light];
+            put_texel(texels, light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE, LIGHT_ENVIRONMENT, (uint32_t)width,
+                      (uint32_t)height, 0);
+            light++;
         }
         double cumulative = 0;
         for (uint32_t l = 0; l < light_count; l++) {

@@ -4,9 +4,10 @@
  *
  * What it builds: one bottom-level BVH per object that an instance places with a transform,
  * a volume flag or a mesh (each object once, however often it is placed), and a top-level
- * BVH (root: node 0) over the world's own primitives (spheres, and the shapes of objects
- * placed with the identity and no volume: those are copied into the top level, so simple
- * scenes pay nothing for instancing) and the instances. Shapes without a material get the
+ * BVH (root: node 0) over the world's own primitives (spheres, and the shapes and mesh
+ * triangles of objects placed with the identity and no volume: those are copied into the
+ * top level, so simple scenes pay nothing for instancing and emissive meshes become
+ * lights) and the instances. Shapes without a material get the
  * instance's, and failing that a default grey Lambertian material (appended last).
  *
  * Output: texel_count texels of four uint32 each (texels[4*i .. 4*i+3] is texel i);

@@ -29,6 +29,7 @@
  *   textures    PACKED_TEXTURE_STRIDE texels each
  *   images      PACKED_IMAGE_STRIDE texels each (a record), pixels elsewhere in the section
  *   lights      PACKED_LIGHT_STRIDE texels each, for light sampling
+ *   environment the environment map's sampling distribution (see lights)
  */
 #ifndef RT_PACKED_LAYOUT_H
 #define RT_PACKED_LAYOUT_H
@@ -58,6 +59,7 @@
 #define PACKED_HEADER_IMAGE_COUNT 15
 #define PACKED_HEADER_LIGHT_OFFSET 16
 #define PACKED_HEADER_LIGHT_COUNT 17
+#define PACKED_HEADER_ENVIRONMENT_OFFSET 18
 
 /* ---- materials: 4 texels
  *   texel 0 = (type tag, albedo.r, albedo.g, albedo.b)
@@ -136,7 +138,11 @@
  *   texel 1 .xyz = position (point, spot) or the direction towards the sun, texel 2 .w = cos
  *   of the spot's outer half-angle or of the sun's angular radius.
  * Area lights are emissive world primitives (spheres, quads, triangles): their radiance is
- * their material's emission. */
+ * their material's emission.
+ * environment (an equirectangular sky): texel 0 = (LIGHT_ENVIRONMENT, image width, image
+ * height, 0); it is importance-sampled by the environment section: one float per texel
+ * (in .x): the cumulative distribution over rows (height values), then for each row the
+ * cumulative distribution over its pixels (width values), of luminance x sin(latitude). */
 #define PACKED_LIGHT_STRIDE 4
 #define LIGHT_SPHERE 0
 #define LIGHT_QUAD 1
@@ -144,7 +150,8 @@
 #define LIGHT_POINT 3
 #define LIGHT_SPOT 4
 #define LIGHT_SUN 5
-#define LIGHT_TYPE_COUNT 6
+#define LIGHT_ENVIRONMENT 6
+#define LIGHT_TYPE_COUNT 7
 
 /* Deepest BVH per level (the builder never exceeds it; deeper nodes become leaves). The
  * shader's stack holds a top-level path, one leaf's instances and a bottom-level path:

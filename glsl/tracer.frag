@@ -112,6 +112,7 @@ uint texture_offset;
 uint image_offset;
 uint light_offset;
 uint light_count;
+uint environment_offset;
 
 // ---- random numbers (glsl/random.glsl, prepended) ----------------------------------
 
@@ -768,6 +769,75 @@ bool sample_delta_light(uint light, vec3 p, vec2 u, out vec3 direction, out floa
     return true;
 }
 
+// ---- environment map sampling ----------------------------------------------------
+
+// Index of the first of count cumulative values (one float per texel from base) that
+// exceeds u: a binary search.
+uint search_cumulative(uint base, uint count, float u)
+{
+    uint low = 0u, high = count - 1u;
+    while (low < high) {
+        uint middle = (low + high) / 2u;
+        if (u < packed_vec4(base + middle).x)
+            high = middle;
+        else
+            low = middle + 1u;
+    }
+    return low;
+}
+
+float cumulative_step(uint base, uint index)
+{
+    return packed_vec4(base + index).x - (index > 0u ? packed_vec4(base + index - 1u).x : 0.0);
+}
+
+// World direction <-> the environment image's (u, v down) coordinates, as sky_radiance
+// reads them (the sky turned by sky_rotation about +Y).
+vec3 environment_direction(vec2 uv)
+{
+    float theta = PI * uv.y, phi = 2.0 * PI * (uv.x - 0.5);
+    vec3 d = vec3(sin(phi) * sin(theta), cos(theta), -cos(phi) * sin(theta));
+    float c = cos(sky_rotation), s = sin(sky_rotation);
+    return vec3(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
+}
+
+// Solid-angle density with which light sampling picks direction (world) from the
+// environment, given the light record's image size.
+float environment_pdf(uint light, vec3 direction)
+{
+    uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
+    uint width = head.y, height = head.z;
+    float c = cos(sky_rotation), s = sin(sky_rotation);
+    vec3 d = vec3(c * direction.x - s * direction.z, direction.y, s * direction.x + c * direction.z);
+    vec2 uv = vec2(0.5 + atan(d.x, -d.z) / (2.0 * PI), acos(clamp(d.y, -1.0, 1.0)) / PI);
+    uint column = min(uint(uv.x * float(width)), width - 1u);
+    uint row = min(uint(uv.y * float(height)), height - 1u);
+    float pixel = cumulative_step(environment_offset, row)
+                * cumulative_step(environment_offset + height + row * width, column);
+    float sine = sin(PI * (float(row) + 0.5) / float(height));
+    return sine > 0.0 ? pixel * float(width * height) / (2.0 * PI * PI * sine) : 0.0;
+}
+
+// A direction towards the environment chosen in proportion to its luminance.
+bool sample_environment(uint light, vec2 u, out vec3 direction, out vec3 emitted, out float pdf)
+{
+    uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
+    uint width = head.y, height = head.z;
+    uint row = search_cumulative(environment_offset, height, u.x);
+    uint row_base = environment_offset + height + row * width;
+    uint column = search_cumulative(row_base, width, u.y);
+    // Reuse what is left of u inside the chosen cells for the position within the pixel.
+    float row_low = row > 0u ? packed_vec4(environment_offset + row - 1u).x : 0.0;
+    float column_low = column > 0u ? packed_vec4(row_base + column - 1u).x : 0.0;
+    float within_row = clamp((u.x - row_low) / max(cumulative_step(environment_offset, row), 1e-20), 0.0, 1.0);
+    float within_column = clamp((u.y - column_low) / max(cumulative_step(row_base, column), 1e-20), 0.0, 1.0);
+    vec2 uv = vec2((float(column) + within_column) / float(width), (float(row) + within_row) / float(height));
+    direction = environment_direction(uv);
+    pdf = environment_pdf(light, direction);
+    emitted = sky_radiance(direction);
+    return pdf > 0.0;
+}
+
 // The fraction of light that gets from p to the light primitive at distance along
 // direction: 0 behind an opaque surface; through volume boundaries it goes on, losing
 // exp(-density * length) in each medium, as the path itself would.
@@ -829,7 +899,11 @@ vec3 next_event(vec3 p, vec3 normal, vec3 shading, vec3 albedo, bool is_phase, u
     vec3 emitted;
     bool delta = false;   // point, spot and sun: BSDF sampling never finds them (no MIS)
     uvec4 light_head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
-    if (light_head.x >= uint(LIGHT_POINT)) {
+    if (light_head.x == uint(LIGHT_ENVIRONMENT)) {
+        if (!sample_environment(light, u.yz, direction, emitted, pdf))
+            return vec3(0.0);
+        distance = INFINITY;
+    } else if (light_head.x >= uint(LIGHT_POINT)) {
         if (!sample_delta_light(light, p, u.yz, direction, distance, emitted))
             return vec3(0.0);
         delta = true;
@@ -884,7 +958,12 @@ vec3 whitted_direct(vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 albedo, u
         float distance, pdf;
         vec3 arriving;
         uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
-        if (head.x >= uint(LIGHT_POINT)) {
+        if (head.x == uint(LIGHT_ENVIRONMENT)) {
+            if (!sample_environment(light, u.yz, direction, arriving, pdf))
+                continue;
+            arriving /= pdf;
+            distance = INFINITY;
+        } else if (head.x >= uint(LIGHT_POINT)) {
             if (!sample_delta_light(light, p, u.yz, direction, distance, arriving))
                 continue;
         } else {
@@ -898,7 +977,7 @@ vec3 whitted_direct(vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 albedo, u
         vec3 reflected = reflect(-direction, shading);
         float highlight = pow(max(dot(reflected, view), 0.0), phong.x) * (phong.x + 2.0) / (2.0 * PI);
         vec3 shade = (albedo / PI + phong.yzw * highlight) * cosine;
-        uint slot = head.x >= uint(LIGHT_POINT) ? NONE : head.y;
+        uint slot = head.x >= uint(LIGHT_POINT) ? NONE : head.y;   // (environment included)
         vec3 transmittance = shadow_transmittance(p + ray_offset(p) * normal, direction, distance, slot, media, time,
                                                   work, overflow);
         result += weight * transmittance * shade * arriving;
@@ -1012,6 +1091,7 @@ void main()
     uvec4 header4 = packed_texel(4u);
     light_offset = header4.x;
     light_count = light_sampling != 0 || integrator == 1 ? header4.y : 0u;
+    environment_offset = header4.z;
 
     // Full-image pixel, row 0 at the top: a crop or tile renders exactly the pixels
     // (and random numbers) of the full render.
@@ -1088,7 +1168,14 @@ void main()
         }
 
         if (!hit_something) {
-            radiance += throughput * sky_radiance(direction);
+            // Light sampling could have picked this sky direction too: weight by MIS.
+            float weight = 1.0;
+            if (previous_pdf > 0.0 && sky_type == SKY_ENVIRONMENT && light_count > 0u && integrator == 0) {
+                uint last = light_count - 1u;
+                if (packed_texel(light_offset + last * uint(PACKED_LIGHT_STRIDE)).x == uint(LIGHT_ENVIRONMENT))
+                    weight = power_heuristic(previous_pdf, light_probability(last) * environment_pdf(last, direction));
+            }
+            radiance += throughput * sky_radiance(direction) * weight;
             path_done = true;
         } else {
             Surface surface = surface_at(hit, origin, direction, time);

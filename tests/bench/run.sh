@@ -35,6 +35,9 @@ bench() {
 "$program" info | sed -n 's/^GL renderer: *//p' | sed 's/^/renderer: /'
 bench weekend scenes/weekend.txt 1200x675 "$spp" --max-depth 50
 bench three-balls scenes/three-balls.txt 640x360 64
+# The seed's quick-sweep mode: a Whitted frame with soft shadows (POV-Ray renders such a
+# frame with an 8x8 area light in about 1.6 s on two cores).
+bench three-balls-whitted scenes/three-balls.txt 640x360 4 --integrator whitted
 
 # Meshes of growing size (icospheres of subdivision 3, 5, 6, 8: 1,280 to 1,310,720
 # triangles), the same small frame each: time per sample should grow about like log n.

@@ -132,4 +132,50 @@ for integrator in path whitted; do
     plane_light sun-down "0 0 0" "light sun 0 -1 0 intensity 3 angle 0" 0.477465 $integrator
     plane_light sun-tilted "0 0 0" "light sun 0.866025 -0.5 0 intensity 3 angle 0" 0.238732 $integrator
 done
+
+# An environment map as a light: a dim sky with one small, very bright patch (a "sun" of
+# four pixels). Importance sampling it must give the image that BSDF sampling alone
+# converges to (the mean of the floor agrees within 3%), with much less noise.
+envdir="$scratch/environment"
+mkdir -p "$envdir"
+{
+    printf 'PF\n64 32\n-1.0\n'
+    # PFM rows run bottom to top; little-endian floats: 0.05 = cd cc 4c 3d, 2000 = 00 00 fa 44.
+    y=31
+    while [ "$y" -ge 0 ]; do
+        x=0
+        while [ "$x" -lt 64 ]; do
+            if [ "$x" -ge 10 ] && [ "$x" -lt 12 ] && { [ "$y" = 8 ] || [ "$y" = 9 ]; }; then
+                printf '\000\000\372\104\000\000\372\104\000\000\372\104'
+            else
+                printf '\315\314\114\075\315\314\114\075\315\314\114\075'
+            fi
+            x=$((x + 1))
+        done
+        y=$((y - 1))
+    done
+} >"$envdir/env.pfm"
+cat >"$envdir/scene.txt" <<'SCENE'
+render size 64 36 spp 16 depth 4 seed 1
+camera from 0 1 4 at 0 0 0 fov 40
+sky environment "env.pfm"
+material floor lambertian 0.6 0.6 0.6
+quad -5 0 -5  0 0 10  10 0 0 floor
+sphere 0 0.5 0 0.5 floor
+SCENE
+if "$program" render "$envdir/scene.txt" -o "$envdir/on.exr" --quiet &&
+   "$program" render "$envdir/scene.txt" -o "$envdir/off.exr" --light-sampling off --quiet &&
+   "$program" render "$envdir/scene.txt" -o "$envdir/reference.exr" --light-sampling off --spp 1024 --quiet; then
+    mean_on=$(channel_mean "$envdir/on.exr" G 0,20,64,36)
+    mean_reference=$(channel_mean "$envdir/reference.exr" G 0,20,64,36)
+    if within "$mean_on" "$mean_reference" 0.03; then pass "environment light sampling converges to the same floor ($mean_on vs $mean_reference)"
+    else fail "environment light sampling" "floor mean $mean_on, reference $mean_reference"; fi
+    rms_on=$("$program" diff "$envdir/on.exr" "$envdir/reference.exr" --fail 1000 --failpercent 100 | sed -n 's/^rms error: //p')
+    rms_off=$("$program" diff "$envdir/off.exr" "$envdir/reference.exr" --fail 1000 --failpercent 100 | sed -n 's/^rms error: //p')
+    if awk -v a="$rms_on" -v b="$rms_off" 'BEGIN { exit !(a < 0.5 * b) }'; then
+        pass "environment importance sampling cuts the error (RMS $rms_on vs $rms_off)"
+    else fail "environment importance sampling" "RMS $rms_on with, $rms_off without"; fi
+else
+    fail "environment light sampling" "render failed"
+fi
 finish
