@@ -880,111 +880,80 @@ float power_heuristic(float chosen, float other)
     return a + b > 0.0 ? a / (a + b) : 0.0;
 }
 
-// Next-event estimation from p: one light chosen by power, one point on it, a shadow
-// ray, weighted against BSDF sampling (whose density for that direction is bsdf_pdf,
-// given by the caller's lobe) with the power heuristic. lobe(direction) returns the
-// BSDF value times the cosine; here it is passed as diffuse (albedo/pi, shading normal)
-// or phase (1/4pi) by `is_phase`.
-vec3 next_event(vec3 p, vec3 normal, vec3 shading, vec3 albedo, bool is_phase, uint media, float time, vec4 u,
-                inout int work, inout bool overflow)
-{
-    if (light_count == 0u)
-        return vec3(0.0);
-    uint light = choose_light(u.x);
-    float choice = light_probability(light);
-    if (choice <= 0.0)
-        return vec3(0.0);
-    vec3 direction;
-    float distance, pdf;
-    vec3 emitted;
-    bool delta = false;   // point, spot and sun: BSDF sampling never finds them (no MIS)
-    uvec4 light_head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
-    if (light_head.x == uint(LIGHT_ENVIRONMENT)) {
-        if (!sample_environment(light, u.yz, direction, emitted, pdf))
-            return vec3(0.0);
-        distance = INFINITY;
-    } else if (light_head.x >= uint(LIGHT_POINT)) {
-        if (!sample_delta_light(light, p, u.yz, direction, distance, emitted))
-            return vec3(0.0);
-        delta = true;
-        pdf = 1.0;
-    } else if (!sample_light(light, p, u.yz, direction, distance, emitted, pdf)) {
-        return vec3(0.0);
-    }
-    float bsdf_pdf;
-    vec3 value;
-    vec3 origin = p;
-    if (is_phase) {
-        bsdf_pdf = 1.0 / (4.0 * PI);
-        value = albedo * bsdf_pdf;
-    } else {
-        float cosine = dot(shading, direction);
-        if (cosine <= 0.0 || dot(normal, direction) <= 0.0)
-            return vec3(0.0);
-        bsdf_pdf = cosine / PI;
-        value = albedo * (cosine / PI);
-        origin = p + ray_offset(p) * normal;
-    }
-    uint light_slot = delta ? NONE : light_head.y;
-    vec3 transmittance = shadow_transmittance(origin, direction, distance, light_slot, media, time, work, overflow);
-    if (delta)
-        return transmittance * value * emitted / choice;
-    float light_pdf = choice * pdf;
-    return transmittance * value * emitted * power_heuristic(light_pdf, bsdf_pdf) / light_pdf;
-}
-
-// ---- Whitted integrator ----------------------------------------------------------
-
-// Phong shading at a diffuse or metal surface point: ambient plus, for every light (one
-// light chosen by power when there are more than WHITTED_ALL_LIGHTS), diffuse and
-// normalised-Phong specular terms, each light shadow-tested. Area lights are lit from a
-// random point each sample, which averages to soft shadows (the seed report's 4.3).
+// Direct light at a scattering point p, with ONE shadow-ray call site (GLSL inlines every
+// call, and each extra copy of the BVH traversal costs llvmpipe dearly).
+//   mode 0 (path tracing): next-event estimation: one light chosen by power, one point on
+//     it, weighted against BSDF sampling (density bsdf_pdf) by the power heuristic; delta
+//     lights (point, spot, sun) unweighted. is_phase: a volume's isotropic phase function
+//     instead of the Lambertian lobe.
+//   mode 1 (Whitted): ambient plus, for every light (one chosen by power when there are
+//     more than WHITTED_ALL_LIGHTS), Lambert diffuse and normalised-Phong specular terms;
+//     area lights are lit from a random point each sample, which averages to soft shadows.
 const uint WHITTED_ALL_LIGHTS = 16u;
 
-vec3 whitted_direct(vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 albedo, uint material, uint media, float time,
-                    uint bounce, inout int work, inout bool overflow)
+vec3 direct_light(int mode, vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 albedo, uint material,
+                  bool is_phase, uint media, float time, uint bounce, inout int work, inout bool overflow)
 {
-    vec4 phong = packed_vec4(material_offset + material * uint(PACKED_MATERIAL_STRIDE) + 3u);
-    vec3 result = ambient * albedo;
-    uint all_lights = light_count;
-    bool choose = all_lights > WHITTED_ALL_LIGHTS;
-    uint count = choose ? 1u : all_lights;
+    vec3 result = mode == 1 ? ambient * albedo : vec3(0.0);
+    if (light_count == 0u)
+        return result;
+    vec4 phong = mode == 1 ? packed_vec4(material_offset + material * uint(PACKED_MATERIAL_STRIDE) + 3u) : vec4(0.0);
+    bool choose = mode == 0 || light_count > WHITTED_ALL_LIGHTS;
+    uint count = choose ? 1u : light_count;
     for (uint k = 0u; k < count; k++) {
-        vec4 u = random4(bounce, 6u + (k & 1u)) ;
-        u = fract(u + float(k >> 1u) * 0.6180339887);   // further lights: shifted streams
+        vec4 u = mode == 0 ? random4(bounce, 5u)
+                           : fract(random4(bounce, 6u + (k & 1u)) + float(k >> 1u) * 0.6180339887);
         uint light = choose ? choose_light(u.x) : k;
-        float weight = choose ? 1.0 / max(light_probability(light), 1e-12) : 1.0;
-        vec3 direction;
-        float distance, pdf;
-        vec3 arriving;
+        float choice = choose ? light_probability(light) : 1.0;
+        if (choice <= 0.0)
+            continue;
+        vec3 direction, emitted;
+        float distance, pdf = 1.0;
+        bool delta = false;
         uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
         if (head.x == uint(LIGHT_ENVIRONMENT)) {
-            if (!sample_environment(light, u.yz, direction, arriving, pdf))
+            if (!sample_environment(light, u.yz, direction, emitted, pdf))
                 continue;
-            arriving /= pdf;
             distance = INFINITY;
         } else if (head.x >= uint(LIGHT_POINT)) {
-            if (!sample_delta_light(light, p, u.yz, direction, distance, arriving))
+            if (!sample_delta_light(light, p, u.yz, direction, distance, emitted))
                 continue;
-        } else {
-            if (!sample_light(light, p, u.yz, direction, distance, arriving, pdf) || pdf <= 0.0)
-                continue;
-            arriving /= pdf;     // radiance over the light's solid angle: irradiance
-        }
-        float cosine = dot(shading, direction);
-        if (cosine <= 0.0 || dot(normal, direction) <= 0.0)
+            delta = true;
+        } else if (!sample_light(light, p, u.yz, direction, distance, emitted, pdf) || pdf <= 0.0) {
             continue;
-        vec3 reflected = reflect(-direction, shading);
-        float highlight = pow(max(dot(reflected, view), 0.0), phong.x) * (phong.x + 2.0) / (2.0 * PI);
-        vec3 shade = (albedo / PI + phong.yzw * highlight) * cosine;
-        uint slot = head.x >= uint(LIGHT_POINT) ? NONE : head.y;   // (environment included)
-        vec3 transmittance = shadow_transmittance(p + ray_offset(p) * normal, direction, distance, slot, media, time,
-                                                  work, overflow);
-        result += weight * transmittance * shade * arriving;
+        }
+        vec3 value;
+        float bsdf_pdf;
+        vec3 origin = p;
+        if (is_phase) {
+            bsdf_pdf = 1.0 / (4.0 * PI);
+            value = albedo * bsdf_pdf;
+        } else {
+            float cosine = dot(shading, direction);
+            if (cosine <= 0.0 || dot(normal, direction) <= 0.0)
+                continue;
+            bsdf_pdf = cosine / PI;
+            value = albedo * (cosine / PI);
+            if (mode == 1) {
+                vec3 reflected = reflect(-direction, shading);
+                float highlight = pow(max(dot(reflected, view), 0.0), phong.x) * (phong.x + 2.0) / (2.0 * PI);
+                value += phong.yzw * highlight * cosine;
+            }
+            origin = p + ray_offset(p) * normal;
+        }
+        float weight;
+        if (delta)
+            weight = 1.0 / choice;
+        else if (mode == 1)
+            weight = 1.0 / (choice * pdf);
+        else
+            weight = power_heuristic(choice * pdf, bsdf_pdf) / (choice * pdf);
+        uint slot = delta || head.x == uint(LIGHT_ENVIRONMENT) ? NONE : head.y;
+        vec3 transmittance = shadow_transmittance(origin, direction, distance, slot, media, time, work, overflow);
+        result += transmittance * value * emitted * weight;
     }
     return result;
 }
-
 
 #ifdef RTSPHERES_AOV_PASS
 // Reads the packed scene's header into the globals every function uses.
@@ -1135,39 +1104,46 @@ void main()
         statistics.x += 1.0;
         bool path_done = false;
         vec4 u = random4(bounce, 1u);
+        uint segment_bounce = bounce;     // the branches below may move bounce and direction on
+        vec3 incoming = direction;
+
+        // Direct light is gathered once per segment, after the branches below decide where
+        // (one call site: see direct_light).
+        bool want_direct = false;
+        int direct_mode = 0;
+        vec3 direct_point = vec3(0.0), direct_normal = vec3(0.0), direct_shading = vec3(0.0);
+        vec3 direct_albedo = vec3(0.0), direct_weight = vec3(0.0);
+        uint direct_material = 0u;
+        bool direct_phase = false;
 
         // In a medium: scatter before the surface with probability 1 - exp(-density * t).
+        bool scattered_in_medium = false;
         uint medium = media_inner(media);
         if (medium != 0u) {
             uint medium_base = instance_offset + (medium - 1u) * uint(PACKED_INSTANCE_STRIDE);
             vec4 volume = packed_vec4(medium_base + 4u);
             float distance = -log(1.0 - random4(bounce, 4u).x) / volume.x;
             if (distance < hit.t) {
+                scattered_in_medium = true;
                 origin += distance * direction;
                 throughput *= volume.yzw;
                 since_vertex = 0.0;
-                radiance += throughput * next_event(origin, vec3(0.0), vec3(0.0), vec3(1.0), true, media, time,
-                                                    random4(bounce, 5u), work, overflow);
+                want_direct = light_count > 0u;
+                direct_point = origin;
+                direct_albedo = vec3(1.0);
+                direct_phase = true;
+                direct_weight = throughput;
                 direction = random_unit_vector(u.xy);
                 previous_pdf = light_count > 0u ? 1.0 / (4.0 * PI) : 0.0;
-                hit_something = false;
                 bounce++;
                 if (bounce > max_depth)
                     path_done = true;
-                if (path_done) {
-                    accumulated += vec4(radiance, 1.0);
-                    float luminance = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
-                    statistics.z += luminance * luminance;
-                    bounce = 0u;
-                    finished_here++;
-                }
-                if (overflow)
-                    break;
-                continue;
             }
         }
 
-        if (!hit_something) {
+        if (scattered_in_medium) {
+            // done above
+        } else if (!hit_something) {
             // Light sampling could have picked this sky direction too: weight by MIS.
             float weight = 1.0;
             if (previous_pdf > 0.0 && sky_type == SKY_ENVIRONMENT && light_count > 0u && integrator == 0) {
@@ -1201,8 +1177,14 @@ void main()
                 if (integrator == 1 && material_type != uint(MATERIAL_EMISSIVE)
                     && material_type != uint(MATERIAL_DIELECTRIC)) {
                     // Whitted: local Phong shading; metals also reflect, diffuse ends here.
-                    radiance += throughput * whitted_direct(p, normal, shading, -direction, albedo, surface.material,
-                                                            media, time, bounce, work, overflow);
+                    want_direct = true;
+                    direct_mode = 1;
+                    direct_point = p;
+                    direct_normal = normal;
+                    direct_shading = shading;
+                    direct_albedo = albedo;
+                    direct_material = surface.material;
+                    direct_weight = throughput;
                     if (material_type == uint(MATERIAL_METAL)) {
                         next_direction = reflect(direction, shading);
                         throughput *= albedo;
@@ -1226,8 +1208,12 @@ void main()
                     radiance += throughput * emission * weight;
                     path_done = true;
                 } else if (material_type == uint(MATERIAL_LAMBERTIAN)) {
-                    radiance += throughput * next_event(p, normal, shading, albedo, false, media, time,
-                                                        random4(bounce, 5u), work, overflow);
+                    want_direct = light_count > 0u;
+                    direct_point = p;
+                    direct_normal = normal;
+                    direct_shading = shading;
+                    direct_albedo = albedo;
+                    direct_weight = throughput;
                     // normal + a uniform unit vector is cosine-distributed about the normal.
                     next_direction = shading + random_unit_vector(u.xy);
                     float length_squared = dot(next_direction, next_direction);
@@ -1273,6 +1259,10 @@ void main()
                 }
             }
         }
+        if (want_direct)
+            radiance += direct_weight * direct_light(direct_mode, direct_point, direct_normal, direct_shading,
+                                                     -incoming, direct_albedo, direct_material, direct_phase, media,
+                                                     time, segment_bounce, work, overflow);
         if (path_done) {
             accumulated += vec4(radiance, 1.0);
             float luminance = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
