@@ -8,6 +8,9 @@
 #   golden   re-render the golden images in golden/ (never run by the tests; say why in
 #            the commit when you commit new ones)
 #   deps     install the Debian packages listed in .ci/debian-packages that are missing
+#   fuzz     build the libFuzzer harnesses (tests/fuzz/) with clang into build-fuzz/ and
+#            fuzz each for FUZZ_SECONDS; the corpus found grows in build-fuzz/corpus/
+#   fuzz-smoke  the fuzzing check the tests run: regressions, then 10 s per harness
 #   clean    remove build products
 #
 # Knobs
@@ -15,9 +18,12 @@
 #   SAN=1      build with AddressSanitizer + UndefinedBehaviorSanitizer (into build-san/)
 #   CFLAGS, CXXFLAGS, LDFLAGS   yours: appended after ours, never replacing them
 #   CC, CXX    compilers (default cc, c++)
+#   FUZZ_SECONDS  how long `make fuzz` runs each harness (default 60)
+#   FUZZ_CC, FUZZ_CXX  the compilers of the fuzz harnesses; must have libFuzzer
+#              (default clang, clang++)
 
 all: rtspheres
-.PHONY: all demo test bench golden deps clean unit-tests
+.PHONY: all demo test bench golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
 
 CC ?= cc
 CXX ?= c++
@@ -116,9 +122,37 @@ demo: deps
 	./$(PROGRAM) render scenes/three-balls.txt -o demo.png
 	@echo "demo: wrote demo.png"
 
+# The sanitizer test run (SAN=1): stop at the first report with a stack, exit 86 (not 1
+# or 2, which the tests expect for other reasons) and suppress only the GL stack's own
+# leaks (tests/sanitizers/lsan.supp). Every report also goes to a file in
+# $(BUILD)/sanitizer-reports/, which tests/run.sh counts as a failure: a test may ignore
+# a command's exit status or stderr, a report must still fail the run. Mesa unloads its
+# driver in eglTerminate, which would leave its leaks without a library name to suppress
+# them by; the preloaded shim keeps libraries loaded (tests/sanitizers/
+# keep_libraries_loaded.c says why), which is also why ASan must not insist on being
+# first in the library list.
+SAN_TEST_SHIM :=
+SAN_TEST_ENV :=
+SAN_REPORTS := $(CURDIR)/$(BUILD)/sanitizer-reports
+ifeq ($(SAN),1)
+SAN_TEST_SHIM := $(BUILD)/keep-libraries-loaded.so
+SAN_REPORT_OPTIONS := halt_on_error=1:print_stacktrace=1:exitcode=86:log_path=$(SAN_REPORTS)/report
+SAN_TEST_ENV := ASAN_OPTIONS=$(SAN_REPORT_OPTIONS):detect_leaks=1:verify_asan_link_order=0 \
+	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp:print_suppressions=0 \
+	UBSAN_OPTIONS=$(SAN_REPORT_OPTIONS) \
+	LD_PRELOAD=$(CURDIR)/$(SAN_TEST_SHIM) \
+	RTSPHERES_SANITIZER_REPORTS=$(SAN_REPORTS)
+endif
+
+$(BUILD)/keep-libraries-loaded.so: tests/sanitizers/keep_libraries_loaded.c
+	$(say) CC $@
+	@mkdir -p $(dir $@)
+	$(Q)$(CC) -shared -fPIC -O2 -Wall -Wextra $< -o $@
+
 test: deps
-	$(Q)$(MAKE) --no-print-directory $(PROGRAM) unit-tests
-	$(Q)sh tests/run.sh $(BUILD) ./$(PROGRAM)
+	$(Q)$(MAKE) --no-print-directory $(PROGRAM) unit-tests $(SAN_TEST_SHIM)
+	$(Q)$(if $(SAN_TEST_ENV),rm -rf $(SAN_REPORTS) && mkdir -p $(SAN_REPORTS) && )$(SAN_TEST_ENV) sh tests/run.sh \
+		$(BUILD) ./$(PROGRAM)
 
 bench: deps
 	$(Q)$(MAKE) --no-print-directory all
@@ -127,7 +161,65 @@ bench: deps
 golden: all
 	$(Q)sh tests/render/make-golden.sh ./$(PROGRAM)
 
+# Fuzzing. The harnesses compile the core sources they need straight into each binary,
+# instrumented for libFuzzer and the sanitizers (clang only), never reusing build/ objects.
+FUZZ_SECONDS ?= 60
+FUZZ_CC ?= clang
+FUZZ_DIR := build-fuzz
+FUZZ_FLAGS := -std=c11 -D_GNU_SOURCE -g -O1 -fno-omit-frame-pointer -Icore -Iglsl \
+	-fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+FUZZ_SCENE_SOURCES := tests/fuzz/fuzz_scene_parse.c core/scene_parse.c core/expression.c core/scene.c \
+	core/status.c core/bvh.c core/pack.c core/camera.c
+FUZZ_EXPRESSION_SOURCES := tests/fuzz/fuzz_expression.c core/expression.c core/status.c
+# The OBJ harness runs scene_load_assets(), which links the C++ shims (tinyobjloader and,
+# for images, OpenImageIO); the libraries themselves are not instrumented.
+FUZZ_CXX ?= clang++
+FUZZ_OBJ_C_SOURCES := tests/fuzz/fuzz_obj_load.c core/scene_parse.c core/expression.c core/scene.c \
+	core/status.c core/bvh.c core/pack.c core/camera.c core/scene_assets.c
+FUZZ_OBJ_CXX_SOURCES := core/obj_load.cpp core/image_io.cpp
+FUZZ_HARNESSES := $(FUZZ_DIR)/fuzz_scene_parse $(FUZZ_DIR)/fuzz_expression $(FUZZ_DIR)/fuzz_obj_load
+
+$(FUZZ_DIR)/fuzz_scene_parse: $(FUZZ_SCENE_SOURCES) $(wildcard core/*.h)
+	$(say) FUZZCC $@
+	@mkdir -p $(dir $@)
+	$(Q)$(FUZZ_CC) $(FUZZ_FLAGS) $(FUZZ_SCENE_SOURCES) -o $@ -lm
+
+$(FUZZ_DIR)/fuzz_expression: $(FUZZ_EXPRESSION_SOURCES) $(wildcard core/*.h)
+	$(say) FUZZCC $@
+	@mkdir -p $(dir $@)
+	$(Q)$(FUZZ_CC) $(FUZZ_FLAGS) $(FUZZ_EXPRESSION_SOURCES) -o $@ -lm
+
+$(FUZZ_DIR)/fuzz_obj_load: $(FUZZ_OBJ_C_SOURCES) $(FUZZ_OBJ_CXX_SOURCES) $(wildcard core/*.h)
+	$(say) FUZZCC $@
+	@mkdir -p $(FUZZ_DIR)/obj
+	$(Q)for source in $(FUZZ_OBJ_C_SOURCES); do \
+		$(FUZZ_CC) $(FUZZ_FLAGS) -c $$source -o $(FUZZ_DIR)/obj/$$(basename $$source .c).o || exit 1; done
+	$(Q)for source in $(FUZZ_OBJ_CXX_SOURCES); do \
+		$(FUZZ_CXX) $(subst -std=c11,-std=c++17,$(FUZZ_FLAGS)) $(PKG_CFLAGS) -c $$source \
+		-o $(FUZZ_DIR)/obj/$$(basename $$source .cpp).o || exit 1; done
+	$(Q)$(FUZZ_CXX) -fsanitize=fuzzer,address,undefined $(FUZZ_DIR)/obj/*.o $(PKG_LIBS) -lm -o $@
+
+fuzz-build: $(FUZZ_HARNESSES)
+
+fuzz: deps
+	$(Q)$(MAKE) --no-print-directory fuzz-build
+	$(Q)sh tests/fuzz/run.sh $(FUZZ_DIR) $(FUZZ_SECONDS) $(FUZZ_DIR)
+
+fuzz-smoke: deps
+	$(Q)mkdir -p $(FUZZ_DIR)/smoke
+	$(Q)sh tests/render/test-fuzz-smoke.sh ./$(PROGRAM) $(FUZZ_DIR)/smoke
+
 clean:
-	rm -rf build build-san rtspheres
+	rm -rf build build-san build-fuzz rtspheres
 
 -include $(shell find build build-san -name '*.d' 2>/dev/null)
+
+# Scale-out on Slurm (tests/slurm/test-slurm.sh, docs/scale-out.md): installs slurmctld,
+# slurmd, slurm-client and munge when missing, starts a throw-away single-node cluster in
+# a temporary directory, runs scripts/slurm/submit.sh (a job array of shards plus the
+# dependent merge), compares the merge with a single-machine render, and stops what it
+# started. `make test` runs it too, through tests/render/test-slurm.sh.
+.PHONY: test-slurm
+test-slurm: deps
+	$(Q)$(MAKE) --no-print-directory $(PROGRAM)
+	$(Q)sh tests/slurm/test-slurm.sh ./$(PROGRAM)

@@ -482,12 +482,20 @@ template <typename T> T *to_malloc(const std::vector<T> &values)
     return copy;
 }
 
+/* Makes v unit length, or zero when it is zero. In double: the squares of floats near
+ * the float range (1e38) overflow a float and those of tiny ones (1e-40) underflow it,
+ * but not a double, so every finite non-zero v becomes a unit vector. */
 void normalize(float *v)
 {
-    float length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (length > 0 && std::isfinite(length))
-        for (int i = 0; i < 3; i++)
-            v[i] /= length;
+    double x = v[0], y = v[1], z = v[2];
+    double length = std::sqrt(x * x + y * y + z * z);
+    if (length > 0 && std::isfinite(length)) {
+        v[0] = (float)(x / length);
+        v[1] = (float)(y / length);
+        v[2] = (float)(z / length);
+    } else {
+        v[0] = v[1] = v[2] = 0.0f;
+    }
 }
 
 /* Fills out from what tinyobjloader returned, checking every index. */
@@ -597,12 +605,25 @@ void build_mesh(const tinyobj::attrib_t &attrib, const std::vector<tinyobj::shap
             const float *p0 = &v[3 * (size_t)c[0].vertex_index];
             const float *p1 = &v[3 * (size_t)c[1].vertex_index];
             const float *p2 = &v[3 * (size_t)c[2].vertex_index];
-            float e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-            float e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-            geometric[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            geometric[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            geometric[2] = e1[0] * e2[1] - e1[1] * e2[0];
-            normalize(geometric);
+            /* In double, scaled down before the cross product: edges of vertices near the
+             * float range (1e38) would overflow a float cross product to inf or NaN. */
+            double e1[3], e2[3], largest = 0;
+            for (int i = 0; i < 3; i++) {
+                e1[i] = (double)p1[i] - p0[i];
+                e2[i] = (double)p2[i] - p0[i];
+                largest = std::fmax(largest, std::fmax(std::fabs(e1[i]), std::fabs(e2[i])));
+            }
+            if (largest > 0)
+                for (int i = 0; i < 3; i++) {
+                    e1[i] /= largest;
+                    e2[i] /= largest;
+                }
+            double cross[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                               e1[0] * e2[1] - e1[1] * e2[0]};
+            double length = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+            if (length > 0)
+                for (int i = 0; i < 3; i++)
+                    geometric[i] = (float)(cross[i] / length);
         }
         for (int k = 0; k < 3; k++) {
             corner_key key = {c[k].vertex_index,

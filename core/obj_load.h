@@ -12,7 +12,8 @@
  *
  * Normals: NULL when no face corner of the file names one (the renderer shades flat).
  * When some corners name normals and others do not, the others get their triangle's
- * geometric normal. Normals are made unit length (a zero normal in the file stays zero).
+ * geometric normal (zero for a degenerate triangle). Normals are made unit length, also
+ * near the float range (a zero normal in the file stays zero).
  * UVs: NULL when no corner names one; otherwise corners without one get (0, 0). UVs are
  * as in the file (v upwards, the OBJ convention).
  *

@@ -50,6 +50,18 @@ for script in tests/render/test-*.sh; do
     echo "  ($name took $(( $(date +%s) - start )) s)"
 done
 
+# The sanitizer run (make test SAN=1) has the sanitizers write every report to a file in
+# $RTSPHERES_SANITIZER_REPORTS: each one fails the run, even when the test that ran the
+# command looked only at its output.
+if [ -n "${RTSPHERES_SANITIZER_REPORTS:-}" ]; then
+    for report in "$RTSPHERES_SANITIZER_REPORTS"/*; do
+        [ -f "$report" ] || continue
+        echo "FAIL sanitizer report $report:"
+        head -n 40 "$report" | sed 's/^/    /'
+        failed=$((failed + 1)); failures="$failures sanitizer($(basename "$report"))"
+    done
+fi
+
 if [ "$passed" = 0 ] && [ "$failed" = 0 ]; then
     echo "tests/run.sh: no tests were found" >&2
     exit 1

@@ -338,6 +338,27 @@ static void test_partly_missing_normals_get_the_face_normal(void **state)
     obj_mesh_free(&mesh);
 }
 
+/* Found by fuzz_obj_load: near the float range a float cross product of the edges (and
+ * the squared length of a file normal) overflowed, and the normal came back inf or NaN. */
+static void test_normals_stay_unit_near_the_float_range(void **state)
+{
+    obj_mesh mesh = load_ok(*state, "huge.obj",
+                            "v -1e38 0 0\nv 1e38 0 0\nv 0 3e38 0\nv 0 0 0\n"
+                            "vn 2e38 2e38 0\nvn 1e-40 0 0\n"
+                            "f 1 2 3\n"
+                            "f 1//1 2//2 4//1\n");
+    assert_int_equal(mesh.triangle_count, 2);
+    for (int corner = 0; corner < 6; corner++) {
+        const float *n = &mesh.normals[3 * mesh.indices[corner]];
+        assert_close(sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1, 1e-5);
+    }
+    /* The first triangle's face normal is +z; the file's normals keep their directions. */
+    assert_close(mesh.normals[3 * mesh.indices[0] + 2], 1, 1e-6);
+    assert_close(mesh.normals[3 * mesh.indices[3] + 0], sqrtf(0.5f), 1e-6);
+    assert_close(mesh.normals[3 * mesh.indices[4] + 0], 1, 1e-6);
+    obj_mesh_free(&mesh);
+}
+
 static void test_crlf_bom_comments_and_groups(void **state)
 {
     obj_mesh mesh = load_ok(*state, "windows.obj",
@@ -908,6 +929,7 @@ int main(void)
         T(test_missing_normals_and_uvs),
         T(test_vertices_unify_position_normal_uv),
         T(test_partly_missing_normals_get_the_face_normal),
+    T(test_normals_stay_unit_near_the_float_range),
         T(test_crlf_bom_comments_and_groups),
         T(test_malformed_lines),
         T(test_out_of_range_indices),
