@@ -75,7 +75,14 @@ if [ -n "$missing" ]; then
         $sudo apt-get update -q >/dev/null 2>&1
         $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends $missing \
             >"${TMPDIR:-/tmp}/test-slurm-apt.$$.log" 2>&1 || {
-            fail "slurm-install" "apt-get install$missing failed: $(tail -3 "${TMPDIR:-/tmp}/test-slurm-apt.$$.log" | tr '\n' ' ')"
+            # munge's post-install script runs a shell as the munge user: it fails when
+            # that user cannot enter / (a chroot made in a mode-0700 directory, as
+            # `mktemp -d` makes them). Say so, since apt's own message does not.
+            hint=""
+            if ! su -s /bin/sh nobody -c true >/dev/null 2>&1; then
+                hint=" (system users cannot run /bin/sh here: / has mode $(stat -c %a /); in a chroot, chmod 755 its root)"
+            fi
+            fail "slurm-install" "apt-get install$missing failed: $(tail -3 "${TMPDIR:-/tmp}/test-slurm-apt.$$.log" | tr '\n' ' ')$hint"
             rm -f "${TMPDIR:-/tmp}/test-slurm-apt.$$.log"
             echo "$passed passed, $failed failed"
             exit 1
