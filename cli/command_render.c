@@ -74,6 +74,9 @@ static void print_help(FILE *stream)
             "                         estimation with MIS; default on): less noise, same image\n"
             "      --roulette-depth N paths may end at random (Russian roulette, unbiased)\n"
             "                         after N segments (default 4)\n"
+            "      --full-tracer      compile the whole tracer, also the code this scene cannot\n"
+            "                         reach (lights, volumes, textures); the image is the same,\n"
+            "                         only slower: for checking exactly that\n"
             "      --pass-budget N    fixed work units per pixel per GPU pass (default: adapted\n"
             "                         so a pass takes about 0.25 s; the image is the same)\n"
             "      --device N         use EGL device N (see `rtspheres info`)\n"
@@ -114,6 +117,7 @@ typedef struct render_request {
     const char *shard_by;
     double checkpoint_seconds;   /* 0: no checkpoints */
     bool no_light_sampling;
+    bool full_tracer;
     render_integrator integrator;
     bool aovs;
     bool denoise;
@@ -237,7 +241,7 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
         OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
         OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
-        OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP,
+        OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER,
     };
     static const struct option long_options[] = {
         {"output", required_argument, NULL, 'o'},
@@ -259,6 +263,7 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         {"checkpoint", required_argument, NULL, OPTION_CHECKPOINT},
         {"resume", required_argument, NULL, OPTION_RESUME},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
+        {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
         {"aovs", no_argument, NULL, OPTION_AOVS},
         {"denoise", no_argument, NULL, OPTION_DENOISE},
@@ -373,6 +378,9 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
                 request->integrator = INTEGRATOR_WHITTED;
             else
                 complaint = "--integrator wants path or whitted";
+            break;
+        case OPTION_FULL_TRACER:
+            request->full_tracer = true;
             break;
         case OPTION_LIGHT_SAMPLING:
             if (strcmp(optarg, "on") != 0 && strcmp(optarg, "off") != 0)
@@ -808,6 +816,7 @@ static int render_frame(gpu_context *context, const render_request *request, int
     options.pass_work_budget = (uint32_t)request->pass_budget;
     options.russian_roulette_depth = (uint32_t)request->roulette_depth;
     options.no_light_sampling = request->no_light_sampling;
+    options.full_tracer = request->full_tracer;
     options.integrator = request->integrator;
     options.aovs = request->aovs || request->denoise;
 

@@ -28,7 +28,7 @@ struct gpu_context {
     gpu_options options;
     /* Kept between renders on this context (frames of an animation, a sweep): the
      * compiled tracer, and the last packed scene uploaded with its hash. */
-    GLuint tracer_program;
+    GLuint tracer_programs[8];            /* by omitted_features (GPU_OMIT_* bits); 0: not built */
     GLuint packed_texture;
     int packed_width_log2;
     uint64_t packed_hash;
@@ -299,8 +299,9 @@ void gpu_destroy(gpu_context *context)
 {
     if (context == NULL)
         return;
-    if (context->tracer_program)
-        glDeleteProgram(context->tracer_program);
+    for (size_t i = 0; i < sizeof context->tracer_programs / sizeof context->tracer_programs[0]; i++)
+        if (context->tracer_programs[i])
+            glDeleteProgram(context->tracer_programs[i]);
     if (context->packed_texture)
         glDeleteTextures(1, &context->packed_texture);
     eglMakeCurrent(context->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -395,13 +396,21 @@ static GLuint build_tracer_program(const char *defines, rt_error *error)
     return link_program(vertex, fragment, error);
 }
 
-/* The context's tracer program, compiled on first use and kept. */
-static rt_status build_program(gpu_tracer *tracer, rt_error *error)
+/* The context's tracer program without the features in omitted (GPU_OMIT_* bits),
+ * compiled on first use and kept. */
+static rt_status build_program(gpu_tracer *tracer, uint32_t omitted, rt_error *error)
 {
     gpu_context *context = tracer->context;
-    if (context->tracer_program == 0)
-        context->tracer_program = build_tracer_program("", error);
-    tracer->program = context->tracer_program;
+    omitted &= GPU_OMIT_DIRECT_LIGHT | GPU_OMIT_VOLUMES | GPU_OMIT_TEXTURES;
+    if (context->tracer_programs[omitted] == 0) {
+        char defines[256];
+        snprintf(defines, sizeof defines, "%s%s%s",
+                 omitted & GPU_OMIT_DIRECT_LIGHT ? "#define RTSPHERES_OMIT_DIRECT_LIGHT 1\n" : "",
+                 omitted & GPU_OMIT_VOLUMES ? "#define RTSPHERES_OMIT_VOLUMES 1\n" : "",
+                 omitted & GPU_OMIT_TEXTURES ? "#define RTSPHERES_OMIT_TEXTURES 1\n" : "");
+        context->tracer_programs[omitted] = build_tracer_program(defines, error);
+    }
+    tracer->program = context->tracer_programs[omitted];
     return tracer->program ? RT_OK : RT_ERROR_RUNTIME;
 }
 
@@ -584,7 +593,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->context = context;
     tracer->width = parameters->width;
     tracer->height = parameters->height;
-    rt_status status = build_program(tracer, error);
+    rt_status status = build_program(tracer, parameters->omitted_features, error);
     uint64_t hash = hash_texels(packed_texels, texel_count);
     if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == hash
         && context->packed_texel_count == texel_count) {

@@ -79,6 +79,31 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     memcpy(p->ambient, s->ambient, sizeof p->ambient);
 }
 
+/* Returns the GPU_OMIT_* bits of the tracer code this render cannot reach (gpu.h): no
+ * light sampling in path tracing without lights (or with it switched off), no volumes
+ * when there is none and the camera is in none, no textures when no material has one. */
+static uint32_t omitted_features(const scene *s, const packed_scene *packed, const render_options *options,
+                                 uint32_t camera_media)
+{
+    uint32_t omitted = 0;
+    if (options->full_tracer)
+        return 0;
+    if (options->integrator == 0 && (packed->light_count == 0 || options->no_light_sampling))
+        omitted |= GPU_OMIT_DIRECT_LIGHT;
+    bool volumes = camera_media != 0;
+    for (int i = 0; i < s->instance_count && !volumes; i++)
+        volumes = s->instances[i].volume;
+    if (!volumes)
+        omitted |= GPU_OMIT_VOLUMES;
+    bool textures = s->texture_count > 0;
+    for (int i = 0; i < s->material_count && !textures; i++)
+        textures = s->materials[i].normal_map >= 0 || s->materials[i].albedo_texture >= 0
+                   || s->materials[i].emission_texture >= 0;
+    if (!textures)
+        omitted |= GPU_OMIT_TEXTURES;
+    return omitted;
+}
+
 /* Reads the tracer's accumulation into a new width x height image of means (R, G, B) and
  * per-pixel finished samples; *samples receives their total. The caller frees image. */
 static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, float *luminance_squares,
@@ -246,6 +271,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     gpu_tracer_parameters parameters;
     tracer_parameters(s, &frame, options, region, &parameters);
     parameters.camera_media = packed_media_at(&packed, s->camera.look_from);
+    parameters.omitted_features = omitted_features(s, &packed, options, parameters.camera_media);
     uint64_t samples_resumed = 0;
     float *sums = NULL;
     if (options->resume != NULL) {

@@ -19,6 +19,8 @@
  *   light sampling on (next-event estimation with MIS; the image's expectation is the
  *     same without it, only the noise differs),
  *   russian_roulette_depth 4 (paths may end at random from the 5th segment on),
+ *   full_tracer false: the tracer is compiled without the features the scene cannot
+ *     reach (gpu.h, GPU_OMIT_*),
  *   sample_start 0, the whole image, no progress callback, no stop flag.
  *
  * With a region, result->image covers only the region (its pixels are exactly those of
@@ -51,6 +53,9 @@ typedef struct render_options {
     uint32_t pass_work_budget;
     double target_pass_seconds;
     bool no_light_sampling;      /* true: BSDF sampling only (to compare the estimators) */
+    bool full_tracer;            /* true: compile every feature into the tracer, even those
+                                  * the scene cannot reach (gpu.h GPU_OMIT_*); for checking
+                                  * that leaving them out changes no image */
     render_integrator integrator;
     bool aovs;                   /* also render the AOV image (see render_result.aovs) */
     uint32_t russian_roulette_depth;

@@ -242,13 +242,14 @@ void to_object(uint instance, vec3 origin, vec3 direction, out vec3 object_origi
     object_direction = vec3(dot(row0.xyz, direction), dot(row1.xyz, direction), dot(row2.xyz, direction));
 }
 
-// Finds the nearest hit along the ray by walking the top-level BVH and, through instance
+// Finds the nearest hit closer than t_max along the ray by walking the top-level BVH and, through instance
 // records, the objects' BVHs, nearer child first, with one explicit stack. work counts
 // node visits and primitive tests; overflow is set when the hard cap cut the traversal.
 // Entering an instance pushes a marker (NONE) that restores the world ray when popped.
-bool trace(vec3 world_origin, vec3 world_direction, float time, out Hit hit, inout int work, inout bool overflow)
+bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out Hit hit, inout int work,
+           inout bool overflow)
 {
-    hit.t = INFINITY;
+    hit.t = t_max;
     hit.primitive = 0u;
     hit.instance = NONE;
     hit.barycentric = vec2(0.0);
@@ -258,7 +259,7 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, out Hit hit, ino
     vec3 direction = world_direction;
     vec3 inverse_direction = 1.0 / direction;
     uint instance = NONE;
-    float node_entry = node_entry_distance(0u, origin, inverse_direction, INFINITY);
+    float node_entry = node_entry_distance(0u, origin, inverse_direction, t_max);
     if (node_entry == INFINITY)
         return false;
 
@@ -339,7 +340,7 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, out Hit hit, ino
             node_entry = node_entry_distance(node, origin, inverse_direction, hit.t);
         }
     }
-    return hit.t < INFINITY;
+    return hit.t < t_max;
 }
 
 // ---- images and textures ---------------------------------------------------------
@@ -527,7 +528,9 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
         uint instance_base = instance_offset + hit.instance * uint(PACKED_INSTANCE_STRIDE);
         uvec4 instance_head = packed_texel(instance_base);
         instance_material = instance_head.y;
+#ifndef RTSPHERES_OMIT_VOLUMES
         surface.volume_boundary = (instance_head.z & uint(INSTANCE_VOLUME)) != 0u;
+#endif
         vec4 row0 = packed_vec4(instance_base + 1u), row1 = packed_vec4(instance_base + 2u),
              row2 = packed_vec4(instance_base + 3u);
         vec3 object_direction;
@@ -549,7 +552,9 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
         shading_normal = normal;
         // Longitude/latitude of the normal as the books map spheres: u around +Y starting
         // at -X, v from 0 at the bottom to 1 at the top.
+#ifndef RTSPHERES_OMIT_TEXTURES
         uv = vec2(0.5 + atan(-normal.z, normal.x) / (2.0 * PI), acos(clamp(-normal.y, -1.0, 1.0)) / PI);
+#endif
         tangent = vec3(normal.z, 0.0, -normal.x);
     } else {
         vec3 edge1 = packed_vec4(base + 2u).xyz;
@@ -583,6 +588,9 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
             }
         }
     }
+#ifdef RTSPHERES_OMIT_TEXTURES
+    normal_map = NONE;
+#endif
     if (normal_map != NONE) {
         // Tangent-space normal map, applied in object space so that the result moves to
         // the world like any normal (inverse transpose), under any placement.
@@ -849,15 +857,17 @@ vec3 shadow_transmittance(vec3 p, vec3 direction, float distance, uint light_slo
     vec3 origin = p;
     for (int crossing = 0; crossing < 8; crossing++) {
         Hit hit;
-        bool any = trace(origin, direction, time, hit, work, overflow);
         float remaining = distance - travelled;
-        float segment = any ? min(hit.t, remaining) : remaining;
+        // Hits within 1e-4 of the light's distance are the light itself (or beyond it):
+        // the traversal need not look that far.
+        bool any = trace(origin, direction, time, remaining * (1.0 - 1e-4), hit, work, overflow);
+        float segment = any ? hit.t : remaining;
         uint medium = media_inner(media);
         if (medium != 0u) {
             float density = packed_vec4(instance_offset + (medium - 1u) * uint(PACKED_INSTANCE_STRIDE) + 4u).x;
             transmittance *= exp(-density * segment);
         }
-        if (!any || hit.t >= remaining * (1.0 - 1e-4) || (hit.instance == NONE && hit.primitive == light_slot))
+        if (!any || (hit.instance == NONE && hit.primitive == light_slot))
             return transmittance;
         if (hit.instance == NONE)
             return vec3(0.0);
@@ -996,7 +1006,7 @@ void main()
         float time = mix(shutter_open, shutter_close, random4(0u, 3u).x);
         work = 0;
         Hit hit;
-        if (!trace(origin, direction, time, hit, work, overflow)) {
+        if (!trace(origin, direction, time, INFINITY, hit, work, overflow)) {
             albedo_sum += clamp(sky_radiance(direction), 0.0, 1.0);
             continue;
         }
@@ -1059,7 +1069,11 @@ void main()
     image_offset = header3.z;
     uvec4 header4 = packed_texel(4u);
     light_offset = header4.x;
+#ifdef RTSPHERES_OMIT_DIRECT_LIGHT
+    light_count = 0u;       // the host left light sampling out: nothing to sample
+#else
     light_count = light_sampling != 0 || integrator == 1 ? header4.y : 0u;
+#endif
     environment_offset = header4.z;
 
     // Full-image pixel, row 0 at the top: a crop or tile renders exactly the pixels
@@ -1100,7 +1114,7 @@ void main()
         // The sample's moment within the shutter: the same for all its segments.
         float time = mix(shutter_open, shutter_close, random4(0u, 3u).x);
         Hit hit;
-        bool hit_something = trace(origin, direction, time, hit, work, overflow);
+        bool hit_something = trace(origin, direction, time, INFINITY, hit, work, overflow);
         statistics.x += 1.0;
         bool path_done = false;
         vec4 u = random4(bounce, 1u);
@@ -1118,7 +1132,11 @@ void main()
 
         // In a medium: scatter before the surface with probability 1 - exp(-density * t).
         bool scattered_in_medium = false;
+#ifdef RTSPHERES_OMIT_VOLUMES
+        uint medium = 0u;
+#else
         uint medium = media_inner(media);
+#endif
         if (medium != 0u) {
             uint medium_base = instance_offset + (medium - 1u) * uint(PACKED_INSTANCE_STRIDE);
             vec4 volume = packed_vec4(medium_base + 4u);
@@ -1172,8 +1190,10 @@ void main()
                 uvec4 material2 = packed_texel(material + 2u);
                 uint material_type = material0.x;
                 vec3 albedo = uintBitsToFloat(material0.yzw);
+#ifndef RTSPHERES_OMIT_TEXTURES
                 if (material2.y != NONE)
                     albedo *= texture_value(material2.y, p, surface.uv);
+#endif
                 if (integrator == 1 && material_type != uint(MATERIAL_EMISSIVE)
                     && material_type != uint(MATERIAL_DIELECTRIC)) {
                     // Whitted: local Phong shading; metals also reflect, diffuse ends here.
@@ -1195,8 +1215,10 @@ void main()
                     }
                 } else if (material_type == uint(MATERIAL_EMISSIVE)) {
                     vec3 emission = uintBitsToFloat(material1.xyz);
+#ifndef RTSPHERES_OMIT_TEXTURES
                     if (material2.z != NONE)
                         emission *= texture_value(material2.z, p, surface.uv);
+#endif
                     // Light sampling could have found this emitter too: weight by MIS.
                     float weight = 1.0;
                     uint light = packed_texel(primitive_offset + hit.primitive * uint(PACKED_PRIMITIVE_STRIDE)).w;
@@ -1259,10 +1281,12 @@ void main()
                 }
             }
         }
+#ifndef RTSPHERES_OMIT_DIRECT_LIGHT
         if (want_direct)
             radiance += direct_weight * direct_light(direct_mode, direct_point, direct_normal, direct_shading,
                                                      -incoming, direct_albedo, direct_material, direct_phase, media,
                                                      time, segment_bounce, work, overflow);
+#endif
         if (path_done) {
             accumulated += vec4(radiance, 1.0);
             float luminance = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
