@@ -4,7 +4,9 @@
 #   all      (default) build ./rtspheres
 #   demo     install missing packages, build, render scenes/three-balls.txt to demo.png
 #   test     install missing packages, build, run every test (unit, render, analytic)
-#   bench    build with release flags and time the benchmark scenes (not a test)
+#   bench    build with release flags and time the benchmark scenes against a plain C
+#            reference built in the same run (not a test): a table with the targets as
+#            ratios, build/bench.csv (appended), build/bench.json, build/bench-plot.png
 #   golden   re-render the golden images in golden/ (never run by the tests; say why in
 #            the commit when you commit new ones)
 #   deps     install the Debian packages listed in .ci/debian-packages that are missing
@@ -21,6 +23,8 @@
 #   FUZZ_SECONDS  how long `make fuzz` runs each harness (default 60)
 #   FUZZ_CC, FUZZ_CXX  the compilers of the fuzz harnesses; must have libFuzzer
 #              (default clang, clang++)
+#   BENCH_SPP, BENCH_REFERENCE_SPP, BENCH_SCALE, BENCH_MESH_LEVELS  the sizes of `make
+#              bench` (environment; tests/bench/run.sh says what each does)
 
 all: rtspheres
 .PHONY: all demo test bench golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
@@ -154,9 +158,16 @@ test: deps
 	$(Q)$(if $(SAN_TEST_ENV),rm -rf $(SAN_REPORTS) && mkdir -p $(SAN_REPORTS) && )$(SAN_TEST_ENV) sh tests/run.sh \
 		$(BUILD) ./$(PROGRAM)
 
+# The bench compiles its own tools (the reference with -O3 -march=native -fopenmp and none
+# of your CFLAGS, since it is the yardstick; the peak-RSS wrapper; the chart) into
+# build/bench/, so `sh tests/bench/run.sh ./rtspheres` also works alone. A sanitizer
+# build would time the sanitizers, so SAN=1 is refused.
 bench: deps
+ifeq ($(SAN),1)
+	@echo "bench: times the release build; run it without SAN=1" >&2; exit 2
+endif
 	$(Q)$(MAKE) --no-print-directory all
-	$(Q)sh tests/bench/run.sh ./$(PROGRAM)
+	$(Q)CC="$(CC)" CXX="$(CXX)" V="$(V)" sh tests/bench/run.sh ./$(PROGRAM)
 
 golden: all
 	$(Q)sh tests/render/make-golden.sh ./$(PROGRAM)

@@ -1,48 +1,268 @@
 #!/bin/sh
-# run.sh: `make bench`: times the benchmark scenes (not a test: nothing here passes or
-# fails on speed). Prints a table and appends one CSV row per scene to build/bench.csv:
-#   date,scene,size,spp,triangles,seconds,samples_per_second,segments_per_second,
-#   bvh_build_seconds,bytes_per_triangle,first_pass_seconds
-# Knobs: BENCH_SPP (default 32) samples per pixel for the weekend scene.
-#   usage: sh tests/bench/run.sh PROGRAM
+# run.sh: `make bench` (issue #6): times a fixed set of scenes and a plain C reference in
+# the same run, and reports rtspheres' speed as ratios to it. Not a test: nothing here
+# passes or fails on speed (the exit status is 1 only when a render itself failed).
+#
+#   usage: sh tests/bench/run.sh PROGRAM          (from the repository root)
+#
+# Does not build rtspheres (the Makefile does); compiles its own tools into build/bench/
+# with $CC / $CXX: the reference (tests/bench/reference_weekend.c, -O3 -march=native
+# -fopenmp, on purpose without your CFLAGS: it is a fixed yardstick), the peak-RSS
+# wrapper (peak_rss.c), the chart (plot.cpp, OpenImageIO) and the mesh generator.
+#
+# The set (sizes and spp as run by default):
+#   startup, startup-cached  weekend at 64x36, 1 spp: process start to the first finished
+#                  pass with Mesa's shader cache off (a first run: context, parse, BVH,
+#                  upload and the whole shader compile; the issue's "cold start") and on
+#   weekend        scenes/weekend.txt 1200x675, BENCH_SPP spp, depth 50, and right after
+#   reference-weekend  the plain C reference of the same scene (same samples, depth 50)
+#   three-balls    640x360, 16 spp; three-balls-whitted the same frame, 4 spp, Whitted
+#   three-balls-anim  24 frames (--frames 0-23) at 320x180, 4 spp, one GPU context
+#   cornell        600x600, 4 spp; next-week 400x400 (half the book's), 2 spp;
+#   crystal-ball   640x480, 4 spp
+#   mesh-L         icospheres of level L (3 5 6 8: 1,280 / 20,480 / 81,920 / 1,310,720
+#                  triangles, the nearest levels to the issue's 1k/10k/100k/1M), 320x240,
+#                  16 spp, depth 8
+# About 2 minutes on 2 idle cores, 5 with a test run alongside; most of it the weekend.
+#
+# Columns: wall s (the whole process, from peak_rss), cores (its CPU time / wall time:
+# below the core count when other work took CPU), render s (rtspheres' own time:
+# from the BVH build to the last pass, so BVH build, upload and shader compile are in it;
+# the reference: its render loop), samples/s, path segments/s (counted by the shader
+# and by the reference, one per ray from the camera or a bounce), us/sample (render s
+# less the BVH build, per sample: the build is a one-off cost, in its own column, whose
+# share would otherwise depend on the spp), BVH s, B/tri (packed bytes per triangle), first pass s (process start to the
+# first finished pass), RSS MiB (peak resident set, the process with all its threads).
+#
+# Outputs:
+#   stdout            one table row per scene as it finishes, then the targets as ratios
+#   build/bench.csv   one row per scene per run, appended (a file with another header is
+#                     moved aside to build/bench-old-DATE.csv first)
+#   build/bench.json  the latest run: machine, knobs, every scene, reference, targets
+#   build/bench-plot.png  time per sample against triangle count (log x)
+#   build/bench/      images, logs (NAME.log) and tools
+#
+# Knobs (environment):
+#   BENCH_SPP            weekend samples per pixel (default 32)
+#   BENCH_REFERENCE_SPP  the reference's samples per pixel (default 8; a rate is compared,
+#                        so fewer samples only make it noisier)
+#   BENCH_SCALE          multiplies the spp of every other scene (default 1; 0.25 for a
+#                        quick look, integer results, at least 1 spp)
+#   BENCH_MESH_LEVELS    icosphere levels (default "3 5 6 8"; 20 * 4^level triangles)
 set -eu
 program=$1
-spp=${BENCH_SPP:-32}
+weekend_spp=${BENCH_SPP:-32}
+reference_spp=${BENCH_REFERENCE_SPP:-8}
+scale=${BENCH_SCALE:-1}
+mesh_levels=${BENCH_MESH_LEVELS:-3 5 6 8}
+CC=${CC:-cc}
+CXX=${CXX:-c++}
 work=build/bench
-mkdir -p "$work"
 csv=build/bench.csv
-[ -f "$csv" ] || echo "date,scene,size,spp,triangles,seconds,samples_per_second,segments_per_second,bvh_build_seconds,bytes_per_triangle,first_pass_seconds" >"$csv"
+json=build/bench.json
+chart=build/bench-plot.png
+rows=$work/run.tsv       # this run's rows, tab-separated, for the summary and the JSON
+mkdir -p "$work"
+: >"$rows"
+run_id=$(date -u +%Y-%m-%dT%H:%M:%SZ)
+failures=0
 
-bench() {
-    name=$1 scene=$2 size=$3 spp=$4
-    shift 4
-    out="$work/$name.exr"
-    "$program" render "$scene" -o "$out" --size "$size" --spp "$spp" --verbose "$@" 2>"$work/$name.log" >/dev/null
-    summary=$(grep -- "-> $out" "$work/$name.log" | tail -1)
-    details=$(grep "rtspheres: scene:" "$work/$name.log" | tail -1)
-    seconds=$(echo "$summary" | sed -n 's/.* spp in \([0-9.]*\) s .*/\1/p')
-    samples=$(echo "$summary" | sed -n 's/.*(\([0-9.e+]*\) samples\/s.*/\1/p')
-    segments=$(echo "$summary" | sed -n 's/.*, \([0-9.e+]*\) path segments\/s.*/\1/p')
-    triangles=$(echo "$details" | sed -n 's/.*(\([0-9]*\) triangles).*/\1/p')
-    build=$(echo "$details" | sed -n 's/.*built in \([0-9.]*\) s.*/\1/p')
-    per_triangle=$(echo "$details" | sed -n 's/.*bytes (\([0-9.]*\) per triangle.*/\1/p')
-    first=$(echo "$details" | sed -n 's/.*first pass done \([0-9.]*\) s.*/\1/p')
-    printf '%-14s %-9s %4s spp %8s tris %7s s %9s samples/s %9s segments/s  BVH %6s s %6s B/tri  first pass %s s\n' \
-        "$name" "$size" "$spp" "$triangles" "$seconds" "$samples" "$segments" "$build" "$per_triangle" "$first"
-    echo "$(date -u +%Y-%m-%dT%H:%M:%SZ),$name,$size,$spp,$triangles,$seconds,$samples,$segments,$build,$per_triangle,$first" >>"$csv"
+header="date,run,scene,size,spp,frames,triangles,wall_seconds,render_seconds,samples_per_second,segments_per_second,seconds_per_sample,bvh_build_seconds,bytes_per_triangle,first_pass_seconds,peak_rss_mib,frames_per_second,cpu_seconds"
+if [ -f "$csv" ] && [ "$(head -n 1 "$csv")" != "$header" ]; then
+    old="build/bench-old-$(date -u +%Y%m%dT%H%M%SZ).csv"
+    mv "$csv" "$old"
+    echo "bench: $csv had other columns; moved it to $old"
+fi
+[ -f "$csv" ] || echo "$header" >"$csv"
+
+# ---- tools ----------------------------------------------------------------------------
+# Builds OUTPUT from SOURCE with the command in the rest of the arguments unless OUTPUT
+# is newer already; says so as the Makefile does (the command itself with V=1).
+build_tool() {
+    tool_output=$1 tool_source=$2
+    shift 2
+    [ -n "$(find "$tool_output" -newer "$tool_source" 2>/dev/null)" ] && return 0
+    if [ "${V:-}" = 1 ]; then echo "$@"; else printf '  %-7s %s\n' TOOL "$tool_output"; fi
+    "$@" || { echo "bench: building $tool_output failed" >&2; exit 1; }
+}
+build_tool "$work/peak_rss" tests/bench/peak_rss.c \
+    "$CC" -std=c11 -Wall -Wextra -O2 tests/bench/peak_rss.c -o "$work/peak_rss"
+build_tool "$work/reference_weekend" tests/bench/reference_weekend.c \
+    "$CC" -std=c11 -Wall -Wextra -O3 -march=native -fopenmp tests/bench/reference_weekend.c -lm \
+    -o "$work/reference_weekend"
+# shellcheck disable=SC2046 # pkg-config prints several flags, to be split into words
+build_tool "$work/plot" tests/bench/plot.cpp \
+    "$CXX" -std=c++17 -Wall -Wextra -O2 $(pkg-config --cflags OpenImageIO) tests/bench/plot.cpp \
+    $(pkg-config --libs OpenImageIO) -o "$work/plot"
+build_tool "$work/assets" scenes/generators/assets.c \
+    "$CC" -std=c11 -O2 scenes/generators/assets.c -lm -o "$work/assets"
+
+# ---- measuring ------------------------------------------------------------------------
+# Prints N scaled by BENCH_SCALE, rounded, at least 1.
+scaled() { awk -v n="$1" -v s="$scale" 'BEGIN { v = int(n * s + 0.5); print v < 1 ? 1 : v }'; }
+
+# Prints the first match of sed expression $2 in text $1, or "-" when there is none.
+field() { found=$(printf '%s\n' "$1" | sed -n "$2" | head -n 1); echo "${found:--}"; }
+
+# Appends one row to the run's rows and the CSV and prints it in the table. Arguments
+# (their column numbers in the rows): 1 name, 2 size, 3 spp, 4 frames, 5 triangles,
+# 6 wall s, 7 render s, 8 samples/s, 9 segments/s, 10 s/sample, 11 BVH s, 12 B/tri,
+# 13 first pass s, 14 RSS MiB, 15 frames/s, 16 CPU s, 17 note; "-" when unknown.
+record() {
+    printf '%s\t' "$@" | sed 's/\t$//' >>"$rows"
+    echo >>"$rows"
+    printf '%-19s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s  %s\n' \
+        "$1" "$2" "$3" "$5" "$6" "$(awk -v c="${16}" -v w="$6" 'BEGIN {
+            if (c == "-" || w == "-" || w <= 0) print "-"; else printf "%.2f", c / w }')" "$7" "$8" "$9" \
+        "$(awk -v s="${10}" 'BEGIN { if (s == "-") print "-"; else printf "%.3g", s * 1e6 }')" \
+        "${11}" "${12}" "${13}" "${14}" "${17}"
+    # The CSV leaves unknown values empty rather than "-", and has no note.
+    echo "$(date -u +%Y-%m-%dT%H:%M:%SZ),$run_id,$1,$2,$3,$4,$5,$6,$7,$8,$9,${10},${11},${12},${13},${14},${15},${16}" |
+        awk -F ',' 'BEGIN { OFS = "," } { for (i = 1; i <= NF; i++) if ($i == "-") $i = ""; print }' >>"$csv"
 }
 
-"$program" info | sed -n 's/^GL renderer: *//p' | sed 's/^/renderer: /'
-bench weekend scenes/weekend.txt 1200x675 "$spp" --max-depth 50
-bench three-balls scenes/three-balls.txt 640x360 64
+# Renders SCENE as NAME under the peak-RSS wrapper and records its row with NOTE; the
+# arguments after NOTE go to rtspheres. $render_environment (NAME=VALUE words, usually
+# empty) is added to rtspheres' environment.
+render_environment=
+bench() {
+    name=$1 scene=$2 size=$3 spp=$4 note=$5
+    shift 5
+    out="$work/$name.exr" log="$work/$name.log"
+    rm -f "$out"     # a failed render must not leave the last run's image to be measured
+    if ! env $render_environment "$work/peak_rss" "$program" render "$scene" -o "$out" --size "$size" --spp "$spp" \
+        --verbose "$@" 2>"$log" >/dev/null; then
+        echo "$name: rtspheres FAILED (exit status in $log:)"; tail -n 3 "$log"
+        failures=$((failures + 1))
+        return 0
+    fi
+    summary=$(grep -- "-> $out" "$log" | tail -n 1)
+    details=$(grep "rtspheres: scene:" "$log" | tail -n 1)
+    measured=$(grep "^peak_rss:" "$log" | tail -n 1)
+    render_seconds=$(field "$summary" 's/.* spp in \([0-9.]*\) s .*/\1/p')
+    samples=$(field "$summary" 's/.*(\([0-9.e+-]*\) samples\/s.*/\1/p')
+    segments=$(field "$summary" 's/.*, \([0-9.e+-]*\) path segments\/s.*/\1/p')
+    triangles=$(field "$details" 's/.*(\([0-9]*\) triangles).*/\1/p')
+    build=$(field "$details" 's/.*built in \([0-9.]*\) s.*/\1/p')
+    per_triangle=$(field "$details" 's/.*bytes (\([0-9.]*\) per triangle.*/\1/p')
+    [ "$triangles" != 0 ] || per_triangle=-
+    first=$(field "$details" 's/.*first pass done \([0-9.]*\) s.*/\1/p')
+    wall=$(field "$measured" 's/.*, \([0-9.]*\) s wall.*/\1/p')
+    cpu=$(field "$measured" 's/.*, \([0-9.]*\) s CPU.*/\1/p')
+    rss=$(field "$measured" 's/^peak_rss: \([0-9]*\) KiB.*/\1/p')
+    rss=$(awk -v k="$rss" 'BEGIN { if (k == "-") print "-"; else printf "%.0f", k / 1024 }')
+    # Time per sample from the render time less the BVH build and the sample count (not
+    # from the rounded rate).
+    per_sample=$(awk -v s="$render_seconds" -v b="$build" -v size="$size" -v spp="$spp" 'BEGIN {
+        split(size, wh, "x"); if (b == "-") b = 0
+        if (s == "-") print "-"; else printf "%.4g", (s - b) / (wh[1] * wh[2] * spp) }')
+    record "$name" "$size" "$spp" 1 "$triangles" "$wall" "$render_seconds" "$samples" "$segments" "$per_sample" \
+        "$build" "$per_triangle" "$first" "$rss" - "$cpu" "$note"
+}
+
+# Renders the three-ball animation (frames 0 .. FRAMES-1 on one GPU context) as NAME and
+# records its row: rates over all frames, first pass and BVH of the first frame.
+bench_animation() {
+    name=$1 scene=$2 size=$3 spp=$4 frames=$5
+    log="$work/$name.log"
+    rm -f "$work/$name"-*.exr
+    if ! "$work/peak_rss" "$program" render "$scene" -o "$work/$name-%03d.exr" --size "$size" --spp "$spp" \
+        --frames "0-$((frames - 1))" --verbose 2>"$log" >/dev/null; then
+        echo "$name: rtspheres FAILED (see $log:)"; tail -n 3 "$log"
+        failures=$((failures + 1))
+        return 0
+    fi
+    details=$(grep "rtspheres: scene:" "$log" | head -n 1)
+    summary=$(grep "frames in .* frames/s" "$log" | tail -n 1)
+    measured=$(grep "^peak_rss:" "$log" | tail -n 1)
+    seconds=$(field "$summary" 's/.* frames* in \([0-9.]*\) s .*/\1/p')
+    fps=$(field "$summary" 's/.*(\([0-9.e+-]*\) frames\/s).*/\1/p')
+    # Path segments: each frame's rate times its time, summed over the frames.
+    segments_total=$(grep -- "-> $work/$name-" "$log" |
+        sed -n 's/.* spp in \([0-9.]*\) s (.*, \([0-9.e+-]*\) path segments\/s.*/\1 \2/p' |
+        awk '{ total += $1 * $2 } END { print total + 0 }')
+    rates=$(awk -v s="$seconds" -v size="$size" -v spp="$spp" -v n="$frames" -v seg="$segments_total" 'BEGIN {
+        split(size, wh, "x"); samples = wh[1] * wh[2] * spp * n
+        if (s == "-" || s <= 0) print "- - -"; else printf "%.3g %.3g %.4g\n", samples / s, seg / s, s / samples }')
+    # shellcheck disable=SC2086 # three numbers (or dashes), one argument each
+    set -- $rates
+    wall=$(field "$measured" 's/.*, \([0-9.]*\) s wall.*/\1/p')
+    cpu=$(field "$measured" 's/.*, \([0-9.]*\) s CPU.*/\1/p')
+    rss=$(field "$measured" 's/^peak_rss: \([0-9]*\) KiB.*/\1/p')
+    rss=$(awk -v k="$rss" 'BEGIN { if (k == "-") print "-"; else printf "%.0f", k / 1024 }')
+    record "$name" "$size" "$spp" "$frames" 0 "$wall" "$seconds" "$1" "$2" "$3" \
+        "$(field "$details" 's/.*built in \([0-9.]*\) s.*/\1/p')" - \
+        "$(field "$details" 's/.*first pass done \([0-9.]*\) s.*/\1/p')" "$rss" "$fps" "$cpu" \
+        "$fps frames/s ($frames frames)"
+}
+
+# Renders the weekend scene with the plain C reference and records its row.
+bench_reference() {
+    size=$1 spp=$2
+    log="$work/reference-weekend.log"
+    if ! "$work/peak_rss" "$work/reference_weekend" scenes/weekend.txt -o "$work/reference-weekend.pfm" \
+        --size "$size" --spp "$spp" --max-depth 50 >"$log" 2>&1; then
+        echo "reference-weekend: FAILED (see $log:)"; tail -n 3 "$log"
+        failures=$((failures + 1))
+        return 0
+    fi
+    summary=$(grep "^reference:" "$log" | tail -n 1)
+    measured=$(grep "^peak_rss:" "$log" | tail -n 1)
+    seconds=$(field "$summary" 's/.* spp in \([0-9.]*\) s .*/\1/p')
+    threads=$(field "$summary" 's/.*, \([0-9]*\) threads).*/\1/p')
+    rss=$(field "$measured" 's/^peak_rss: \([0-9]*\) KiB.*/\1/p')
+    rss=$(awk -v k="$rss" 'BEGIN { if (k == "-") print "-"; else printf "%.0f", k / 1024 }')
+    per_sample=$(awk -v s="$seconds" -v size="$size" -v spp="$spp" 'BEGIN {
+        split(size, wh, "x"); if (s == "-") print "-"; else printf "%.4g", s / (wh[1] * wh[2] * spp) }')
+    record reference-weekend "$size" "$spp" 1 0 "$(field "$measured" 's/.*, \([0-9.]*\) s wall.*/\1/p')" \
+        "$seconds" "$(field "$summary" 's/.*(\([0-9.e+-]*\) samples\/s.*/\1/p')" \
+        "$(field "$summary" 's/.*, \([0-9.e+-]*\) path segments\/s.*/\1/p')" "$per_sample" - - - "$rss" - \
+        "$(field "$measured" 's/.*, \([0-9.]*\) s CPU.*/\1/p')" "plain C, brute force, OpenMP $threads threads"
+}
+
+# Prints column $2 of the row named $1 of this run, or "-".
+value() {
+    awk -F '\t' -v name="$1" -v column="$2" '$1 == name { v = $column } END { print v == "" ? "-" : v }' "$rows"
+}
+
+# ---- the run --------------------------------------------------------------------------
+renderer=$("$program" info 2>/dev/null | sed -n 's/^GL renderer: *//p')
+cpu_model=$(sed -n 's/^model name[[:space:]]*: *//p' /proc/cpuinfo 2>/dev/null | head -n 1)
+cores=$(nproc 2>/dev/null || echo "-")
+load_start=$(cut -d ' ' -f 1-3 /proc/loadavg 2>/dev/null || echo "-")
+echo "bench: $run_id, $cpu_model, $cores cores, renderer $renderer"
+echo "bench: load average at the start $load_start (other work on the machine slows both renderers alike" \
+    "only when it stays steady)"
+printf '%-19s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s  %s\n' \
+    scene size spp triangles "wall s" cores "render s" samples/s segments/s us/sample "BVH s" B/tri "first" "RSS" note
+printf '%-19s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s\n' \
+    "" "" "" "" "" "" "" "" "" "" "" "" "pass s" "MiB"
+
+# The start-up probe: with Mesa's on-disk shader cache off, every run compiles the tracer
+# from scratch, as a first run on a new machine does.
+render_environment=MESA_SHADER_CACHE_DISABLE=true
+bench startup scenes/weekend.txt 64x36 1 "start-up probe: Mesa shader cache off" --max-depth 50
+render_environment=
+# The same with the cache as later runs find it (one unrecorded run fills it first).
+"$program" render scenes/weekend.txt -o "$work/startup-cached.exr" --size 64x36 --spp 1 --quiet 2>/dev/null || :
+bench startup-cached scenes/weekend.txt 64x36 1 "start-up probe: Mesa shader cache on" --max-depth 50
+# The headline pair back to back, so that the same load weighs on both.
+bench weekend scenes/weekend.txt 1200x675 "$weekend_spp" "" --max-depth 50
+bench_reference 1200x675 "$reference_spp"
+bench three-balls scenes/three-balls.txt 640x360 "$(scaled 16)" ""
 # The seed's quick-sweep mode: a Whitted frame with soft shadows (POV-Ray renders such a
 # frame with an 8x8 area light in about 1.6 s on two cores).
-bench three-balls-whitted scenes/three-balls.txt 640x360 4 --integrator whitted
+bench three-balls-whitted scenes/three-balls.txt 640x360 4 "Whitted (POV-Ray: 1.6 s)" --integrator whitted
+bench_animation three-balls-anim scenes/three-balls.txt 320x180 "$(scaled 4)" 24
+# The books' scenes at the books' sizes, except the Next Week scene at half its 800x800
+# (its fog makes every path scatter: 1 spp of the full frame takes ~40 s here).
+bench cornell scenes/cornell.txt 600x600 "$(scaled 4)" ""
+bench next-week scenes/next-week.txt 400x400 "$(scaled 2)" ""
+bench crystal-ball scenes/crystal-ball.txt 640x480 "$(scaled 4)" ""
 
-# Meshes of growing size (icospheres of subdivision 3, 5, 6, 8: 1,280 to 1,310,720
-# triangles), the same small frame each: time per sample should grow about like log n.
-cc -std=c11 -O2 scenes/generators/assets.c -lm -o "$work/assets"
-for level in 3 5 6 8; do
+# Meshes of growing size, the same small frame each: time per sample should grow about
+# like log n. Generated at run time (the largest OBJ is 138 MB), never committed.
+for level in $mesh_levels; do
     [ -f "$work/icosphere-$level.obj" ] || "$work/assets" "$work" "$level" >/dev/null
     cat >"$work/mesh-$level.txt" <<SCENE
 render size 320 240 depth 8 seed 1
@@ -55,6 +275,104 @@ group material shiny {
     mesh "icosphere-$level.obj"
 }
 SCENE
-    bench "mesh-$level" "$work/mesh-$level.txt" 320x240 16
+    bench "mesh-$level" "$work/mesh-$level.txt" 320x240 "$(scaled 16)" ""
 done
-echo "results appended to $csv"
+load_end=$(cut -d ' ' -f 1-3 /proc/loadavg 2>/dev/null || echo "-")
+
+# ---- the weekend images agree? (a sanity check of the reference, never a failure) ------
+rtspheres_mean=$("$program" stats "$work/weekend.exr" 2>/dev/null |
+    awk '/^channel [RGB]:/ { printf "%s%.4f", n++ ? " " : "", $4 }')
+reference_mean=$(sed -n 's/.*; mean \(.*\)$/\1/p' "$work/reference-weekend.log" 2>/dev/null | tail -n 1)
+mean_difference=$(echo "${rtspheres_mean:--} ${reference_mean:--}" | awk 'NF == 6 {
+    for (i = 1; i <= 3; i++) { d = ($i - $(i + 3)) / ($i > 0 ? $i : 1); d = d < 0 ? -d : d; if (d > m) m = d }
+    printf "%.2g", 100 * m; exit } { print "-" }')
+echo
+echo "weekend mean colour: rtspheres ${rtspheres_mean:--}, reference ${reference_mean:--}" \
+    "(largest difference ${mean_difference}%; same scene when within about 1%)"
+
+# ---- the chart --------------------------------------------------------------------------
+plot_data=$work/plot-data.txt
+echo "# triangles seconds_per_sample name (make bench, $run_id)" >"$plot_data"
+for level in $mesh_levels; do
+    awk -F '\t' -v name="mesh-$level" '$1 == name && $5 != "-" && $10 != "-" { print $5, $10, $1 }' \
+        "$rows" >>"$plot_data"
+done
+if [ "$(grep -vc '^#' "$plot_data")" -gt 0 ] && "$work/plot" "$plot_data" "$chart"; then
+    echo "chart: $chart (time per sample against triangles; data in $plot_data)"
+else
+    echo "chart: not drawn"
+fi
+
+# ---- targets (issue #6) -------------------------------------------------------------------
+first_level=$(echo "$mesh_levels" | awk '{ print $1 }')
+last_level=$(echo "$mesh_levels" | awk '{ print $NF }')
+targets=$work/targets.tsv
+{
+    # name, value, comparison, limit, unit, how it is computed
+    printf 'weekend_segments_ratio\t%s\t>=\t3\tx\tweekend path segments/s / reference path segments/s\n' \
+        "$(awk -v a="$(value weekend 9)" -v b="$(value reference-weekend 9)" 'BEGIN {
+            if (a == "-" || b == "-" || b <= 0) print "-"; else printf "%.3g", a / b }')"
+    printf 'mesh_time_per_sample_growth\t%s\t<=\t2.5\tx\ttime per sample mesh-%s / mesh-%s (BVH build apart)\n' \
+        "$(awk -v a="$(value "mesh-$last_level" 10)" -v b="$(value "mesh-$first_level" 10)" 'BEGIN {
+            if (a == "-" || b == "-" || b <= 0) print "-"; else printf "%.3g", a / b }')" "$last_level" "$first_level"
+    printf 'cold_start_first_pass\t%s\t<\t0.5\ts\tcold start to first pass (start-up probe, no shader cache)\n' \
+        "$(value startup 13)"
+    printf 'packed_bytes_per_triangle\t%s\t<=\t100\tB\tpacked bytes per triangle, mesh-%s\n' \
+        "$(value "mesh-$last_level" 12)" "$last_level"
+} | awk -F '\t' 'BEGIN { OFS = "\t" } {
+    reached = ($3 == ">=" && $2 >= $4) || ($3 == "<=" && $2 <= $4) || ($3 == "<" && $2 < $4)
+    met = $2 == "-" ? "unknown" : reached ? "met" : "missed"
+    print $1, $2, $3, $4, $5, $6, met }' >"$targets"
+echo
+echo "targets (ratios measured in this run):"
+awk -F '\t' '{ printf "  %-74s %7s %-2s %-3s %-2s %s\n", $6, $2, $3, $4, $5, $7 }' "$targets"
+# Counting the BVH build in (the one-off cost the growth target leaves to its own column):
+echo "  (time per sample with the BVH build in it: mesh-$last_level / mesh-$first_level = $(awk -F '\t' \
+    -v a="mesh-$last_level" -v b="mesh-$first_level" '$1 == a || $1 == b {
+        split($2, wh, "x"); t[$1] = $7 == "-" ? -1 : $7 / (wh[1] * wh[2] * $3) }
+    END { if (t[a] > 0 && t[b] > 0) printf "%.3g", t[a] / t[b]; else print "unknown" }' "$rows"))"
+# Other work on the machine takes cores from whichever renderer runs at the time: path
+# segments per CPU-second (all threads) are less sensitive to that than per wall second.
+echo "  (path segments per CPU-second instead: $(awk -v a="$(value weekend 9)" -v ar="$(value weekend 7)" \
+    -v ac="$(value weekend 16)" -v b="$(value reference-weekend 9)" -v br="$(value reference-weekend 7)" \
+    -v bc="$(value reference-weekend 16)" 'BEGIN {
+        if (a == "-" || ar == "-" || ac == "-" || b == "-" || br == "-" || bc == "-" || ac <= 0 || bc <= 0 || b <= 0)
+            print "unknown"
+        else printf "rtspheres %.3g, reference %.3g, ratio %.3g", a * ar / ac, b * br / bc,
+                    (a * ar / ac) / (b * br / bc) }'))"
+echo "  (first pass with Mesa's shader cache: $(value startup-cached 13) s;" \
+    "weekend's own, a full 1200x675 pass: $(value weekend 13) s)"
+echo "load average at the end $load_end"
+
+# ---- JSON of this run -----------------------------------------------------------------------
+# Prints $1 as a JSON string.
+json_string() { printf '"%s"' "$(printf '%s' "$1" | sed 's/\\/\\\\/g; s/"/\\"/g')"; }
+{
+    printf '{\n  "date": "%s",\n' "$run_id"
+    printf '  "machine": {"cpu": %s, "cores": %s, "renderer": %s, "load_average_start": %s, "load_average_end": %s},\n' \
+        "$(json_string "$cpu_model")" "$(echo "$cores" | sed 's/^-$/null/')" "$(json_string "$renderer")" \
+        "$(json_string "$load_start")" "$(json_string "$load_end")"
+    printf '  "knobs": {"BENCH_SPP": %s, "BENCH_REFERENCE_SPP": %s, "BENCH_SCALE": %s, "BENCH_MESH_LEVELS": %s},\n' \
+        "$weekend_spp" "$reference_spp" "$scale" "$(json_string "$mesh_levels")"
+    printf '  "scenes": [\n'
+    awk -F '\t' 'function number(v) { return v == "-" || v == "" ? "null" : v }
+        { printf "%s    {\"name\": \"%s\", \"size\": \"%s\", \"spp\": %s, \"frames\": %s, \"triangles\": %s, " \
+              "\"wall_seconds\": %s, \"render_seconds\": %s, \"samples_per_second\": %s, " \
+              "\"segments_per_second\": %s, \"seconds_per_sample\": %s, \"bvh_build_seconds\": %s, " \
+              "\"bytes_per_triangle\": %s, \"first_pass_seconds\": %s, \"peak_rss_mib\": %s, " \
+              "\"frames_per_second\": %s, \"cpu_seconds\": %s, \"note\": \"%s\"}", (NR > 1 ? ",\n" : ""), $1, $2,
+              number($3), number($4), number($5), number($6), number($7), number($8), number($9), number($10),
+              number($11), number($12), number($13), number($14), number($15), number($16), $17 }
+        END { print "" }' "$rows"
+    printf '  ],\n'
+    printf '  "weekend_mean": {"rtspheres": [%s], "reference": [%s], "largest_difference_percent": %s},\n' \
+        "$(echo "${rtspheres_mean:-}" | sed 's/ /, /g')" "$(echo "${reference_mean:-}" | sed 's/ /, /g')" \
+        "$(echo "$mean_difference" | sed 's/^-$/null/')"
+    printf '  "targets": [\n'
+    awk -F '\t' '{ printf "%s    {\"name\": \"%s\", \"value\": %s, \"comparison\": \"%s\", \"limit\": %s, " \
+                      "\"unit\": \"%s\", \"what\": \"%s\", \"status\": \"%s\"}", (NR > 1 ? ",\n" : ""), $1,
+                      $2 == "-" ? "null" : $2, $3, $4, $5, $6, $7 } END { print "" }' "$targets"
+    printf '  ],\n  "chart": "%s"\n}\n' "$chart"
+} >"$json"
+echo "results: $json (this run), rows appended to $csv"
+[ "$failures" = 0 ] || { echo "bench: $failures render(s) FAILED" >&2; exit 1; }
