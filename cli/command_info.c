@@ -69,6 +69,7 @@ int command_info(int argc, char **argv)
     printf("GL version:       %s\n", info.gl_version);
     printf("GLSL version:     %s\n", info.glsl_version);
     printf("max texture size: %d\n", info.max_texture_size);
+    printf("max texture buffer size: %d texels (the packed scene's limit)\n", info.max_texture_buffer_size);
     printf("max draw buffers: %d\n", info.max_draw_buffers);
     printf("max fragment atomic counters: %d\n", info.max_fragment_atomic_counters);
     gpu_destroy(context);

@@ -21,6 +21,10 @@ static const char *const state_sampler_names[STATE_TARGET_COUNT] = {
     "state_counters", "state_accumulated", "state_statistics",
 };
 
+/* Tracer variants kept per context: a render uses one (and the AOV pass one more); an
+ * animation or sweep keeps using the same few. */
+#define GPU_PROGRAM_CACHE_SIZE 16
+
 struct gpu_context {
     EGLDisplay display;
     EGLContext context;
@@ -28,9 +32,14 @@ struct gpu_context {
     gpu_options options;
     /* Kept between renders on this context (frames of an animation, a sweep): the
      * compiled tracer, and the last packed scene uploaded with its hash. */
-    GLuint tracer_programs[8];            /* by omitted_features (GPU_OMIT_* bits); 0: not built */
-    GLuint packed_texture;
-    int packed_width_log2;
+    struct {                              /* compiled tracer variants, by variant key */
+        uint32_t key;
+        GLuint program;
+    } tracer_programs[GPU_PROGRAM_CACHE_SIZE];
+    int tracer_program_count;
+    int next_eviction;                    /* the slot a full cache replaces next */
+    GLuint packed_texture;                /* a buffer texture over packed_buffer */
+    GLuint packed_buffer;
     uint64_t packed_hash;
     uint32_t packed_texel_count;
 };
@@ -41,7 +50,7 @@ struct gpu_tracer {
     GLuint program;
     GLuint vertex_array;
     GLuint packed_texture;
-    int packed_width_log2;
+    GLuint packed_buffer;
     GLuint state_textures[2][STATE_TARGET_COUNT];
     GLuint framebuffers[2];
     GLuint counter_buffer;
@@ -183,6 +192,7 @@ static void read_gl_info(gpu_context *context)
     copy_string(info->glsl_version, sizeof info->glsl_version,
                 (const char *)glGetString(GL_SHADING_LANGUAGE_VERSION));
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &info->max_texture_size);
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &info->max_texture_buffer_size);
     glGetIntegerv(GL_MAX_DRAW_BUFFERS, &info->max_draw_buffers);
     glGetIntegerv(GL_MAX_COLOR_ATTACHMENTS, &info->max_color_attachments);
     glGetIntegerv(GL_MAX_FRAGMENT_ATOMIC_COUNTERS, &info->max_fragment_atomic_counters);
@@ -299,11 +309,13 @@ void gpu_destroy(gpu_context *context)
 {
     if (context == NULL)
         return;
-    for (size_t i = 0; i < sizeof context->tracer_programs / sizeof context->tracer_programs[0]; i++)
-        if (context->tracer_programs[i])
-            glDeleteProgram(context->tracer_programs[i]);
+    for (int i = 0; i < context->tracer_program_count; i++)
+        if (context->tracer_programs[i].program)
+            glDeleteProgram(context->tracer_programs[i].program);
     if (context->packed_texture)
         glDeleteTextures(1, &context->packed_texture);
+    if (context->packed_buffer)
+        glDeleteBuffers(1, &context->packed_buffer);
     eglMakeCurrent(context->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(context->display, context->context);
     eglTerminate(context->display);
@@ -396,22 +408,62 @@ static GLuint build_tracer_program(const char *defines, rt_error *error)
     return link_program(vertex, fragment, error);
 }
 
-/* The context's tracer program without the features in omitted (GPU_OMIT_* bits),
- * compiled on first use and kept. */
-static rt_status build_program(gpu_tracer *tracer, uint32_t omitted, rt_error *error)
+/* Writes the #defines of a tracer variant into defines (size bytes): the GPU_OMIT_* bits
+ * of omitted, and with GPU_FIX_UNIFORMS the integrator and sky type as constants. */
+static void variant_defines(uint32_t omitted, int integrator, int sky_type, char *defines, size_t size)
+{
+    static const char *const names[] = {"DIRECT_LIGHT", "VOLUMES", "TEXTURES", "SPHERES", "MOVING_SPHERES",
+                                        "FLAT", "INSTANCES", "EMITTERS"};
+    size_t used = 0;
+    defines[0] = '\0';
+    for (unsigned bit = 0; bit < sizeof names / sizeof names[0]; bit++)
+        if (omitted & (1u << bit))
+            used += (size_t)snprintf(defines + used, size - used, "#define RTSPHERES_OMIT_%s 1\n", names[bit]);
+    if (omitted & GPU_FIX_UNIFORMS)
+        snprintf(defines + used, size - used, "#define RTSPHERES_INTEGRATOR %d\n#define RTSPHERES_SKY_TYPE %d\n",
+                 integrator, sky_type);
+}
+
+/* The key of a variant in the context's program cache: the bits, and the constants
+ * compiled in with GPU_FIX_UNIFORMS. */
+static uint32_t variant_key(uint32_t omitted, int integrator, int sky_type)
+{
+    omitted &= (1u << GPU_VARIANT_BITS) - 1u;
+    if (omitted & GPU_FIX_UNIFORMS)
+        return omitted | (uint32_t)(integrator & 3) << 16 | (uint32_t)(sky_type & 15) << 20;
+    return omitted;
+}
+
+/* The context's tracer program for the variant of the parameters (omitted_features,
+ * integrator, sky type), compiled on first use and kept (the oldest goes when the cache
+ * is full; a render holding it still has it, since only the next render asks again). */
+static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *parameters, rt_error *error)
 {
     gpu_context *context = tracer->context;
-    omitted &= GPU_OMIT_DIRECT_LIGHT | GPU_OMIT_VOLUMES | GPU_OMIT_TEXTURES;
-    if (context->tracer_programs[omitted] == 0) {
-        char defines[256];
-        snprintf(defines, sizeof defines, "%s%s%s",
-                 omitted & GPU_OMIT_DIRECT_LIGHT ? "#define RTSPHERES_OMIT_DIRECT_LIGHT 1\n" : "",
-                 omitted & GPU_OMIT_VOLUMES ? "#define RTSPHERES_OMIT_VOLUMES 1\n" : "",
-                 omitted & GPU_OMIT_TEXTURES ? "#define RTSPHERES_OMIT_TEXTURES 1\n" : "");
-        context->tracer_programs[omitted] = build_tracer_program(defines, error);
+    uint32_t omitted = parameters->omitted_features;
+    uint32_t key = variant_key(omitted, parameters->integrator, parameters->sky_type);
+    for (int i = 0; i < context->tracer_program_count; i++)
+        if (context->tracer_programs[i].key == key) {
+            tracer->program = context->tracer_programs[i].program;
+            return RT_OK;
+        }
+    char defines[512];
+    variant_defines(omitted, parameters->integrator, parameters->sky_type, defines, sizeof defines);
+    GLuint program = build_tracer_program(defines, error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    int slot = context->tracer_program_count;
+    if (slot == GPU_PROGRAM_CACHE_SIZE) {
+        slot = context->next_eviction;
+        context->next_eviction = (context->next_eviction + 1) % GPU_PROGRAM_CACHE_SIZE;
+        glDeleteProgram(context->tracer_programs[slot].program);
+    } else {
+        context->tracer_program_count++;
     }
-    tracer->program = context->tracer_programs[omitted];
-    return tracer->program ? RT_OK : RT_ERROR_RUNTIME;
+    context->tracer_programs[slot].key = key;
+    context->tracer_programs[slot].program = program;
+    tracer->program = program;
+    return RT_OK;
 }
 
 /* FNV-1a over the packed texels: tells an unchanged scene between frames. */
@@ -426,38 +478,31 @@ static uint64_t hash_texels(const uint32_t *texels, uint32_t texel_count)
     return hash;
 }
 
-/* Uploads the packed scene into a square-ish RGBA32UI texture whose width is a power of
- * two, checked against GL_MAX_TEXTURE_SIZE. */
+/* Uploads the packed scene into a buffer object read through an RGBA32UI buffer texture
+ * (usamplerBuffer), checked against GL_MAX_TEXTURE_BUFFER_SIZE. A buffer texture rather
+ * than a 2D one because a fetch from it is a bounds check and a load: on llvmpipe a 2D
+ * texelFetch also looks up each lane's mip level and row pitch, and the weekend scene
+ * traced 1.7x faster with the buffer (docs/performance.md). */
 static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels, uint32_t texel_count,
                                      rt_error *error)
 {
-    int max_size = tracer->context->info.max_texture_size;
-    int width_log2 = 0;
-    while ((1u << width_log2) * (uint64_t)(1u << width_log2) < texel_count && (1 << (width_log2 + 1)) <= max_size)
-        width_log2++;
-    uint32_t width = 1u << width_log2;
-    uint64_t rows = (texel_count + width - 1) / width;
-    if (rows == 0)
-        rows = 1;
-    if (rows > (uint64_t)max_size)
+    int64_t max_texels = tracer->context->info.max_texture_buffer_size;
+    if ((int64_t)texel_count > max_texels)
         return rt_error_set(error, RT_ERROR_INPUT,
-                            "GPU: the packed scene needs %u texels, more than a %dx%d texture "
-                            "(GL_MAX_TEXTURE_SIZE %d) holds: %llu rows too many",
-                            texel_count, max_size, max_size, max_size,
-                            (unsigned long long)(rows - (uint64_t)max_size));
-    uint32_t *padded = calloc((size_t)width * rows, 4 * sizeof(uint32_t));
-    if (padded == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory packing the scene");
-    memcpy(padded, texels, (size_t)texel_count * 4 * sizeof(uint32_t));
+                            "GPU: the packed scene needs %u texels of 16 bytes, more than this device's "
+                            "buffer textures hold (GL_MAX_TEXTURE_BUFFER_SIZE %lld): %lld texels too many",
+                            texel_count, (long long)max_texels, (long long)texel_count - (long long)max_texels);
+    /* A zero-sized buffer is not a valid texture store: keep at least one texel. */
+    static const uint32_t empty[4] = {0, 0, 0, 0};
+    glGenBuffers(1, &tracer->packed_buffer);
+    glBindBuffer(GL_TEXTURE_BUFFER, tracer->packed_buffer);
+    glBufferData(GL_TEXTURE_BUFFER, (GLsizeiptr)(texel_count ? texel_count : 1) * 4 * (GLsizeiptr)sizeof(uint32_t),
+                 texel_count ? (const void *)texels : (const void *)empty, GL_STATIC_DRAW);
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
     glGenTextures(1, &tracer->packed_texture);
-    glBindTexture(GL_TEXTURE_2D, tracer->packed_texture);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32UI, (GLsizei)width, (GLsizei)rows, 0, GL_RGBA_INTEGER,
-                 GL_UNSIGNED_INT, padded);
-    free(padded);
-    tracer->packed_width_log2 = width_log2;
+    glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32UI, tracer->packed_buffer);
+    glBindTexture(GL_TEXTURE_BUFFER, 0);
     return check_gl("uploading the packed scene", error);
 }
 
@@ -544,7 +589,7 @@ static void set_vec3(GLuint program, const char *name, const float value[3])
 }
 
 /* Sets every uniform of the tracer from the parameters. */
-static void set_parameters(gpu_tracer *tracer, GLuint program, const gpu_tracer_parameters *p)
+static void set_parameters(GLuint program, const gpu_tracer_parameters *p)
 {
     glUseProgram(program);
     glUniform2i(glGetUniformLocation(program, "image_size"), p->width, p->height);
@@ -577,7 +622,6 @@ static void set_parameters(gpu_tracer *tracer, GLuint program, const gpu_tracer_
     glUniform1i(glGetUniformLocation(program, "light_sampling"), p->light_sampling ? 1 : 0);
     glUniform1i(glGetUniformLocation(program, "integrator"), p->integrator);
     glUniform3f(glGetUniformLocation(program, "ambient"), p->ambient[0], p->ambient[1], p->ambient[2]);
-    glUniform1i(glGetUniformLocation(program, "packed_width_log2"), tracer->packed_width_log2);
     glUniform1i(glGetUniformLocation(program, "packed_scene"), STATE_TARGET_COUNT);
     for (int target = 0; target < STATE_TARGET_COUNT; target++)
         glUniform1i(glGetUniformLocation(program, state_sampler_names[target]), target);
@@ -593,22 +637,24 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->context = context;
     tracer->width = parameters->width;
     tracer->height = parameters->height;
-    rt_status status = build_program(tracer, parameters->omitted_features, error);
+    rt_status status = build_program(tracer, parameters, error);
     uint64_t hash = hash_texels(packed_texels, texel_count);
     if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == hash
         && context->packed_texel_count == texel_count) {
         tracer->packed_texture = context->packed_texture;
-        tracer->packed_width_log2 = context->packed_width_log2;
+        tracer->packed_buffer = context->packed_buffer;
         tracer->reused_scene = true;
     } else if (status == RT_OK) {
         if (context->packed_texture != 0) {
             glDeleteTextures(1, &context->packed_texture);
+            glDeleteBuffers(1, &context->packed_buffer);
             context->packed_texture = 0;
+            context->packed_buffer = 0;
         }
         status = upload_packed_scene(tracer, packed_texels, texel_count, error);
         if (status == RT_OK) {
             context->packed_texture = tracer->packed_texture;
-            context->packed_width_log2 = tracer->packed_width_log2;
+            context->packed_buffer = tracer->packed_buffer;
             context->packed_hash = hash;
             context->packed_texel_count = texel_count;
         }
@@ -626,7 +672,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
     glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), NULL, GL_DYNAMIC_READ);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, tracer->counter_buffer);
-    set_parameters(tracer, tracer->program, parameters);
+    set_parameters(tracer->program, parameters);
     tracer->parameters = *parameters;
     tracer->parameters.resume = NULL;
     status = check_gl("setting up the tracer", error);
@@ -652,7 +698,7 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
         glBindTexture(GL_TEXTURE_2D, tracer->state_textures[source][state]);
     }
     glActiveTexture(GL_TEXTURE0 + STATE_TARGET_COUNT);
-    glBindTexture(GL_TEXTURE_2D, tracer->packed_texture);
+    glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
     glBindVertexArray(tracer->vertex_array);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -714,7 +760,12 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
 rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_depth, float *normal_coverage,
                                  rt_error *error)
 {
-    GLuint program = build_tracer_program("#define RTSPHERES_AOV_PASS 1\n", error);
+    /* The render's variant: the AOV pass reaches no more of the tracer than the render. */
+    char defines[512];
+    const gpu_tracer_parameters *p = &tracer->parameters;
+    variant_defines(p->omitted_features, p->integrator, p->sky_type, defines, sizeof defines);
+    strncat(defines, "#define RTSPHERES_AOV_PASS 1\n", sizeof defines - strlen(defines) - 1);
+    GLuint program = build_tracer_program(defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
     int width = tracer->width, height = tracer->height;
@@ -733,11 +784,11 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the AOV framebuffer is incomplete");
     if (status == RT_OK) {
-        set_parameters(tracer, program, &tracer->parameters);
+        set_parameters(program, &tracer->parameters);
         glUniform1i(glGetUniformLocation(program, "aov_samples"), samples);
         glViewport(0, 0, width, height);
         glActiveTexture(GL_TEXTURE0 + STATE_TARGET_COUNT);
-        glBindTexture(GL_TEXTURE_2D, tracer->packed_texture);
+        glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
         glBindVertexArray(tracer->vertex_array);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         float *outputs[2] = {albedo_depth, normal_coverage};
@@ -778,8 +829,10 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
         glDeleteFramebuffers(1, &tracer->framebuffers[set]);
     }
     /* The program and the packed scene belong to the context (kept for the next frame). */
-    if (tracer->packed_texture != tracer->context->packed_texture)
+    if (tracer->packed_texture != tracer->context->packed_texture) {
         glDeleteTextures(1, &tracer->packed_texture);
+        glDeleteBuffers(1, &tracer->packed_buffer);
+    }
     glDeleteBuffers(1, &tracer->counter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);
     free(tracer);

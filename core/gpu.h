@@ -38,6 +38,7 @@ typedef struct gpu_info {
     char egl_vendor[128], egl_version[128];
     char gl_vendor[128], gl_renderer[256], gl_version[128], glsl_version[128];
     int max_texture_size;
+    int max_texture_buffer_size; /* texels of a buffer texture: bounds the packed scene */
     int max_draw_buffers;
     int max_color_attachments;
     int max_fragment_atomic_counters;
@@ -61,18 +62,33 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 
 /* ---- the tracer -------------------------------------------------------------------- */
 
-/* Parts of the tracer a scene may not need. Leaving them out of the shader changes no
- * image: a scene without lights never samples one. It makes the shader smaller, and on
- * llvmpipe every piece of code a loop iteration carries costs, run or not (the weekend
- * scene traced 1.2-1.4x faster without the direct-lighting code). Each combination is
- * compiled once per context, on first use.
- *   GPU_OMIT_DIRECT_LIGHT  no light sampling: path tracing of a scene with no lights,
- *                          or with light sampling off (never for Whitted: ambient)
- *   GPU_OMIT_VOLUMES       no volume anywhere, the camera in none
- *   GPU_OMIT_TEXTURES      no texture and no normal map on any material */
-#define GPU_OMIT_DIRECT_LIGHT 1u
-#define GPU_OMIT_VOLUMES 2u
-#define GPU_OMIT_TEXTURES 4u
+/* Parts of the tracer a scene may not need (omitted_features below). Leaving them out of
+ * the shader changes no image: a scene without lights never samples one. It makes the
+ * shader smaller, and llvmpipe runs both sides of every branch (only loops really jump),
+ * so every piece of code in the tracer's loops costs on every iteration, run or not: the
+ * weekend scene traced about 1.5x faster with only what it uses (docs/performance.md).
+ * Each combination is compiled once per context, on first use.
+ *   GPU_OMIT_DIRECT_LIGHT    no light sampling: path tracing of a scene with no lights,
+ *                            or with light sampling off (never for Whitted: ambient)
+ *   GPU_OMIT_VOLUMES         no volume anywhere, the camera in none
+ *   GPU_OMIT_TEXTURES        no texture and no normal map on any material
+ *   GPU_OMIT_SPHERES         no sphere (moving or not) in any BVH
+ *   GPU_OMIT_MOVING_SPHERES  no moving sphere
+ *   GPU_OMIT_FLAT            no triangle and no quad
+ *   GPU_OMIT_INSTANCES       no instance record: one BVH level
+ *   GPU_OMIT_EMITTERS        no emissive material
+ *   GPU_FIX_UNIFORMS         the integrator and the sky type compiled in as constants
+ *                            (the values in the parameters), not read from uniforms */
+#define GPU_OMIT_DIRECT_LIGHT (1u << 0)
+#define GPU_OMIT_VOLUMES (1u << 1)
+#define GPU_OMIT_TEXTURES (1u << 2)
+#define GPU_OMIT_SPHERES (1u << 3)
+#define GPU_OMIT_MOVING_SPHERES (1u << 4)
+#define GPU_OMIT_FLAT (1u << 5)
+#define GPU_OMIT_INSTANCES (1u << 6)
+#define GPU_OMIT_EMITTERS (1u << 7)
+#define GPU_FIX_UNIFORMS (1u << 8)
+#define GPU_VARIANT_BITS 9
 
 /* Per-render parameters of the tracer shader. Vectors are world space. */
 typedef struct gpu_tracer_parameters {
@@ -102,8 +118,9 @@ typedef struct gpu_tracer_parameters {
     bool light_sampling;                  /* next-event estimation with MIS at diffuse hits */
     int integrator;                       /* 0: path tracing; 1: Whitted with Phong shading */
     float ambient[3];                     /* Whitted's ambient light */
-    uint32_t omitted_features;            /* GPU_OMIT_* bits: code this scene cannot reach,
-                                           * left out of the compiled tracer (0: none) */
+    uint32_t omitted_features;            /* GPU_OMIT_* and GPU_FIX_UNIFORMS bits: code this
+                                           * scene cannot reach, left out of the compiled
+                                           * tracer (0: none, the whole tracer) */
     const float *resume;                  /* NULL, or width*height*4 floats, rows top to bottom:
                                            * (sum r, g, b, finished samples) to continue from;
                                            * a pixel with n finished samples goes on with

@@ -79,15 +79,17 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     memcpy(p->ambient, s->ambient, sizeof p->ambient);
 }
 
-/* Returns the GPU_OMIT_* bits of the tracer code this render cannot reach (gpu.h): no
- * light sampling in path tracing without lights (or with it switched off), no volumes
- * when there is none and the camera is in none, no textures when no material has one. */
+/* Returns the GPU_OMIT_* bits of the tracer code this render cannot reach (gpu.h), and
+ * GPU_FIX_UNIFORMS: no light sampling in path tracing without lights (or with it switched
+ * off), no volumes when there is none and the camera is in none, no textures when no
+ * material has one; primitive types and emitters as the packed records (every BVH level)
+ * hold them. The --full-tracer option asks for 0: everything, read from uniforms. */
 static uint32_t omitted_features(const scene *s, const packed_scene *packed, const render_options *options,
                                  uint32_t camera_media)
 {
-    uint32_t omitted = 0;
     if (options->full_tracer)
         return 0;
+    uint32_t omitted = GPU_FIX_UNIFORMS;
     if (options->integrator == 0 && (packed->light_count == 0 || options->no_light_sampling))
         omitted |= GPU_OMIT_DIRECT_LIGHT;
     bool volumes = camera_media != 0;
@@ -101,6 +103,25 @@ static uint32_t omitted_features(const scene *s, const packed_scene *packed, con
                    || s->materials[i].emission_texture >= 0;
     if (!textures)
         omitted |= GPU_OMIT_TEXTURES;
+    bool present[PRIMITIVE_TYPE_COUNT] = {false};
+    for (uint32_t slot = 0; slot < packed->primitive_count; slot++) {
+        uint32_t type = packed_uint(packed, packed->primitive_offset + slot * PACKED_PRIMITIVE_STRIDE, 0);
+        if (type < PRIMITIVE_TYPE_COUNT)
+            present[type] = true;
+    }
+    if (!present[PRIMITIVE_SPHERE] && !present[PRIMITIVE_MOVING_SPHERE])
+        omitted |= GPU_OMIT_SPHERES;
+    if (!present[PRIMITIVE_MOVING_SPHERE])
+        omitted |= GPU_OMIT_MOVING_SPHERES;
+    if (!present[PRIMITIVE_TRIANGLE] && !present[PRIMITIVE_QUAD])
+        omitted |= GPU_OMIT_FLAT;
+    if (!present[PRIMITIVE_INSTANCE])
+        omitted |= GPU_OMIT_INSTANCES;
+    bool emitters = false;
+    for (uint32_t m = 0; m < packed->material_count && !emitters; m++)
+        emitters = packed_uint(packed, packed->material_offset + m * PACKED_MATERIAL_STRIDE, 0) == MATERIAL_EMISSIVE;
+    if (!emitters)
+        omitted |= GPU_OMIT_EMITTERS;
     return omitted;
 }
 

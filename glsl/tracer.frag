@@ -43,8 +43,7 @@ uniform sampler2D state_accumulated;
 uniform sampler2D state_statistics;
 #endif
 
-uniform usampler2D packed_scene;
-uniform int packed_width_log2;
+uniform usamplerBuffer packed_scene;
 
 uniform ivec2 image_size;       // the region this render covers (the whole image or a crop)
 uniform ivec2 region_origin;    // its top-left pixel in the full image (row 0 at the top)
@@ -59,7 +58,11 @@ uniform float lens_radius;
 uniform float shutter_open;
 uniform float shutter_close;
 uniform uint camera_media;      // media the camera is in, packed like out_counters.z
+#ifdef RTSPHERES_SKY_TYPE
+const int sky_type = RTSPHERES_SKY_TYPE;   // compiled in for this scene (gpu.h)
+#else
 uniform int sky_type;
+#endif
 uniform vec3 sky_bottom;
 uniform vec3 sky_top;
 uniform float sky_intensity;
@@ -73,7 +76,11 @@ uniform uint max_depth;
 uniform uint russian_roulette_depth;
 uniform int pass_work_budget;
 uniform int light_sampling;     // 0: BSDF sampling only (for tests of the estimators)
+#ifdef RTSPHERES_INTEGRATOR
+const int integrator = RTSPHERES_INTEGRATOR;   // compiled in for this render (gpu.h)
+#else
 uniform int integrator;         // 0: path tracing, 1: Whitted with Phong shading
+#endif
 uniform vec3 ambient;           // Whitted: ambient light
 
 layout(binding = 0, offset = 0) uniform atomic_uint unfinished_pixels;
@@ -89,13 +96,17 @@ const uint NONE = PACKED_NONE;
 const uint ENTER_INSTANCE = 0x80000000u;
 const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 
+// Variants (gpu.h GPU_OMIT_*): code for what the scene lacks is left out, because
+// llvmpipe runs both sides of every branch and so pays for all code in a loop.
+#if defined(RTSPHERES_OMIT_FLAT) && defined(RTSPHERES_OMIT_MOVING_SPHERES) && defined(RTSPHERES_OMIT_INSTANCES)
+#define RTSPHERES_ONLY_SPHERES 1
+#endif
+
 // ---- packed scene access ---------------------------------------------------------
 
 uvec4 packed_texel(uint index)
 {
-    uint column = index & ((1u << uint(packed_width_log2)) - 1u);
-    uint row = index >> uint(packed_width_log2);
-    return texelFetch(packed_scene, ivec2(int(column), int(row)), 0);
+    return texelFetch(packed_scene, int(index));
 }
 
 vec3 packed_xyz(uvec4 texel) { return uintBitsToFloat(texel.xyz); }
@@ -213,17 +224,27 @@ void intersect_primitive(uint slot, uvec4 head, vec3 origin, vec3 direction, flo
     vec4 a = packed_vec4(base + 1u);
     float t = INFINITY;
     vec2 coordinates = vec2(0.0);
-    if (head.x == uint(PRIMITIVE_SPHERE)) {
+#ifdef RTSPHERES_ONLY_SPHERES
+    t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
+#else
+    bool flat_primitive = head.x == uint(PRIMITIVE_TRIANGLE) || head.x == uint(PRIMITIVE_QUAD);
+#ifndef RTSPHERES_OMIT_MOVING_SPHERES
+    if (head.x == uint(PRIMITIVE_MOVING_SPHERE))
+        a.xyz = mix(a.xyz, packed_vec4(base + 2u).xyz, time);
+#endif
+#ifndef RTSPHERES_OMIT_SPHERES
+    if (!flat_primitive)
         t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
-    } else if (head.x == uint(PRIMITIVE_MOVING_SPHERE)) {
-        vec3 later = packed_vec4(base + 2u).xyz;
-        t = intersect_sphere(mix(a.xyz, later, time), a.w, origin, direction, hit.t);
-    } else {
+#endif
+#ifndef RTSPHERES_OMIT_FLAT
+    if (flat_primitive) {
         vec3 edge1 = packed_vec4(base + 2u).xyz;
         vec3 edge2 = packed_vec4(base + 3u).xyz;
         t = intersect_flat(a.xyz, edge1, edge2, head.x == uint(PRIMITIVE_QUAD), origin, direction, hit.t,
                            coordinates);
     }
+#endif
+#endif
     if (t < hit.t) {
         hit.t = t;
         hit.primitive = slot;
@@ -273,12 +294,15 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
             overflow = true;
             break;
         }
+#ifndef RTSPHERES_OMIT_INSTANCES
         if (node == NONE) {
             origin = world_origin;
             direction = world_direction;
             inverse_direction = 1.0 / direction;
             instance = NONE;
-        } else if (node_entry < hit.t) {
+        } else
+#endif
+        if (node_entry < hit.t) {
             uint base = node_offset + node * uint(PACKED_NODE_STRIDE);
             uvec4 low = packed_texel(base);
             uvec4 high = packed_texel(base + 1u);
@@ -287,7 +311,12 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
             if (count > 0u) {
                 for (uint slot = first; slot < first + count; slot++) {
                     work++;
+#ifdef RTSPHERES_ONLY_SPHERES
+                    uvec4 head = uvec4(uint(PRIMITIVE_SPHERE), 0u, 0u, 0u);   // no record to look at
+#else
                     uvec4 head = packed_texel(primitive_offset + slot * uint(PACKED_PRIMITIVE_STRIDE));
+#endif
+#ifndef RTSPHERES_OMIT_INSTANCES
                     if (head.x == uint(PRIMITIVE_INSTANCE)) {
                         if (stack_size + 2 <= STACK_SIZE) {
                             stack_node[stack_size] = NONE;
@@ -298,7 +327,9 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
                         } else {
                             overflow = true;   // reported as an error, never skipped silently
                         }
-                    } else {
+                    } else
+#endif
+                    {
                         intersect_primitive(slot, head, origin, direction, time, instance, hit);
                     }
                 }
@@ -332,6 +363,7 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
         stack_size--;
         node = stack_node[stack_size];
         node_entry = stack_entry[stack_size];
+#ifndef RTSPHERES_OMIT_INSTANCES
         if (node != NONE && (node & ENTER_INSTANCE) != 0u) {
             instance = node & ~ENTER_INSTANCE;
             to_object(instance, world_origin, world_direction, origin, direction);
@@ -339,6 +371,7 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
             node = packed_texel(instance_offset + instance * uint(PACKED_INSTANCE_STRIDE)).x;
             node_entry = node_entry_distance(node, origin, inverse_direction, hit.t);
         }
+#endif
     }
     return hit.t < t_max;
 }
@@ -524,6 +557,7 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
     vec3 object_point = surface.position;
     mat3 normal_to_world = mat3(1.0);
     uint instance_material = NONE;
+#ifndef RTSPHERES_OMIT_INSTANCES
     if (hit.instance != NONE) {
         uint instance_base = instance_offset + hit.instance * uint(PACKED_INSTANCE_STRIDE);
         uvec4 instance_head = packed_texel(instance_base);
@@ -539,15 +573,32 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
         // Columns are the rows of world-to-object: transpose(M) * n.
         normal_to_world = mat3(row0.xyz, row1.xyz, row2.xyz);
     }
+#endif
     surface.material = head.y != NONE ? head.y : instance_material != NONE ? instance_material : default_material;
+#ifdef RTSPHERES_OMIT_TEXTURES
+    uint normal_map = NONE;
+#else
     uint normal_map = packed_texel(material_offset + surface.material * uint(PACKED_MATERIAL_STRIDE) + 2u).w;
-    vec3 normal;
-    vec3 shading_normal;
+#endif
+    vec3 normal = vec3(0.0, 1.0, 0.0);
+    vec3 shading_normal = normal;
     vec3 tangent = vec3(0.0);     // object-space direction of increasing u (for normal maps)
     float handedness = 1.0;
     vec2 uv = hit.barycentric;
-    if (head.x == uint(PRIMITIVE_SPHERE) || head.x == uint(PRIMITIVE_MOVING_SPHERE)) {
-        vec3 center = head.x == uint(PRIMITIVE_SPHERE) ? a.xyz : mix(a.xyz, packed_vec4(base + 2u).xyz, time);
+    bool flat_primitive = head.x == uint(PRIMITIVE_TRIANGLE) || head.x == uint(PRIMITIVE_QUAD);
+#ifdef RTSPHERES_OMIT_SPHERES
+    flat_primitive = true;
+#endif
+#ifdef RTSPHERES_OMIT_FLAT
+    flat_primitive = false;
+#endif
+#ifndef RTSPHERES_OMIT_SPHERES
+    if (!flat_primitive) {
+        vec3 center = a.xyz;
+#ifndef RTSPHERES_OMIT_MOVING_SPHERES
+        if (head.x == uint(PRIMITIVE_MOVING_SPHERE))
+            center = mix(a.xyz, packed_vec4(base + 2u).xyz, time);
+#endif
         normal = (object_point - center) / a.w;
         shading_normal = normal;
         // Longitude/latitude of the normal as the books map spheres: u around +Y starting
@@ -556,7 +607,10 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
         uv = vec2(0.5 + atan(-normal.z, normal.x) / (2.0 * PI), acos(clamp(-normal.y, -1.0, 1.0)) / PI);
 #endif
         tangent = vec3(normal.z, 0.0, -normal.x);
-    } else {
+    }
+#endif
+#ifndef RTSPHERES_OMIT_FLAT
+    if (flat_primitive) {
         vec3 edge1 = packed_vec4(base + 2u).xyz;
         vec3 edge2 = packed_vec4(base + 3u).xyz;
         normal = cross(edge1, edge2);
@@ -588,8 +642,6 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
             }
         }
     }
-#ifdef RTSPHERES_OMIT_TEXTURES
-    normal_map = NONE;
 #endif
     if (normal_map != NONE) {
         // Tangent-space normal map, applied in object space so that the result moves to
@@ -852,6 +904,12 @@ bool sample_environment(uint light, vec2 u, out vec3 direction, out vec3 emitted
 vec3 shadow_transmittance(vec3 p, vec3 direction, float distance, uint light_slot, uint media, float time,
                           inout int work, inout bool overflow)
 {
+#ifdef RTSPHERES_OMIT_VOLUMES
+    // No medium anywhere: every surface in the way is opaque.
+    Hit blocker;
+    bool blocked = trace(p, direction, time, distance * (1.0 - 1e-4), blocker, work, overflow);
+    return blocked && !(blocker.instance == NONE && blocker.primitive == light_slot) ? vec3(0.0) : vec3(1.0);
+#else
     vec3 transmittance = vec3(1.0);
     float travelled = 0.0;
     vec3 origin = p;
@@ -882,6 +940,7 @@ vec3 shadow_transmittance(vec3 p, vec3 direction, float distance, uint light_slo
         travelled += step;
     }
     return vec3(0.0);
+#endif
 }
 
 float power_heuristic(float chosen, float other)
@@ -1213,7 +1272,9 @@ void main()
                     } else {
                         path_done = true;
                     }
-                } else if (material_type == uint(MATERIAL_EMISSIVE)) {
+                }
+#ifndef RTSPHERES_OMIT_EMITTERS
+                else if (material_type == uint(MATERIAL_EMISSIVE)) {
                     vec3 emission = uintBitsToFloat(material1.xyz);
 #ifndef RTSPHERES_OMIT_TEXTURES
                     if (material2.z != NONE)
@@ -1229,7 +1290,9 @@ void main()
                     }
                     radiance += throughput * emission * weight;
                     path_done = true;
-                } else if (material_type == uint(MATERIAL_LAMBERTIAN)) {
+                }
+#endif
+                else if (material_type == uint(MATERIAL_LAMBERTIAN)) {
                     want_direct = light_count > 0u;
                     direct_point = p;
                     direct_normal = normal;

@@ -1,11 +1,13 @@
 #!/bin/sh
 # test-tracer-variants.sh: the tracer is compiled without the code a scene cannot reach
-# (no light sampling without lights, no volumes, no textures: gpu.h GPU_OMIT_*), which
-# must change no image. Each scene is rendered twice, as it is and with --full-tracer
-# (everything compiled in), with the same seed: the images must agree exactly, since the
-# code left out never runs for these scenes. A difference means a feature was left out
-# that the scene does reach (a wrong GPU_OMIT_* rule in core/render.c), or the shader's
-# #ifdef blocks changed what the remaining code computes.
+# (gpu.h GPU_OMIT_*: light sampling without lights, volumes, textures, each primitive
+# type, instances, emitters; and the integrator and sky type compiled in as constants),
+# which must change no image. Each scene is rendered twice, as it is and with
+# --full-tracer (everything compiled in, every setting a uniform), with the same seed: the
+# images must agree exactly, since the code left out never runs for these scenes. A
+# difference means a feature was left out that the scene does reach (a wrong rule in
+# core/render.c omitted_features), or the shader's #if blocks changed what the remaining
+# code computes. Between them the scenes below leave out and keep each feature.
 #   usage: sh tests/render/test-tracer-variants.sh PROGRAM SCRATCH_DIR
 set -u
 program=$1
@@ -31,15 +33,26 @@ check() {
     fi
 }
 
-# No lights, no volumes, no textures: all three left out.
+# Spheres only: no lights, volumes, textures, triangles, moving spheres, instances or
+# emitters; a gradient sky.
 check weekend scenes/weekend.txt --max-depth 16
-# Lights, but light sampling off: the direct-lighting code left out.
+# Lights, but light sampling off: the direct-lighting code left out; point, spot and sun
+# lights, quads and emitters kept.
 check lights-without-sampling scenes/lights.txt --light-sampling off
-# Lights and a volume, no textures.
+check lights scenes/lights.txt
+# Lights and a volume (the smoke boxes are instances), quads, no textures, no spheres.
 check cornell-smoke scenes/cornell-smoke.txt
-# Textures and image skies: only what the scene lacks is left out.
+# Textures (image, checker, noise, normal maps) and an image sky.
 check textures scenes/textures.txt
+# Moving spheres, instances, a volume, fog, textures, emitters, a black sky.
+check next-week scenes/next-week.txt --size 32x32 --spp 2
+# A mesh in instances, a sky box.
+check crystal-ball scenes/crystal-ball.txt
+check instancing scenes/instancing.txt
 # Whitted always keeps direct lighting (its ambient term), even without lights.
 check weekend-whitted scenes/weekend.txt --integrator whitted --max-depth 8
+check lights-whitted scenes/lights.txt --integrator whitted
+# The AOV pass and the denoiser use the render's variant too.
+check three-balls-aovs scenes/three-balls.txt --aovs
 
 finish
