@@ -70,6 +70,12 @@ int command_info(int argc, char **argv)
     printf("GLSL version:     %s\n", info.glsl_version);
     printf("max texture size: %d\n", info.max_texture_size);
     printf("max texture buffer size: %d texels (the packed scene's limit)\n", info.max_texture_buffer_size);
+    if (info.simd_lanes > 0)
+        printf("work bound:       %d lanes per shader invocation under a 65,535-iteration loop cap: "
+               "work cap %d, pass budget at most %d\n", info.simd_lanes, info.work_cap, info.max_pass_work_budget);
+    else
+        printf("work bound:       no loop-iteration cap: work cap %d, pass budget at most %d\n", info.work_cap,
+               info.max_pass_work_budget);
     printf("max draw buffers: %d\n", info.max_draw_buffers);
     printf("max fragment atomic counters: %d\n", info.max_fragment_atomic_counters);
     gpu_destroy(context);

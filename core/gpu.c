@@ -182,6 +182,35 @@ static rt_status create_context_on(gpu_context *context, EGLDisplay display, con
     return RT_OK;
 }
 
+/* Fills info's work bound from the renderer (gpu.h). llvmpipe names its vector width,
+ * "llvmpipe (LLVM 15.0.6, 256 bits)": a lane is 32 bits. Any other software renderer,
+ * or a width that cannot be read, is taken to run 16 lanes (512 bits), the widest
+ * llvmpipe uses. */
+static void set_work_limits(gpu_info *info)
+{
+    enum { LOOP_ITERATION_CAP = 65535, OVERSHOOT = 1024, HARDWARE_WORK_CAP = 1000000, HARDWARE_MAX_BUDGET = 50000 };
+    info->simd_lanes = 0;
+    if (info->software) {
+        info->simd_lanes = 16;
+        const char *bits = strstr(info->gl_renderer, " bits)");
+        if (bits != NULL) {
+            const char *start = bits;
+            while (start > info->gl_renderer && start[-1] >= '0' && start[-1] <= '9')
+                start--;
+            int width = atoi(start);
+            if (width >= 128 && width <= 512 && width % 32 == 0)
+                info->simd_lanes = width / 32;
+        }
+    }
+    if (info->simd_lanes == 0) {
+        info->work_cap = HARDWARE_WORK_CAP;
+        info->max_pass_work_budget = HARDWARE_MAX_BUDGET;
+    } else {
+        info->work_cap = LOOP_ITERATION_CAP / (info->simd_lanes + 1) - OVERSHOOT;
+        info->max_pass_work_budget = info->work_cap / 2;
+    }
+}
+
 /* Reads renderer strings and limits of the current context into context->info. */
 static void read_gl_info(gpu_context *context)
 {
@@ -193,11 +222,18 @@ static void read_gl_info(gpu_context *context)
                 (const char *)glGetString(GL_SHADING_LANGUAGE_VERSION));
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &info->max_texture_size);
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &info->max_texture_buffer_size);
+    /* For tests of the "scene too large" path, which no real test scene could reach
+     * (134M texels is 2 GiB): RTSPHERES_TEST_MAX_TEXTURE_BUFFER_SIZE lowers, never
+     * raises, the limit. */
+    const char *test_limit = getenv("RTSPHERES_TEST_MAX_TEXTURE_BUFFER_SIZE");
+    if (test_limit != NULL && atoi(test_limit) > 0 && atoi(test_limit) < info->max_texture_buffer_size)
+        info->max_texture_buffer_size = atoi(test_limit);
     glGetIntegerv(GL_MAX_DRAW_BUFFERS, &info->max_draw_buffers);
     glGetIntegerv(GL_MAX_COLOR_ATTACHMENTS, &info->max_color_attachments);
     glGetIntegerv(GL_MAX_FRAGMENT_ATOMIC_COUNTERS, &info->max_fragment_atomic_counters);
     info->software = strstr(info->gl_renderer, "llvmpipe") != NULL || strstr(info->gl_renderer, "softpipe") != NULL
                      || strstr(info->gl_renderer, "swrast") != NULL;
+    set_work_limits(info);
 }
 
 rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *error)
@@ -511,8 +547,10 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
 {
     int max_size = tracer->context->info.max_texture_size;
     if (tracer->width > max_size || tracer->height > max_size)
-        return rt_error_set(error, RT_ERROR_INPUT, "GPU: image %dx%d is larger than GL_MAX_TEXTURE_SIZE %d",
-                            tracer->width, tracer->height, max_size);
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "GPU: the image %dx%d is larger than the device's textures (GL_MAX_TEXTURE_SIZE %d): "
+                            "render it in tiles (--tile, --crop) of at most %d pixels a side",
+                            tracer->width, tracer->height, max_size, max_size);
     if (tracer->context->info.max_draw_buffers < STATE_TARGET_COUNT)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
                             STATE_TARGET_COUNT, tracer->context->info.max_draw_buffers);
@@ -588,8 +626,15 @@ static void set_vec3(GLuint program, const char *name, const float value[3])
     glUniform3f(glGetUniformLocation(program, name), value[0], value[1], value[2]);
 }
 
+/* Returns budget within what the device's work bound allows (gpu.h). */
+static uint32_t clamp_budget(const gpu_info *info, uint32_t budget)
+{
+    uint32_t most = (uint32_t)info->max_pass_work_budget;
+    return budget < 1 ? 1 : budget > most ? most : budget;
+}
+
 /* Sets every uniform of the tracer from the parameters. */
-static void set_parameters(GLuint program, const gpu_tracer_parameters *p)
+static void set_parameters(const gpu_info *info, GLuint program, const gpu_tracer_parameters *p)
 {
     glUseProgram(program);
     glUniform2i(glGetUniformLocation(program, "image_size"), p->width, p->height);
@@ -618,7 +663,8 @@ static void set_parameters(GLuint program, const gpu_tracer_parameters *p)
     glUniform1ui(glGetUniformLocation(program, "samples_per_pixel"), p->samples_per_pixel);
     glUniform1ui(glGetUniformLocation(program, "max_depth"), p->max_depth);
     glUniform1ui(glGetUniformLocation(program, "russian_roulette_depth"), p->russian_roulette_depth);
-    glUniform1i(glGetUniformLocation(program, "pass_work_budget"), (GLint)p->pass_work_budget);
+    glUniform1i(glGetUniformLocation(program, "pass_work_budget"), (GLint)clamp_budget(info, p->pass_work_budget));
+    glUniform1i(glGetUniformLocation(program, "work_cap"), info->work_cap);
     glUniform1i(glGetUniformLocation(program, "light_sampling"), p->light_sampling ? 1 : 0);
     glUniform1i(glGetUniformLocation(program, "integrator"), p->integrator);
     glUniform3f(glGetUniformLocation(program, "ambient"), p->ambient[0], p->ambient[1], p->ambient[2]);
@@ -672,7 +718,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
     glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), NULL, GL_DYNAMIC_READ);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, tracer->counter_buffer);
-    set_parameters(tracer->program, parameters);
+    set_parameters(&context->info, tracer->program, parameters);
     tracer->parameters = *parameters;
     tracer->parameters.resume = NULL;
     status = check_gl("setting up the tracer", error);
@@ -713,7 +759,8 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
 {
     glUseProgram(tracer->program);
-    glUniform1i(glGetUniformLocation(tracer->program, "pass_work_budget"), (GLint)budget);
+    glUniform1i(glGetUniformLocation(tracer->program, "pass_work_budget"),
+                (GLint)clamp_budget(&tracer->context->info, budget));
 }
 
 /* Reads one state texture of the latest set into rows top to bottom. */
@@ -784,7 +831,7 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the AOV framebuffer is incomplete");
     if (status == RT_OK) {
-        set_parameters(program, &tracer->parameters);
+        set_parameters(&tracer->context->info, program, &tracer->parameters);
         glUniform1i(glGetUniformLocation(program, "aov_samples"), samples);
         glViewport(0, 0, width, height);
         glActiveTexture(GL_TEXTURE0 + STATE_TARGET_COUNT);

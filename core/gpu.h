@@ -43,6 +43,15 @@ typedef struct gpu_info {
     int max_color_attachments;
     int max_fragment_atomic_counters;
     bool software;               /* a CPU rasteriser (llvmpipe, softpipe) */
+    /* The work bound (glsl/tracer.frag, "the work bound"). On llvmpipe, which ends all
+     * loops of an invocation after 65,535 iterations together and runs simd_lanes pixels
+     * as one invocation: work_cap = 65535 / (simd_lanes + 1) - 1024 (1024: what a pixel
+     * may still run after reaching the cap), and passes of at most work_cap / 2. On
+     * other devices there is no such cap (simd_lanes 0): work_cap 1,000,000 only stops
+     * a runaway traversal, and the budget is at most 50,000. */
+    int simd_lanes;
+    int work_cap;
+    int max_pass_work_budget;
 } gpu_info;
 
 typedef struct gpu_context gpu_context;

@@ -322,6 +322,10 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
                                                              : DEFAULT_TARGET_PASS_SECONDS;
     double budget = parameters.pass_work_budget;
+    gpu_info device;
+    gpu_get_info(context, &device);
+    double most_budget = device.max_pass_work_budget < MAXIMUM_ADAPTIVE_BUDGET ? device.max_pass_work_budget
+                                                                               : MAXIMUM_ADAPTIVE_BUDGET;
     for (;;) {
         gpu_pass_report report;
         double pass_start = seconds_now();
@@ -336,7 +340,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
             scale = scale < 0.5 ? 0.5 : scale > 4.0 ? 4.0 : scale;
             budget *= scale;
             budget = budget < MINIMUM_ADAPTIVE_BUDGET ? MINIMUM_ADAPTIVE_BUDGET
-                     : budget > MAXIMUM_ADAPTIVE_BUDGET ? MAXIMUM_ADAPTIVE_BUDGET : budget;
+                     : budget > most_budget ? most_budget : budget;
             gpu_tracer_set_pass_work_budget(tracer, (uint32_t)budget);
         }
         progress.passes++;
@@ -389,10 +393,11 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (totals.traversal_overflows > 0) {
         image_free(&result->image);
         return rt_error_set(error, RT_ERROR_RUNTIME,
-                            "RENDER: %.0f ray traversals exceeded the shader's hard work cap or traversal stack and "
-                            "were cut short; the image would be wrong. The scene's BVH is degenerate (many "
-                            "overlapping primitives, or a huge leaf of instances)",
-                            totals.traversal_overflows);
+                            "RENDER: %.0f paths reached the shader's work cap (%d loop iterations per pass, "
+                            "`rtspheres info`) or the traversal stack and were cut short; the image would be "
+                            "wrong. The scene's BVH is degenerate (many overlapping primitives, or a huge leaf "
+                            "of instances)",
+                            totals.traversal_overflows, device.work_cap);
     }
 
     result->passes = progress.passes;

@@ -74,7 +74,8 @@ uniform uint sample_start;
 uniform uint samples_per_pixel;
 uniform uint max_depth;
 uniform uint russian_roulette_depth;
-uniform int pass_work_budget;
+uniform int pass_work_budget;   // work units a pixel may start in this pass
+uniform int work_cap;           // no invocation ever does more (see below)
 uniform int light_sampling;     // 0: BSDF sampling only (for tests of the estimators)
 #ifdef RTSPHERES_INTEGRATOR
 const int integrator = RTSPHERES_INTEGRATOR;   // compiled in for this render (gpu.h)
@@ -88,12 +89,10 @@ layout(binding = 0, offset = 4) uniform atomic_uint samples_finished;
 
 const float INFINITY = 1.0 / 0.0;
 const float PI = 3.14159265358979;
-const int TRAVERSAL_HARD_CAP = 60000;
 const int SKY_CONSTANT = 1;
 const int SKY_BOX = 2;
 const int SKY_ENVIRONMENT = 3;
 const uint NONE = PACKED_NONE;
-const uint ENTER_INSTANCE = 0x80000000u;
 const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 
 // Variants (gpu.h GPU_OMIT_*): code for what the scene lacks is left out, because
@@ -101,6 +100,31 @@ const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 #if defined(RTSPHERES_OMIT_FLAT) && defined(RTSPHERES_OMIT_MOVING_SPHERES) && defined(RTSPHERES_OMIT_INSTANCES)
 #define RTSPHERES_ONLY_SPHERES 1
 #endif
+
+// ---- the work bound ----------------------------------------------------------------
+//
+// llvmpipe ends all loops of one shader invocation once they have run 65,535 iterations
+// together, silently, and it runs the pixels of one SIMD vector (8 lanes at 256 bits) as
+// one invocation: every loop runs until its slowest lane is done, and at least once
+// even when no lane needs it. So work counts, per pixel, every loop iteration the pixel
+// runs (every loop below adds to it) plus SEGMENT_WORK for each path segment, which is
+// at least the number of loops a segment passes through. Then a vector's iterations are
+// at most (lanes + 1) x the largest pixel's work, and the host picks work_cap (and the
+// largest budget) so that stays under the cap (gpu.c); a pixel that would pass work_cap
+// stops and sets overflow, which the host turns into an error: never a silently wrong
+// image. tests/render/test-pass-budget.sh checks images do not depend on the budget.
+const int SEGMENT_WORK = 64;
+int work;            // this invocation's work so far
+bool overflow;       // work_cap was reached: the path in flight is cut short
+
+// Counts one loop iteration; false (and overflow set) when the cap is reached.
+bool count_work()
+{
+    work++;
+    if (work > work_cap)
+        overflow = true;
+    return !overflow;
+}
 
 // ---- packed scene access ---------------------------------------------------------
 
@@ -263,12 +287,21 @@ void to_object(uint instance, vec3 origin, vec3 direction, out vec3 object_origi
     object_direction = vec3(dot(row0.xyz, direction), dot(row1.xyz, direction), dot(row2.xyz, direction));
 }
 
-// Finds the nearest hit closer than t_max along the ray by walking the top-level BVH and, through instance
-// records, the objects' BVHs, nearer child first, with one explicit stack. work counts
-// node visits and primitive tests; overflow is set when the hard cap cut the traversal.
-// Entering an instance pushes a marker (NONE) that restores the world ray when popped.
-bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out Hit hit, inout int work,
-           inout bool overflow)
+// Finds the nearest hit closer than t_max along the ray by walking the top-level BVH and,
+// through instance records, the objects' BVHs, nearer child first, with one explicit
+// stack. work counts node visits and primitive tests; overflow is set when the hard cap
+// cut the traversal.
+//
+// The loop carries the current node as the (first, count) pair of its record rather than
+// its index: both children's records are fetched anyway to test their boxes, and their w
+// components are those pairs, so a node is never fetched twice (4 fetches per interior
+// node instead of 6). Stack entries are such pairs too, with two markers for instances:
+// count ENTER_INSTANCE (first = the instance) moves the ray into the instance's object,
+// count LEAVE_INSTANCE restores the world ray.
+const uint ENTER_INSTANCE_MARK = 0xfffffffeu;
+const uint LEAVE_INSTANCE_MARK = 0xffffffffu;
+
+bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out Hit hit)
 {
     hit.t = t_max;
     hit.primitive = 0u;
@@ -280,22 +313,21 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
     vec3 direction = world_direction;
     vec3 inverse_direction = 1.0 / direction;
     uint instance = NONE;
-    float node_entry = node_entry_distance(0u, origin, inverse_direction, t_max);
+    uvec4 root_low = packed_texel(node_offset), root_high = packed_texel(node_offset + 1u);
+    float node_entry = intersect_box(packed_xyz(root_low), packed_xyz(root_high), origin, inverse_direction, t_max);
     if (node_entry == INFINITY)
         return false;
+    uint first = root_low.w, count = root_high.w;
 
-    uint stack_node[STACK_SIZE];
+    uint stack_first[STACK_SIZE];
+    uint stack_count[STACK_SIZE];
     float stack_entry[STACK_SIZE];
     int stack_size = 0;
-    uint node = 0u;
     for (;;) {
-        work++;
-        if (work > TRAVERSAL_HARD_CAP || overflow) {
-            overflow = true;
+        if (!count_work())
             break;
-        }
 #ifndef RTSPHERES_OMIT_INSTANCES
-        if (node == NONE) {
+        if (count == LEAVE_INSTANCE_MARK) {
             origin = world_origin;
             direction = world_direction;
             inverse_direction = 1.0 / direction;
@@ -303,14 +335,8 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
         } else
 #endif
         if (node_entry < hit.t) {
-            uint base = node_offset + node * uint(PACKED_NODE_STRIDE);
-            uvec4 low = packed_texel(base);
-            uvec4 high = packed_texel(base + 1u);
-            uint first = low.w;
-            uint count = high.w;
             if (count > 0u) {
-                for (uint slot = first; slot < first + count; slot++) {
-                    work++;
+                for (uint slot = first; slot < first + count && count_work(); slot++) {
 #ifdef RTSPHERES_ONLY_SPHERES
                     uvec4 head = uvec4(uint(PRIMITIVE_SPHERE), 0u, 0u, 0u);   // no record to look at
 #else
@@ -319,9 +345,10 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
 #ifndef RTSPHERES_OMIT_INSTANCES
                     if (head.x == uint(PRIMITIVE_INSTANCE)) {
                         if (stack_size + 2 <= STACK_SIZE) {
-                            stack_node[stack_size] = NONE;
+                            stack_count[stack_size] = LEAVE_INSTANCE_MARK;
                             stack_entry[stack_size] = -INFINITY;
-                            stack_node[stack_size + 1] = head.w | ENTER_INSTANCE;
+                            stack_first[stack_size + 1] = head.w;
+                            stack_count[stack_size + 1] = ENTER_INSTANCE_MARK;
                             stack_entry[stack_size + 1] = -INFINITY;
                             stack_size += 2;
                         } else {
@@ -334,25 +361,30 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
                     }
                 }
             } else {
-                float left_entry = node_entry_distance(first, origin, inverse_direction, hit.t);
-                float right_entry = node_entry_distance(first + 1u, origin, inverse_direction, hit.t);
-                uint near_node = first, far_node = first + 1u;
-                float near_entry = left_entry, far_entry = right_entry;
-                if (right_entry < left_entry) {
-                    near_node = first + 1u; far_node = first;
-                    near_entry = right_entry; far_entry = left_entry;
-                }
+                uint base = node_offset + first * uint(PACKED_NODE_STRIDE);
+                uvec4 left_low = packed_texel(base), left_high = packed_texel(base + 1u);
+                uvec4 right_low = packed_texel(base + 2u), right_high = packed_texel(base + 3u);
+                float left_entry = intersect_box(packed_xyz(left_low), packed_xyz(left_high), origin,
+                                                 inverse_direction, hit.t);
+                float right_entry = intersect_box(packed_xyz(right_low), packed_xyz(right_high), origin,
+                                                  inverse_direction, hit.t);
+                bool right_nearer = right_entry < left_entry;
+                uvec2 near_node = right_nearer ? uvec2(right_low.w, right_high.w) : uvec2(left_low.w, left_high.w);
+                uvec2 far_node = right_nearer ? uvec2(left_low.w, left_high.w) : uvec2(right_low.w, right_high.w);
+                float near_entry = min(left_entry, right_entry), far_entry = max(left_entry, right_entry);
                 if (near_entry < INFINITY) {
                     if (far_entry < INFINITY) {
                         if (stack_size < STACK_SIZE) {
-                            stack_node[stack_size] = far_node;
+                            stack_first[stack_size] = far_node.x;
+                            stack_count[stack_size] = far_node.y;
                             stack_entry[stack_size] = far_entry;
                             stack_size++;
                         } else {
                             overflow = true;
                         }
                     }
-                    node = near_node;
+                    first = near_node.x;
+                    count = near_node.y;
                     node_entry = near_entry;
                     continue;
                 }
@@ -361,15 +393,20 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
         if (stack_size == 0)
             break;
         stack_size--;
-        node = stack_node[stack_size];
+        first = stack_first[stack_size];
+        count = stack_count[stack_size];
         node_entry = stack_entry[stack_size];
 #ifndef RTSPHERES_OMIT_INSTANCES
-        if (node != NONE && (node & ENTER_INSTANCE) != 0u) {
-            instance = node & ~ENTER_INSTANCE;
+        if (count == ENTER_INSTANCE_MARK) {
+            instance = first;
             to_object(instance, world_origin, world_direction, origin, direction);
             inverse_direction = 1.0 / direction;
-            node = packed_texel(instance_offset + instance * uint(PACKED_INSTANCE_STRIDE)).x;
-            node_entry = node_entry_distance(node, origin, inverse_direction, hit.t);
+            uint root = node_offset + packed_texel(instance_offset + instance * uint(PACKED_INSTANCE_STRIDE)).x
+                                      * uint(PACKED_NODE_STRIDE);
+            uvec4 low = packed_texel(root), high = packed_texel(root + 1u);
+            first = low.w;
+            count = high.w;
+            node_entry = intersect_box(packed_xyz(low), packed_xyz(high), origin, inverse_direction, hit.t);
         }
 #endif
     }
@@ -393,6 +430,7 @@ vec3 image_lookup(uint image, vec2 uv)
     vec2 weight = position - vec2(corner);
     vec3 colour = vec3(0.0);
     for (int k = 0; k < 4; k++) {
+        work++;
         ivec2 texel = corner + ivec2(k & 1, k >> 1);
         texel.x = (texel.x % width + width) % width;
         texel.y = clamp(texel.y, 0, height - 1);
@@ -411,6 +449,7 @@ float gradient_noise(vec3 p)
     vec3 fade = f * f * f * (f * (f * 6.0 - 15.0) + 10.0);
     float result = 0.0;
     for (int k = 0; k < 8; k++) {
+        work++;
         ivec3 offset = ivec3(k & 1, (k >> 1) & 1, k >> 2);
         uvec4 h = hash4(uvec4(uvec3(ivec3(cell) + offset), 0x5eedu));
         vec3 gradient = normalize(vec3(h.xyz >> 8u) * (2.0 / 16777216.0) - 1.0 + 1e-6);
@@ -424,6 +463,7 @@ float turbulence(vec3 p)
 {
     float sum = 0.0, weight = 1.0;
     for (int octave = 0; octave < 7; octave++) {
+        work++;
         sum += weight * abs(gradient_noise(p));
         weight *= 0.5;
         p *= 2.0;
@@ -436,6 +476,7 @@ vec3 texture_value(uint texture, vec3 p, vec2 uv)
 {
     // Checkers nest at most one level: their two cells are evaluated as flat textures.
     for (int level = 0; level < 2; level++) {
+        work++;
         uint base = texture_offset + texture * uint(PACKED_TEXTURE_STRIDE);
         uvec4 head = packed_texel(base);
         vec4 data = packed_vec4(base + 1u);
@@ -697,6 +738,7 @@ uint choose_light(float u)
 {
     uint low = 0u, high = light_count - 1u;
     while (low < high) {
+        work++;
         uint middle = (low + high) / 2u;
         if (u < packed_vec4(light_offset + middle * uint(PACKED_LIGHT_STRIDE) + 1u).w)
             high = middle;
@@ -837,6 +879,7 @@ uint search_cumulative(uint base, uint count, float u)
 {
     uint low = 0u, high = count - 1u;
     while (low < high) {
+        work++;
         uint middle = (low + high) / 2u;
         if (u < packed_vec4(base + middle).x)
             high = middle;
@@ -901,24 +944,24 @@ bool sample_environment(uint light, vec2 u, out vec3 direction, out vec3 emitted
 // The fraction of light that gets from p to the light primitive at distance along
 // direction: 0 behind an opaque surface; through volume boundaries it goes on, losing
 // exp(-density * length) in each medium, as the path itself would.
-vec3 shadow_transmittance(vec3 p, vec3 direction, float distance, uint light_slot, uint media, float time,
-                          inout int work, inout bool overflow)
+vec3 shadow_transmittance(vec3 p, vec3 direction, float distance, uint light_slot, uint media, float time)
 {
 #ifdef RTSPHERES_OMIT_VOLUMES
     // No medium anywhere: every surface in the way is opaque.
     Hit blocker;
-    bool blocked = trace(p, direction, time, distance * (1.0 - 1e-4), blocker, work, overflow);
+    bool blocked = trace(p, direction, time, distance * (1.0 - 1e-4), blocker);
     return blocked && !(blocker.instance == NONE && blocker.primitive == light_slot) ? vec3(0.0) : vec3(1.0);
 #else
     vec3 transmittance = vec3(1.0);
     float travelled = 0.0;
     vec3 origin = p;
     for (int crossing = 0; crossing < 8; crossing++) {
+        work++;
         Hit hit;
         float remaining = distance - travelled;
         // Hits within 1e-4 of the light's distance are the light itself (or beyond it):
         // the traversal need not look that far.
-        bool any = trace(origin, direction, time, remaining * (1.0 - 1e-4), hit, work, overflow);
+        bool any = trace(origin, direction, time, remaining * (1.0 - 1e-4), hit);
         float segment = any ? hit.t : remaining;
         uint medium = media_inner(media);
         if (medium != 0u) {
@@ -961,7 +1004,7 @@ float power_heuristic(float chosen, float other)
 const uint WHITTED_ALL_LIGHTS = 16u;
 
 vec3 direct_light(int mode, vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 albedo, uint material,
-                  bool is_phase, uint media, float time, uint bounce, inout int work, inout bool overflow)
+                  bool is_phase, uint media, float time, uint bounce)
 {
     vec3 result = mode == 1 ? ambient * albedo : vec3(0.0);
     if (light_count == 0u)
@@ -970,6 +1013,7 @@ vec3 direct_light(int mode, vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 a
     bool choose = mode == 0 || light_count > WHITTED_ALL_LIGHTS;
     uint count = choose ? 1u : light_count;
     for (uint k = 0u; k < count; k++) {
+        work++;
         vec4 u = mode == 0 ? random4(bounce, 5u)
                            : fract(random4(bounce, 6u + (k & 1u)) + float(k >> 1u) * 0.6180339887);
         uint light = choose ? choose_light(u.x) : k;
@@ -1018,7 +1062,7 @@ vec3 direct_light(int mode, vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 a
         else
             weight = power_heuristic(choice * pdf, bsdf_pdf) / (choice * pdf);
         uint slot = delta || head.x == uint(LIGHT_ENVIRONMENT) ? NONE : head.y;
-        vec3 transmittance = shadow_transmittance(origin, direction, distance, slot, media, time, work, overflow);
+        vec3 transmittance = shadow_transmittance(origin, direction, distance, slot, media, time);
         result += transmittance * value * emitted * weight;
     }
     return result;
@@ -1052,10 +1096,15 @@ void main()
     rng_pixel = uvec2(image_pixel);
     rng_seed_hash = random_seed_hash(seed);
     vec3 albedo_sum = vec3(0.0), normal_sum = vec3(0.0);
-    float depth_sum = 0.0, hits = 0.0;
-    int work = 0;
-    bool overflow = false;
-    for (int k = 0; k < aov_samples; k++) {
+    float depth_sum = 0.0, hits = 0.0, taken = 0.0;
+    work = 0;
+    overflow = false;
+    // One invocation does all the AOV samples, so they share the work bound: a pixel
+    // stops taking samples while a whole one still fits (half the cap), and averages
+    // those it took.
+    for (int k = 0; k < aov_samples && work < work_cap / 2; k++) {
+        work += SEGMENT_WORK;
+        taken += 1.0;
         rng_sample = sample_start + uint(k);
         vec4 u = random4(0u, 0u);
         vec2 film = (film_pixel + u.xy) / vec2(full_size);
@@ -1063,9 +1112,8 @@ void main()
         vec3 origin = camera_origin + lens.x * camera_u + lens.y * camera_v;
         vec3 direction = normalize(camera_lower_left + film.x * camera_horizontal + film.y * camera_vertical - origin);
         float time = mix(shutter_open, shutter_close, random4(0u, 3u).x);
-        work = 0;
         Hit hit;
-        if (!trace(origin, direction, time, INFINITY, hit, work, overflow)) {
+        if (!trace(origin, direction, time, INFINITY, hit)) {
             albedo_sum += clamp(sky_radiance(direction), 0.0, 1.0);
             continue;
         }
@@ -1085,7 +1133,7 @@ void main()
         depth_sum += hit.t;
         hits += 1.0;
     }
-    float n = float(max(aov_samples, 1));
+    float n = max(taken, 1.0);
     out_albedo_depth = vec4(albedo_sum / n, hits > 0.0 ? depth_sum / hits : 0.0);
     vec3 normal = hits > 0.0 ? normal_sum / hits : vec3(0.0);
     out_normal = vec4(dot(normal, normal) > 0.0 ? normalize(normal) : vec3(0.0), hits / n);
@@ -1143,8 +1191,8 @@ void main()
     rng_seed_hash = random_seed_hash(seed);
     rng_sample = sample_start + samples_started - 1u;
 
-    int work = 0;
-    bool overflow = false;
+    work = 0;
+    overflow = false;
     uint finished_here = 0u;
     for (;;) {
         if (bounce == 0u) {
@@ -1169,11 +1217,12 @@ void main()
         }
         if (work >= pass_work_budget)
             break;
+        work += SEGMENT_WORK;
 
         // The sample's moment within the shutter: the same for all its segments.
         float time = mix(shutter_open, shutter_close, random4(0u, 3u).x);
         Hit hit;
-        bool hit_something = trace(origin, direction, time, INFINITY, hit, work, overflow);
+        bool hit_something = trace(origin, direction, time, INFINITY, hit);
         statistics.x += 1.0;
         bool path_done = false;
         vec4 u = random4(bounce, 1u);
@@ -1348,7 +1397,7 @@ void main()
         if (want_direct)
             radiance += direct_weight * direct_light(direct_mode, direct_point, direct_normal, direct_shading,
                                                      -incoming, direct_albedo, direct_material, direct_phase, media,
-                                                     time, segment_bounce, work, overflow);
+                                                     time, segment_bounce);
 #endif
         if (path_done) {
             accumulated += vec4(radiance, 1.0);

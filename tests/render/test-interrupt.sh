@@ -105,9 +105,10 @@ wait "$pid" 2>/dev/null
 
 # A second signal ends the render at once (the default action): death by SIGINT.
 # shellcheck disable=SC2086
-# Long passes (a fixed large budget): the first signal must still be waiting for its pass
-# to end when the second one comes.
-"$program" render $scene -o "$scratch/twice.exr" --size 64x36 --spp 100000 --checkpoint 0.2 --pass-budget 50000 --quiet &
+# Long passes (the largest budget the device allows, over a 640x360 image: about a
+# second a pass): the first signal must still be waiting for its pass to end when the
+# second one comes.
+"$program" render $scene -o "$scratch/twice.exr" --size 640x360 --spp 100000 --checkpoint 0.2 --pass-budget 50000 --quiet &
 pid=$!
 wait_for_file "$scratch/twice.partial.exr"
 kill -s INT "$pid"

@@ -4,10 +4,14 @@
 # type, instances, emitters; and the integrator and sky type compiled in as constants),
 # which must change no image. Each scene is rendered twice, as it is and with
 # --full-tracer (everything compiled in, every setting a uniform), with the same seed: the
-# images must agree exactly, since the code left out never runs for these scenes. A
-# difference means a feature was left out that the scene does reach (a wrong rule in
-# core/render.c omitted_features), or the shader's #if blocks changed what the remaining
-# code computes. Between them the scenes below leave out and keep each feature.
+# code left out never runs for these scenes, so the images agree but for float rounding:
+# with the integrator and sky type compiled in as constants LLVM may contract a multiply
+# and an add into one fused operation where the uniform version does not (seen: 1.5e-8
+# on 9 of 16 pixels of loop-stress.txt; the other scenes agree bit for bit), hence the
+# 1e-5 threshold. A feature left out that the scene does reach (a wrong rule in
+# core/render.c omitted_features) shows as errors of 0.1 and more (seen: 1.47 with moving
+# spheres left out of next-week.txt). Between them the scenes below leave out and keep
+# each feature.
 #   usage: sh tests/render/test-tracer-variants.sh PROGRAM SCRATCH_DIR
 set -u
 program=$1
@@ -25,9 +29,9 @@ check() {
         fail "tracer variant $name" "a render failed: $(head -c 300 "$scratch/$name.log")"
         return
     fi
-    if "$program" diff "$scratch/$name.exr" "$scratch/$name-full.exr" --fail 0 --failpercent 0 \
+    if "$program" diff "$scratch/$name.exr" "$scratch/$name-full.exr" --fail 1e-5 --failpercent 0 \
             >"$scratch/$name.diff" 2>&1; then
-        pass "tracer variant $name: the same image as the full tracer ($(grep "^max error" "$scratch/$name.diff"))"
+        pass "tracer variant $name: agrees with the full tracer ($(grep "^max error" "$scratch/$name.diff"))"
     else
         fail "tracer variant $name" "differs from the full tracer: $(tr '\n' ' ' <"$scratch/$name.diff")"
     fi
@@ -52,6 +56,8 @@ check instancing scenes/instancing.txt
 # Whitted always keeps direct lighting (its ambient term), even without lights.
 check weekend-whitted scenes/weekend.txt --integrator whitted --max-depth 8
 check lights-whitted scenes/lights.txt --integrator whitted
+# Everything at once: environment light, point/spot/sun, textures, a volume, emitters.
+check loop-stress tests/render/scenes/loop-stress.txt --spp 16
 # The AOV pass and the denoiser use the render's variant too.
 check three-balls-aovs scenes/three-balls.txt --aovs
 
