@@ -38,8 +38,9 @@ static void print_help(FILE *stream)
             ".png/.jpg/.tif (8-bit sRGB).\n"
             "\n"
             "options (--spp, --size, --max-depth, --seed override the scene's `render` line):\n"
-            "  -o, --output FILE      the image to write (required); with --frames a pattern\n"
-            "                         such as frame-%%04d.png\n"
+            "  -o, --output FILE      the image to write (required); a name pattern such as\n"
+            "                         frame-%%04d.png gets each frame's number with --frames,\n"
+            "                         else the value of -D frame=N, else 0 (%%%% for a '%%')\n"
             "  -s, --spp N            samples per pixel\n"
             "      --size WxH         image size in pixels, e.g. 640x360\n"
             "      --max-depth N      path segments per sample at most\n"
@@ -98,7 +99,10 @@ static void on_stop_signal(int signal_number)
 /* Everything the command line asked for; zero/negative means "not given". */
 typedef struct render_request {
     const char *scene_path;
-    const char *output;
+    const char *output;          /* the -o name; without --frames, its expansion (see batch.h) */
+    char output_name[4096];      /* the expanded name without --frames */
+    const char *frame_define;    /* VALUE of the last -D frame=VALUE, or NULL */
+    const char *time_define;     /* VALUE of the last -D time=VALUE, or NULL */
     long long spp, width, height, max_depth, seed;
     long long pass_budget, device, roulette_depth;
     double exposure;
@@ -450,6 +454,10 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
             }
             copy[equals - optarg] = '\0';
             request->define_copies[request->define_count] = copy;
+            if (strcmp(copy, "frame") == 0)
+                request->frame_define = copy + (equals - optarg) + 1;
+            else if (strcmp(copy, "time") == 0)
+                request->time_define = copy + (equals - optarg) + 1;
             request->defines[request->define_count] =
                 (scene_define){.name = copy, .value = copy + (equals - optarg) + 1};
             request->define_count++;
@@ -487,6 +495,35 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         fprintf(stderr, "rtspheres render: no output file; add -o OUTPUT (.exr, .png, .jpg, .hdr, .tif)\n");
         return EXIT_BAD_INPUT;
     }
+    /* Every output name is a pattern (batch.h): with --frames each frame formats it; without
+     * them it is formatted once, with the value of -D frame=N or with 0. */
+    if (request->frames.count > 0) {
+        if (request->frame_define != NULL || request->time_define != NULL) {
+            fprintf(stderr, "rtspheres render: -D %s and --frames both set $%s (--frames sets $frame and $time); "
+                            "give one\n", request->frame_define != NULL ? "frame" : "time",
+                    request->frame_define != NULL ? "frame" : "time");
+            return EXIT_BAD_INPUT;
+        }
+        if (request->frames.count > 1 && !output_pattern_has_frame(output)) {
+            fprintf(stderr, "rtspheres render: %d frames would all write '%s'; put a frame number pattern in the "
+                            "output, e.g. frame-%%04d.png\n", request->frames.count, output);
+            return EXIT_BAD_INPUT;
+        }
+        /* The checks below look at the first frame's name. */
+        if (output_pattern_format(output, request->frames.frames[0], request->output_name,
+                                  sizeof request->output_name, &error) != RT_OK) {
+            fprintf(stderr, "rtspheres render: %s\n", error.message);
+            return EXIT_BAD_INPUT;
+        }
+    } else {
+        if (output_name_without_frames(output, request->frame_define, request->output_name,
+                                       sizeof request->output_name, &error) != RT_OK) {
+            fprintf(stderr, "rtspheres render: %s\n", error.message);
+            return EXIT_BAD_INPUT;
+        }
+        request->output = request->output_name;
+    }
+    output = request->output_name;
     if (!known_output(output)) {
         fprintf(stderr, "rtspheres render: cannot tell the format of '%s'; use .exr, .hdr, .png, .jpg or .tif\n",
                 output);
@@ -503,15 +540,6 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
     }
     if (request->has_crop && request->tile_count) {
         fprintf(stderr, "rtspheres render: --crop and --tile both choose the region; give one\n");
-        return EXIT_BAD_INPUT;
-    }
-    if (request->frames.count > 1 && !output_pattern_has_frame(output)) {
-        fprintf(stderr, "rtspheres render: %d frames would all write '%s'; put a frame number pattern in the "
-                        "output, e.g. frame-%%04d.png\n", request->frames.count, output);
-        return EXIT_BAD_INPUT;
-    }
-    if (request->frames.count > 0 && output_pattern_format(output, 0, (char[4096]){0}, 4096, &error) != RT_OK) {
-        fprintf(stderr, "rtspheres render: %s\n", error.message);
         return EXIT_BAD_INPUT;
     }
     if (request->aovs && strcasecmp(extension_of(output), ".exr") != 0) {
@@ -968,7 +996,19 @@ int command_render(int argc, char **argv)
             if (request.shard_count && strcmp(request.shard_by, "frames") == 0 && i % request.shard_count != request.shard_index)
                 continue;
             char name[4096];
-            output_pattern_format(request.output, request.frames.frames[i], name, sizeof name, NULL);
+            rt_error name_error = {{0}};
+            if (output_pattern_format(request.output, request.frames.frames[i], name, sizeof name, &name_error)
+                != RT_OK) {
+                fprintf(stderr, "rtspheres render: %s\n", name_error.message);
+                exit_code = EXIT_BAD_INPUT;
+                break;
+            }
+            if (same_file(name, request.scene_path)) {
+                fprintf(stderr, "rtspheres render: frame %d's output '%s' is the scene file; refusing to overwrite "
+                                "it\n", request.frames.frames[i], name);
+                exit_code = EXIT_BAD_INPUT;
+                break;
+            }
             exit_code = render_frame(context, &request, request.frames.frames[i], name);
             rendered++;
         }

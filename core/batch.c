@@ -1,6 +1,8 @@
 /* batch.c: see batch.h. */
 #include "batch.h"
 
+#include "expression.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <stdio.h>
@@ -204,4 +206,24 @@ rt_status output_pattern_format(const char *pattern, int frame, char *name, size
     }
     name[used] = '\0';
     return RT_OK;
+}
+
+rt_status output_name_without_frames(const char *pattern, const char *frame_define, char *name, size_t size,
+                                     rt_error *error)
+{
+    long frame = 0;
+    if (frame_define != NULL && output_pattern_has_frame(pattern)) {
+        double value = 0;
+        rt_error expression_error = {{0}};
+        if (expression_evaluate(frame_define, strlen(frame_define), 1, NULL, NULL, &value, NULL, &expression_error)
+            != RT_OK)
+            return rt_error_set(error, RT_ERROR_INPUT, "output '%s': the frame number -D frame=%s: %s", pattern,
+                                frame_define, expression_error.message);
+        if (!(value >= 0 && value <= LARGEST_FRAME) || value != (double)(long)value)
+            return rt_error_set(error, RT_ERROR_INPUT,
+                                "output '%s': -D frame=%s is %.17g, not a frame number for the name (a whole "
+                                "number 0 to %d)", pattern, frame_define, value, LARGEST_FRAME);
+        frame = (long)value;
+    }
+    return output_pattern_format(pattern, (int)frame, name, size, error);
 }

@@ -7,7 +7,9 @@
  * same file). At most BATCH_MAX_FRAMES frames.
  *
  * Output patterns: a name with exactly one `%d`-style conversion (`%d`, `%4d`, `%04d`)
- * is formatted with the frame number; `%%` is a literal percent sign.
+ * is formatted with the frame number; `%%` is a literal percent sign. Every output name
+ * is a pattern, with or without --frames: without them the frame number is the value of
+ * `-D frame=VALUE` when given, else 0 (output_name_without_frames()).
  */
 #ifndef RT_BATCH_H
 #define RT_BATCH_H
@@ -44,5 +46,14 @@ bool output_pattern_has_frame(const char *pattern);
 /* Formats pattern with frame into name (size bytes). A pattern with no conversion is
  * copied as it is. More than one conversion, or any other conversion, is RT_ERROR_INPUT. */
 rt_status output_pattern_format(const char *pattern, int frame, char *name, size_t size, rt_error *error);
+
+/* The output name of a render without --frames: pattern formatted with the value of
+ * frame_define (the VALUE text of the last `-D frame=VALUE`, an expression without
+ * variables), or with 0 when frame_define is NULL. The value matters only when pattern
+ * has a conversion; then it must be a whole number 0..99999999, like a --frames entry.
+ * Errors (RT_ERROR_INPUT): those of output_pattern_format(), a value that does not
+ * evaluate or is not such a whole number. */
+rt_status output_name_without_frames(const char *pattern, const char *frame_define, char *name, size_t size,
+                                     rt_error *error);
 
 #endif

@@ -100,6 +100,37 @@ static void output_patterns(void **state)
     assert_int_equal(output_pattern_format("a%d.png", 1, name, 4, &error), RT_ERROR_INPUT);
 }
 
+/* Without --frames the output name is still a pattern: formatted with -D frame=VALUE, or 0. */
+static void output_names_without_frames(void **state)
+{
+    (void)state;
+    char name[64];
+    assert_int_equal(output_name_without_frames("c-%d.exr", NULL, name, sizeof name, NULL), RT_OK);
+    assert_string_equal(name, "c-0.exr");
+    assert_int_equal(output_name_without_frames("f-%04d.png", "12", name, sizeof name, NULL), RT_OK);
+    assert_string_equal(name, "f-0012.png");
+    assert_int_equal(output_name_without_frames("f-%d.png", "2*3+1", name, sizeof name, NULL), RT_OK);
+    assert_string_equal(name, "f-7.png");
+    assert_int_equal(output_name_without_frames("100%%.png", NULL, name, sizeof name, NULL), RT_OK);
+    assert_string_equal(name, "100%.png");
+    /* Without a conversion the value of $frame does not matter, even when it is no frame. */
+    assert_int_equal(output_name_without_frames("plain.png", "2.5", name, sizeof name, NULL), RT_OK);
+    assert_string_equal(name, "plain.png");
+    const char *bad[][3] = {
+        {"f-%d.png", "2.5", "not a frame number"},    {"f-%d.png", "-1", "not a frame number"},
+        {"f-%d.png", "100000000", "not a frame number"}, {"f-%d.png", "1/0", "-D frame=1/0"},
+        {"f-%d.png", "$x", "-D frame=$x"},           {"a%d-%d.png", NULL, "exactly one"},
+        {"a%s.png", "1", "exactly one"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        rt_error error = {{0}};
+        assert_int_equal(output_name_without_frames(bad[i][0], bad[i][1], name, sizeof name, &error), RT_ERROR_INPUT);
+        if (strstr(error.message, bad[i][2]) == NULL)
+            fail_msg("'%s' with frame '%s': message '%s' lacks '%s'", bad[i][0], bad[i][1] ? bad[i][1] : "(none)",
+                     error.message, bad[i][2]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -107,6 +138,7 @@ int main(void)
         cmocka_unit_test(frame_list_errors),
         cmocka_unit_test(shards),
         cmocka_unit_test(output_patterns),
+        cmocka_unit_test(output_names_without_frames),
     };
     return cmocka_run_group_tests_name("batch", tests, NULL, NULL);
 }
