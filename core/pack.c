@@ -43,6 +43,8 @@ typedef struct pending_primitive {
     uint32_t material;           /* PACKED_NONE: the instance's */
     uint32_t instance;           /* PRIMITIVE_INSTANCE */
     int32_t mesh, triangle;      /* mesh triangles: where to read attributes; else -1 */
+    int32_t baked_instance;      /* a copy moved into the world by this scene instance's
+                                  * transform (its normals too); -1: as the scene has it */
     float data[3][4];
     bvh_box box;
 } pending_primitive;
@@ -66,6 +68,7 @@ static pending_primitive *list_push(primitive_list *list)
     pending_primitive *item = &list->items[list->count++];
     memset(item, 0, sizeof *item);
     item->mesh = item->triangle = -1;
+    item->baked_instance = -1;
     item->material = PACKED_NONE;
     item->instance = PACKED_NONE;
     return item;
@@ -152,12 +155,31 @@ static void pending_from_shape(pending_primitive *item, const scene_shape *shape
     box_pad(&item->box);
 }
 
-/* Fills item from triangle t of a loaded mesh. */
-static void pending_from_triangle(pending_primitive *item, const scene_mesh *mesh, int mesh_index, int t)
+/* Moves a shape by the affine m (rows x, y, z): points by m, a quad's edges by its linear
+ * part, a sphere's radius by scale (the caller bakes spheres only under a uniform scale). */
+static void transform_shape(scene_shape *shape, const float m[3][4], float scale)
+{
+    int points = shape->type == SHAPE_MOVING_SPHERE ? 2 : shape->type == SHAPE_SPHERE ? 1 : 3;
+    for (int k = 0; k < points; k++) {
+        bool edge = shape->type == SHAPE_QUAD && k > 0;
+        float q[3];
+        for (int r = 0; r < 3; r++)
+            q[r] = m[r][0] * shape->points[k][0] + m[r][1] * shape->points[k][1] + m[r][2] * shape->points[k][2]
+                   + (edge ? 0.0f : m[r][3]);
+        memcpy(shape->points[k], q, sizeof q);
+    }
+    shape->radius *= scale;
+}
+
+/* Fills item from triangle t of a loaded mesh, moved by transform when it is not NULL. */
+static void pending_from_triangle(pending_primitive *item, const scene_mesh *mesh, int mesh_index, int t,
+                                  const float (*transform)[4])
 {
     scene_shape shape = {.type = SHAPE_TRIANGLE};
     for (int k = 0; k < 3; k++)
         memcpy(shape.points[k], mesh->positions + 3 * (size_t)mesh->indices[3 * (size_t)t + k], 3 * sizeof(float));
+    if (transform != NULL)
+        transform_shape(&shape, transform, 1.0f);
     int material = mesh->triangle_materials ? mesh->triangle_materials[t] : -1;
     pending_from_shape(item, &shape, material >= 0 ? (uint32_t)material : PACKED_NONE);
     if (mesh->normals != NULL || mesh->uvs != NULL) {
@@ -199,6 +221,18 @@ static bool is_identity(const float m[3][4])
             if (m[r][c] != (r == c ? 1.0f : 0.0f))
                 return false;
     return true;
+}
+
+/* The factor s when m's linear part is s times the identity (a uniform scale without
+ * rotation, s > 0), else 0. */
+static float uniform_scale(const float m[3][4])
+{
+    float scale = m[0][0];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            if (m[r][c] != (r == c ? scale : 0.0f))
+                return 0.0f;
+    return scale > 0 ? scale : 0.0f;
 }
 
 /* The world box of an object box under object_to_world (its 8 corners transformed). */
@@ -251,8 +285,12 @@ static void put_texel(uint32_t *texels, uint64_t index, uint32_t x, uint32_t y, 
     texels[4 * index + 3] = w;
 }
 
-/* The attribute record of a mesh triangle: vertex normals and uvs (zero where absent). */
-static void write_attributes(uint32_t *texels, uint64_t base, const scene_mesh *mesh, int t)
+/* The attribute record of a mesh triangle: vertex normals and uvs (zero where absent).
+ * normal_transform, when not NULL, is the inverse of the placement that baked the
+ * triangle into the world: normals move by its transpose, as the shader moves an
+ * instance's normals (and, being linear, interpolate to the same shading normal). */
+static void write_attributes(uint32_t *texels, uint64_t base, const scene_mesh *mesh, int t,
+                             const float (*normal_transform)[4])
 {
     float n[3][3] = {{0}}, uv[3][2] = {{0}};
     uint32_t flags = 0;
@@ -260,6 +298,13 @@ static void write_attributes(uint32_t *texels, uint64_t base, const scene_mesh *
         uint32_t v = mesh->indices[3 * (size_t)t + k];
         if (mesh->normals) {
             memcpy(n[k], mesh->normals + 3 * (size_t)v, 3 * sizeof(float));
+            if (normal_transform != NULL) {
+                float moved[3];
+                for (int c = 0; c < 3; c++)
+                    moved[c] = normal_transform[0][c] * n[k][0] + normal_transform[1][c] * n[k][1]
+                               + normal_transform[2][c] * n[k][2];
+                memcpy(n[k], moved, sizeof moved);
+            }
             flags |= ATTRIBUTE_HAS_NORMALS;
         }
         if (mesh->uvs) {
@@ -298,11 +343,16 @@ static uint32_t resolve_material(int own, int override)
 }
 
 /* Adds the primitives of scene object index to list; materials resolved with override
- * (for objects copied into the top level) or left to the instance (override = -2). */
-static rt_status add_object_primitives(packer *p, int index, int override, primitive_list *list, rt_error *error)
+ * (for objects copied into the top level) or left to the instance (override = -2).
+ * baked_instance >= 0: the copies are moved into the world by that scene instance's
+ * transform (spheres under it must be a uniform scale: see instance_bakes). */
+static rt_status add_object_primitives(packer *p, int index, int override, primitive_list *list, int baked_instance,
+                                       rt_error *error)
 {
     const scene *s = p->scene;
     const scene_object *object = &s->objects[index];
+    const float (*transform)[4] = baked_instance >= 0 ? s->instances[baked_instance].object_to_world : NULL;
+    float scale = transform != NULL ? uniform_scale(transform) : 1.0f;
     if (object->mesh >= 0) {
         const scene_mesh *mesh = &s->meshes[object->mesh];
         if (mesh->positions == NULL && mesh->triangle_count > 0)
@@ -311,20 +361,60 @@ static rt_status add_object_primitives(packer *p, int index, int override, primi
             pending_primitive *item = list_push(list);
             if (item == NULL)
                 return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
-            pending_from_triangle(item, mesh, object->mesh, t);
+            pending_from_triangle(item, mesh, object->mesh, t, transform);
+            item->baked_instance = baked_instance;
             if (item->material == PACKED_NONE && override >= 0)
                 item->material = (uint32_t)override;
         }
         return RT_OK;
     }
     for (int k = 0; k < object->shape_count; k++) {
-        const scene_shape *shape = &s->shapes[object->first_shape + k];
+        scene_shape shape = s->shapes[object->first_shape + k];
+        if (transform != NULL)
+            transform_shape(&shape, transform, scale);
         pending_primitive *item = list_push(list);
         if (item == NULL)
             return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
-        pending_from_shape(item, shape, resolve_material(shape->material, override));
+        pending_from_shape(item, &shape, resolve_material(shape.material, override));
+        item->baked_instance = baked_instance;
     }
     return RT_OK;
+}
+
+/* Whether the material index resolves to an emissive material. */
+static bool is_emissive(const scene *s, uint32_t material)
+{
+    return material != PACKED_NONE && material < (uint32_t)s->material_count
+           && s->materials[material].type == MATERIAL_EMISSIVE;
+}
+
+/* Whether a placement bakes its object into the world (copies moved by its transform)
+ * instead of instancing it: when something of the object emits under this placement, so
+ * that it becomes a light, which only world primitives can be (light sampling works in
+ * world space). Not for volumes, and not when the object has spheres and the transform
+ * is more than a uniform scale, rotation free (a rotated sphere's texture would turn
+ * with the world, a stretched one is no sphere): those emitters stay instanced and are
+ * found by BSDF sampling only. Moving spheres never become lights. */
+static bool instance_bakes(const scene *s, const scene_instance *instance)
+{
+    if (instance->volume)
+        return false;
+    const scene_object *object = &s->objects[instance->object];
+    bool emits = false, spheres = false;
+    if (object->mesh >= 0) {
+        const scene_mesh *mesh = &s->meshes[object->mesh];
+        for (int t = 0; t < mesh->triangle_count && !emits; t++) {
+            int own = mesh->triangle_materials ? mesh->triangle_materials[t] : -1;
+            emits = is_emissive(s, resolve_material(own, instance->material));
+        }
+    }
+    for (int k = 0; object->mesh < 0 && k < object->shape_count; k++) {
+        const scene_shape *shape = &s->shapes[object->first_shape + k];
+        spheres |= shape->type == SHAPE_SPHERE || shape->type == SHAPE_MOVING_SPHERE;
+        if (shape->type != SHAPE_MOVING_SPHERE)
+            emits |= is_emissive(s, resolve_material(shape->material, instance->material));
+    }
+    return emits && (!spheres || uniform_scale(instance->object_to_world) > 0);
 }
 
 /* Collects the top level: world spheres, identity placements copied in, instances. */
@@ -344,12 +434,14 @@ static rt_status collect(packer *p, rt_error *error)
         if (instance->object < 0 || instance->object >= s->object_count)
             return rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d names object %d of %d", i, instance->object,
                                 s->object_count);
-        /* Identity placements join the top level, meshes too: their emissive triangles
-         * then become lights (instanced ones are found by BSDF sampling only). */
+        /* Identity placements join the top level, meshes too, and so do placements of
+         * emitting objects, moved into the world: their emitters then become lights. */
         bool copy_in = !instance->volume && is_identity(instance->object_to_world);
+        bool bake = !copy_in && instance_bakes(s, instance);
         p->instance_of_scene[i] = PACKED_NONE;
-        if (copy_in) {
-            rt_status status = add_object_primitives(p, instance->object, instance->material, &p->top.primitives, error);
+        if (copy_in || bake) {
+            rt_status status = add_object_primitives(p, instance->object, instance->material, &p->top.primitives,
+                                                     bake ? i : -1, error);
             if (status != RT_OK)
                 return status;
             continue;
@@ -385,7 +477,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     for (int o = 0; o < s->object_count && status == RT_OK; o++) {
         if (!p.object_needed[o])
             continue;
-        status = add_object_primitives(&p, o, -2, &p.objects[o].primitives, error);
+        status = add_object_primitives(&p, o, -2, &p.objects[o].primitives, -1, error);
         if (status == RT_OK && p.objects[o].primitives.count == 0)
             status = rt_error_set(error, RT_ERROR_INPUT, "PACK: object %d placed by an instance is empty", o);
         if (status == RT_OK)
@@ -533,8 +625,11 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             uint32_t attribute = PACKED_NONE;
             if (item->mesh >= 0) {
                 attribute = (uint32_t)next_attribute;
+                float inverse[3][4];
+                bool baked = item->baked_instance >= 0
+                             && invert_affine(s->instances[item->baked_instance].object_to_world, inverse);
                 write_attributes(texels, attribute_offset + next_attribute * PACKED_ATTRIBUTE_STRIDE,
-                                 &s->meshes[item->mesh], item->triangle);
+                                 &s->meshes[item->mesh], item->triangle, baked ? (const float (*)[4])inverse : NULL);
                 next_attribute++;
             }
             put_texel(texels, base, item->type, item->material, attribute, item->instance);

@@ -555,6 +555,85 @@ static void emissive_spheres_become_lights(void **state)
     scene_free(&s);
 }
 
+/* Emitters of placed objects become lights: the placement is baked into the world (the
+ * object's shapes moved by its transform) when something of it emits under it, except
+ * spheres under more than a uniform scale, which stay instanced. */
+static void placed_emitters_become_lights(void **state)
+{
+    (void)state;
+    scene s;
+    scene_defaults(&s);
+    add_material(&s, "grey", MATERIAL_LAMBERTIAN, 0.5f, 0.5f, 0.5f);
+    add_material(&s, "glow", MATERIAL_EMISSIVE, 1, 1, 1);
+    /* Object 0: an emissive quad and a grey triangle. Object 1: an emissive sphere.
+     * Object 2: a triangle without a material (the placement's). */
+    scene_shape quad = {.type = SHAPE_QUAD, .material = 1, .points = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}}};
+    scene_shape triangle = {.type = SHAPE_TRIANGLE, .material = 0, .points = {{0, 1, 0}, {1, 1, 0}, {0, 1, 1}}};
+    scene_shape sphere = {.type = SHAPE_SPHERE, .material = 1, .radius = 0.5f, .points = {{1, 2, 3}}};
+    scene_shape bare = {.type = SHAPE_TRIANGLE, .material = -1, .points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
+    scene_object objects[3] = {{.first_shape = 0, .shape_count = 2, .mesh = -1},
+                               {.first_shape = 2, .shape_count = 1, .mesh = -1},
+                               {.first_shape = 3, .shape_count = 1, .mesh = -1}};
+    assert_true(scene_add_shape(&s, &quad) >= 0 && scene_add_shape(&s, &triangle) >= 0);
+    assert_true(scene_add_shape(&s, &sphere) >= 0 && scene_add_shape(&s, &bare) >= 0);
+    for (int o = 0; o < 3; o++)
+        assert_true(scene_add_object(&s, &objects[o]) >= 0);
+    /* The quad's object stretched and turned: baked. */
+    scene_instance stretched = {.object = 0, .material = -1,
+                                .object_to_world = {{0, -2, 0, 5}, {3, 0, 0, 6}, {0, 0, 1, 7}}};
+    /* The sphere turned: stays an instance. Moved and scaled by 2: baked. */
+    scene_instance turned = {.object = 1, .material = -1,
+                             .object_to_world = {{0, -1, 0, 0}, {1, 0, 0, 0}, {0, 0, 1, 0}}};
+    scene_instance scaled = {.object = 1, .material = -1,
+                             .object_to_world = {{2, 0, 0, 10}, {0, 2, 0, 0}, {0, 0, 2, 0}}};
+    /* The bare triangle glows only under this placement's material: baked; grey: not. */
+    scene_instance glowing = {.object = 2, .material = 1,
+                              .object_to_world = {{1, 0, 0, 0}, {0, 1, 0, 20}, {0, 0, 1, 0}}};
+    scene_instance grey = {.object = 2, .material = 0,
+                           .object_to_world = {{1, 0, 0, 0}, {0, 1, 0, 30}, {0, 0, 1, 0}}};
+    scene_instance placements[5] = {stretched, turned, scaled, glowing, grey};
+    for (int i = 0; i < 5; i++)
+        assert_true(scene_add_instance(&s, &placements[i]) >= 0);
+    packed_scene packed;
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_int_equal(packed.instance_count, 2);   /* turned and grey */
+    assert_int_equal(packed.light_count, 3);      /* the quad, the scaled sphere, the glowing triangle */
+    bool seen_quad = false, seen_sphere = false, seen_triangle = false;
+    for (uint32_t l = 0; l < packed.light_count; l++) {
+        uint32_t base = packed.light_offset + l * PACKED_LIGHT_STRIDE;
+        packed_primitive light = packed_primitive_at(&packed, packed_uint(&packed, base, 1));
+        assert_int_equal(light.material, 1);
+        if (light.type == PRIMITIVE_QUAD) {
+            /* Corner (0,0,0) -> (5,6,7); edges (1,0,0) -> (0,3,0) and (0,0,1) -> (0,0,1). */
+            const float expected[3][3] = {{5, 6, 7}, {0, 3, 0}, {0, 0, 1}};
+            for (int k = 0; k < 3; k++)
+                for (int i = 0; i < 3; i++)
+                    assert_float_equal(light.data[k][i], expected[k][i], 1e-6);
+            seen_quad = true;
+        } else if (light.type == PRIMITIVE_SPHERE) {
+            assert_float_equal(light.data[0][0], 12, 1e-6);
+            assert_float_equal(light.data[0][1], 4, 1e-6);
+            assert_float_equal(light.data[0][2], 6, 1e-6);
+            assert_float_equal(light.data[0][3], 1, 1e-6);
+            seen_sphere = true;
+        } else {
+            assert_int_equal(light.type, PRIMITIVE_TRIANGLE);
+            assert_float_equal(light.data[0][1], 20, 1e-6);
+            seen_triangle = true;
+        }
+    }
+    assert_true(seen_quad && seen_sphere && seen_triangle);
+    /* The baked copies are hit where the placed shapes are: the quad's middle, (0.5, 0,
+     * 0.5) in the object's coordinates, is (5, 7.5, 7.5) in the world, on the plane x = 5. */
+    float origin[3] = {20, 7.5f, 7.5f}, direction[3] = {-1, 0, 0};
+    packed_hit hit;
+    assert_true(packed_intersect_nearest(&packed, origin, direction, 0, INFINITY, &hit));
+    assert_float_equal(hit.t, 15, 1e-4);
+    assert_int_equal(hit.instance, PACKED_NONE);
+    packed_scene_free(&packed);
+    scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -566,6 +645,7 @@ int main(void)
         cmocka_unit_test(instance_records_and_materials),
         cmocka_unit_test(singular_instance_is_an_error),
         cmocka_unit_test(emissive_spheres_become_lights),
+        cmocka_unit_test(placed_emitters_become_lights),
     };
     return cmocka_run_group_tests_name("pack", tests, NULL, NULL);
 }
