@@ -504,15 +504,15 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
                     request->frame_define != NULL ? "frame" : "time");
             return EXIT_BAD_INPUT;
         }
-        if (request->frames.count > 1 && !output_pattern_has_frame(output)) {
-            fprintf(stderr, "rtspheres render: %d frames would all write '%s'; put a frame number pattern in the "
-                            "output, e.g. frame-%%04d.png\n", request->frames.count, output);
-            return EXIT_BAD_INPUT;
-        }
         /* The checks below look at the first frame's name. */
         if (output_pattern_format(output, request->frames.frames[0], request->output_name,
                                   sizeof request->output_name, &error) != RT_OK) {
             fprintf(stderr, "rtspheres render: %s\n", error.message);
+            return EXIT_BAD_INPUT;
+        }
+        if (request->frames.count > 1 && !output_pattern_has_frame(output)) {
+            fprintf(stderr, "rtspheres render: %d frames would all write '%s'; put a frame number pattern in the "
+                            "output, e.g. frame-%%04d.png\n", request->frames.count, output);
             return EXIT_BAD_INPUT;
         }
     } else {
