@@ -550,11 +550,23 @@ static int parse_arguments(int argc, char **argv, render_request *request, bool 
         fprintf(stderr, "rtspheres render: --resume continues one image; render the frames one at a time\n");
         return EXIT_BAD_INPUT;
     }
+    if (request->shard_by != NULL && request->shard_count == 0) {
+        fprintf(stderr, "rtspheres render: --shard-by %s does nothing without --shard I/N\n", request->shard_by);
+        return EXIT_BAD_INPUT;
+    }
     if (request->shard_count) {
         const char *by = request->shard_by ? request->shard_by : request->frames.count > 1 ? "frames" : "samples";
         request->shard_by = by;
         if (strcmp(by, "frames") == 0 && request->frames.count == 0) {
             fprintf(stderr, "rtspheres render: --shard-by frames needs --frames\n");
+            return EXIT_BAD_INPUT;
+        }
+        /* As with an empty sample shard or tile: a part with nothing to render is an error,
+         * not a silent success that writes nothing. */
+        if (strcmp(by, "frames") == 0 && request->shard_index >= request->frames.count) {
+            fprintf(stderr, "rtspheres render: shard %d/%d of %d frame%s is empty; use fewer shards\n",
+                    request->shard_index, request->shard_count, request->frames.count,
+                    request->frames.count == 1 ? "" : "s");
             return EXIT_BAD_INPUT;
         }
         if (strcmp(by, "samples") == 0 && request->has_samples) {
