@@ -147,7 +147,8 @@ typedef struct scene_sphere {
 typedef enum scene_shape_type {
     SHAPE_SPHERE = 0,            /* points[0] centre, radius */
     SHAPE_MOVING_SPHERE = 1,     /* points[0] centre at time 0, points[1] at time 1, radius */
-    SHAPE_TRIANGLE = 2,          /* points[0..2] corners (counter-clockwise seen from the front) */
+    SHAPE_TRIANGLE = 2,          /* points[0..2] corners (counter-clockwise seen from the front);
+                                  * optional normals and uvs per corner (has_normals, has_uvs) */
     SHAPE_QUAD = 3,              /* points[0] corner Q, points[1] edge u, points[2] edge v:
                                   * the parallelogram Q + a u + b v, a, b in [0,1]; uv = (a, b) */
 } scene_shape_type;
@@ -157,6 +158,16 @@ typedef struct scene_shape {
     int material;                /* index into scene.materials, or -1: the instance's */
     float points[3][3];
     float radius;
+    /* SHAPE_TRIANGLE only (false and zero for every other type and for a triangle written
+     * without them): per-corner shading data, corner k going with points[k], in the
+     * object's coordinates like points (an instance transform applies to them as to a
+     * mesh's vertex normals). The same data a mesh triangle has through its vertices. */
+    bool has_normals;            /* true: normals[k] is the unit shading normal at corner k;
+                                  * false: flat shading (the geometric normal) */
+    bool has_uvs;                /* true: uvs[k] is the texture coordinate (u, v) at corner k,
+                                  * v pointing up as in scene_mesh.uvs; false: none */
+    float normals[3][3];         /* unit length when has_normals, else zero */
+    float uvs[3][2];             /* any finite values when has_uvs, else zero */
 } scene_shape;
 
 /* A triangle mesh, loaded from an OBJ file once however often it is placed. The parser

@@ -2323,14 +2323,105 @@ static bool statement_moving_sphere(parser *p, source_line *line, const token *k
     return add_block_shape(p, &shape, &where);
 }
 
-/* triangle X Y Z  X Y Z  X Y Z [MATERIAL]: counter-clockwise seen from the front. */
+/* Reads the three corner normals of the triangle's `normals` clause into shape: each three
+ * numbers (finite, within the float range), not all zero, stored at unit length. */
+static bool read_triangle_normals(parser *p, source_line *line, scene_shape *shape)
+{
+    static const char *const corners[3] = {"first", "second", "third"};
+    for (int k = 0; k < 3; k++) {
+        char owner[DESCRIPTION_BUFFER];
+        snprintf(owner, sizeof owner, "the triangle's %s normal", corners[k]);
+        double normal[3];
+        size_t offsets[3];
+        if (!read_point(p, line, owner, normal, offsets))
+            return false;
+        if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0)
+            return fail_at(p, line, offsets[0], "%s is zero (0 0 0), so it has no direction (a normal needs a "
+                           "length > 0; it is made unit length)", owner);
+        normalise_into(normal, shape->normals[k]);
+    }
+    shape->has_normals = true;
+    return true;
+}
+
+/* Reads the three corner texture coordinates of the triangle's `uvs` clause into shape. */
+static bool read_triangle_uvs(parser *p, source_line *line, scene_shape *shape)
+{
+    static const char *const corners[3] = {"first", "second", "third"};
+    static const char *const axes[2] = {"u", "v"};
+    for (int k = 0; k < 3; k++) {
+        for (int i = 0; i < 2; i++) {
+            char what[DESCRIPTION_BUFFER];
+            snprintf(what, sizeof what, "the triangle's %s uv %s", corners[k], axes[i]);
+            if (!read_float(p, line, what, &shape->uvs[k][i], NULL))
+                return false;
+        }
+    }
+    shape->has_uvs = true;
+    return true;
+}
+
+/* True when token t of line is the name of a material defined so far. */
+static bool names_material(parser *p, const source_line *line, const token *t)
+{
+    char name[SCENE_NAME_MAX];
+    if (t->kind != TOKEN_WORD || t->length >= SCENE_NAME_MAX)
+        return false;
+    memcpy(name, line->text + t->offset, t->length);
+    name[t->length] = '\0';
+    return scene_find_material(p->scene, name) >= 0;
+}
+
+/* Reads the next token of line into *t without consuming it; true when nothing but a
+ * comment follows it (the last word of a statement). */
+static bool is_last_word(parser *p, source_line *line, token *t)
+{
+    size_t cursor = line->cursor, last_token_end = line->last_token_end;
+    token after = {.kind = TOKEN_END};
+    bool ok = next_token(p, line, t) && next_token(p, line, &after);
+    line->cursor = cursor;
+    line->last_token_end = last_token_end;
+    return ok && after.kind == TOKEN_END;
+}
+
+/* triangle X Y Z  X Y Z  X Y Z [normals NX NY NZ  NX NY NZ  NX NY NZ] [uvs U V  U V  U V]
+ * [MATERIAL]: counter-clockwise seen from the front; the clauses in either order, each at
+ * most once. A clause word that ends the line is the material when a material of that
+ * name is defined (so a scene whose material is called `normals` reads as it did). */
 static bool statement_triangle(parser *p, source_line *line, const token *keyword)
 {
     scene_shape shape = {.type = SHAPE_TRIANGLE};
     if (!read_vector(p, line, "the triangle's first corner", shape.points[0], NULL) ||
         !read_vector(p, line, "the triangle's second corner", shape.points[1], NULL) ||
-        !read_vector(p, line, "the triangle's third corner", shape.points[2], NULL) ||
-        !read_shape_material(p, line, "the triangle", "triangles", &shape.material))
+        !read_vector(p, line, "the triangle's third corner", shape.points[2], NULL))
+        return false;
+    static const char *const clauses[] = {"normals", "uvs"};
+    size_t first_offsets[2] = {SIZE_MAX, SIZE_MAX};
+    for (;;) {
+        token t = {.kind = TOKEN_END};
+        if (!peek_token(p, line, &t))
+            return false;
+        if (!token_is(line, &t, clauses[0]) && !token_is(line, &t, clauses[1]))
+            break;
+        token word = {.kind = TOKEN_END};
+        if (is_last_word(p, line, &word) && names_material(p, line, &t))
+            break;
+        int clause = -1;
+        if (!next_token(p, line, &t) || !match_clause(p, line, &t, "triangle", clauses, 2, first_offsets, &clause))
+            return false;
+        if (!(clause == 0 ? read_triangle_normals(p, line, &shape) : read_triangle_uvs(p, line, &shape)))
+            return false;
+    }
+    /* A word that is followed by more and names no material is a misspelt clause. */
+    token t = {.kind = TOKEN_END}, word = {.kind = TOKEN_END};
+    if (!peek_token(p, line, &t))
+        return false;
+    if (t.kind == TOKEN_WORD && !is_last_word(p, line, &word) && !names_material(p, line, &t)) {
+        char found[QUOTE_BUFFER + 16];
+        return fail_at(p, line, t.offset, "unknown triangle clause %s (expected normals or uvs, or a material "
+                       "defined earlier as the last word)", describe_token(line, &t, found, sizeof found));
+    }
+    if (!read_shape_material(p, line, "the triangle", "triangles", &shape.material))
         return false;
     source_position where = position_in(line, keyword->offset);
     return add_block_shape(p, &shape, &where);

@@ -38,6 +38,40 @@ if "$program" render scenes/glass-furnace.txt -o "$out" --size 64x64 --spp 64 --
 else
     fail "glass furnace" "render failed"
 fi
+# The whole image is mostly the sphere, but a missing or invisible sphere would give 1
+# too: so also the pixels inside its silhouette (radius about 31 pixels), rendered as a
+# crop with AOVs. There every pixel is 1 (each bounce has weight exactly 1, so every
+# sample is 1), the depth shows every pixel hits the sphere's front (3 from the camera
+# in the middle, 3.12 at the crop's corners; 0 would be the sky), and the paths pass
+# through the glass: 3 segments (in, out, to the sky) or more for most samples, 2 for the
+# few (about 4%) reflected at the front; measured 2.998 per sample. The sky alone would
+# be 1, an opaque sphere 2: more than 2.5 is required.
+out="$scratch/glass-furnace-sphere.exr"
+if "$program" render scenes/glass-furnace.txt -o "$out" --size 64x64 --spp 64 --crop 20,20,44,44 --aovs --quiet; then
+    "$program" stats "$out" >"$scratch/glass-stats"
+    crop_range() { sed -n "s/^channel $1: mean [^ ]* min \([^ ]*\) max \([^ ]*\)/\1 \2/p" "$scratch/glass-stats"; }
+    crop_mean() { sed -n "s/^channel $1: mean \([^ ]*\) .*/\1/p" "$scratch/glass-stats"; }
+    for channel in R G B; do
+        mean=$(crop_mean $channel)
+        range=$(crop_range $channel)
+        if within "$mean" 1 0.01 && within "${range% *}" 1 0.001 && within "${range#* }" 1 0.001; then
+            pass "glass furnace on the sphere, channel $channel: every pixel 1 (mean $mean, min/max $range)"
+        else fail "glass furnace on the sphere, channel $channel" "mean $mean, min/max $range, expected 1"; fi
+    done
+    depth=$(crop_range depth.Z)
+    segments=$(sed -n 's/^metadata rtspheres:path_segments: //p' "$scratch/glass-stats")
+    samples=$(sed -n 's/^metadata rtspheres:samples_finished: //p' "$scratch/glass-stats")
+    per_sample=$(awk -v s="$segments" -v n="$samples" 'BEGIN { if (n > 0) printf "%.3f", s / n }')
+    if ! awk -v r="$depth" 'BEGIN { split(r, v, " "); exit !(v[1] >= 2.999 && v[2] <= 3.2) }'; then
+        fail "glass furnace: the crop sees the sphere" "depth.Z min/max '$depth', expected 3 to 3.2"
+    elif ! awk -v p="$per_sample" 'BEGIN { exit !(p != "" && p > 2.5) }'; then
+        fail "glass furnace: the crop sees the sphere" "$per_sample path segments per sample, expected more than 2.5"
+    else
+        pass "glass furnace: the crop sees the sphere (depth $depth, $per_sample path segments per sample)"
+    fi
+else
+    fail "glass furnace on the sphere" "render failed"
+fi
 
 # A diffuse plane (radius-1000 sphere) under a uniform sky: exactly albedo * sky = 0.6
 # in every pixel; anything darker is self-intersection on the big sphere.

@@ -1508,6 +1508,186 @@ static void test_shape_errors(void **state)
                        "shape needs a material outside a group)");
 }
 
+/* triangle ... [normals N N N] [uvs UV UV UV] [MATERIAL]: per-corner shading data. */
+static void test_triangle_normals_and_uvs(void **state)
+{
+    (void)state;
+    scene s;
+    /* The group's shapes come first in scene.shapes: a block's shapes are added when it
+     * closes, the top level's at the end. */
+    parse_ok("material m lambertian 1 1 1\n"
+             "group material m {\n"
+             "    triangle 0 0 0  1 0 0  0 1 0  normals 0 0 1  0 0 1  0 0 1\n"
+             "}\n"
+             "set n 2\n"
+             "triangle 0 0 0  1 0 0  0 1 0  normals 0 0 $n  0 3 4  (1e-30) (1e-30) 0  uvs 0 0  1 0.5  -2 3 m\n"
+             "triangle 0 0 0  1 0 0  0 1 0  uvs 0.25 0.75  1 0  0 1  normals 0 0 1  0 0 1  0 0 -1 m  # either order\n"
+             "triangle 0 0 0  1 0 0  0 1 0  uvs 0 0 1 0 0 1 m\n"
+             "triangle 0 0 0  1 0 0  0 1 0  normals 1 0 0 0 1 0 0 0 1 m\n"
+             "triangle 0 0 0  1 0 0  0 1 0 m\n"
+             "quad 0 0 0  1 0 0  0 1 0 m\n", NULL, &s);
+    assert_int_equal(s.shape_count, 7);
+    /* In a block the material may be left out after the clauses, as after the corners. */
+    const scene_shape *t = &s.shapes[0];
+    assert_true(t->has_normals);
+    assert_false(t->has_uvs);
+    assert_int_equal(t->material, -1);
+    assert_int_equal(s.instances[0].material, 0);
+
+    t = &s.shapes[1];
+    assert_int_equal(t->type, SHAPE_TRIANGLE);
+    assert_int_equal(t->material, 0);
+    assert_vector_equal(t->points[2], 0, 1, 0);
+    assert_true(t->has_normals);
+    assert_true(t->has_uvs);
+    /* Stored at unit length, also a tiny one. */
+    assert_vector_equal(t->normals[0], 0, 0, 1);
+    assert_vector_equal(t->normals[1], 0, 0.6, 0.8);
+    assert_vector_equal(t->normals[2], sqrt(0.5), sqrt(0.5), 0);
+    assert_double_equal(t->uvs[0][0], 0, 0);
+    assert_double_equal(t->uvs[0][1], 0, 0);
+    assert_double_equal(t->uvs[1][0], 1, 0);
+    assert_double_equal(t->uvs[1][1], 0.5, 0);
+    assert_double_equal(t->uvs[2][0], -2, 0);   /* any finite value */
+    assert_double_equal(t->uvs[2][1], 3, 0);
+
+    t = &s.shapes[2];
+    assert_true(t->has_normals && t->has_uvs);
+    assert_double_equal(t->uvs[0][0], 0.25, 0);
+    assert_double_equal(t->uvs[0][1], 0.75, 0);
+    assert_vector_equal(t->normals[2], 0, 0, -1);  /* need not agree with the corner order */
+    assert_int_equal(t->material, 0);
+
+    t = &s.shapes[3];
+    assert_false(t->has_normals);
+    assert_true(t->has_uvs);
+    for (int k = 0; k < 3; k++)
+        assert_vector_equal(t->normals[k], 0, 0, 0);
+    assert_double_equal(t->uvs[2][1], 1, 0);
+
+    t = &s.shapes[4];
+    assert_true(t->has_normals);
+    assert_false(t->has_uvs);
+    assert_vector_equal(t->normals[1], 0, 1, 0);
+    for (int k = 0; k < 3; k++) {
+        assert_double_equal(t->uvs[k][0], 0, 0);
+        assert_double_equal(t->uvs[k][1], 0, 0);
+    }
+
+    /* Without the clauses, and for every other shape: flat, no uvs, all zero. */
+    for (int i = 5; i <= 6; i++) {
+        t = &s.shapes[i];
+        assert_false(t->has_normals);
+        assert_false(t->has_uvs);
+        for (int k = 0; k < 3; k++) {
+            assert_vector_equal(t->normals[k], 0, 0, 0);
+            assert_double_equal(t->uvs[k][0], 0, 0);
+            assert_double_equal(t->uvs[k][1], 0, 0);
+        }
+    }
+    assert_int_equal(s.shapes[6].type, SHAPE_QUAD);
+    scene_free(&s);
+
+    /* A material called normals or uvs still works as the last word, as it always did. */
+    parse_ok("material normals lambertian 1 1 1\n"
+             "material uvs lambertian 1 0 0\n"
+             "triangle 0 0 0  1 0 0  0 1 0 normals\n"
+             "triangle 0 0 0  1 0 0  0 1 0 uvs\n"
+             "triangle 0 0 0  1 0 0  0 1 0 normals 0 0 1 0 0 1 0 0 1 uvs\n"
+             "triangle 0 0 0  1 0 0  0 1 0 uvs 0 0 1 0 0 1 normals  # a comment\n", NULL, &s);
+    assert_int_equal(s.shape_count, 4);
+    assert_int_equal(s.shapes[0].material, 0);
+    assert_false(s.shapes[0].has_normals);
+    assert_int_equal(s.shapes[1].material, 1);
+    assert_false(s.shapes[1].has_uvs);
+    assert_true(s.shapes[2].has_normals);
+    assert_int_equal(s.shapes[2].material, 1);
+    assert_true(s.shapes[3].has_uvs);
+    assert_int_equal(s.shapes[3].material, 0);
+    scene_free(&s);
+}
+
+/* The example of docs/scene-format.md, "Triangle normals and uvs", exactly. */
+static void test_documented_triangle_example(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("texture photo image \"photo.png\"\n"
+             "material print lambertian @photo\n"
+             "triangle -1 0 0   1 0 0   1 1 0   normals -0.5 0 1  0.5 0 1  0.5 0 1   uvs 0 0  1 0  1 1   print\n"
+             "triangle -1 0 0   1 1 0  -1 1 0   normals -0.5 0 1  0.5 0 1 -0.5 0 1   uvs 0 0  1 1  0 1   print\n",
+             NULL, &s);
+    assert_int_equal(s.shape_count, 2);
+    double c = 1 / sqrt(1.25);
+    for (int i = 0; i < 2; i++) {
+        assert_true(s.shapes[i].has_normals);
+        assert_true(s.shapes[i].has_uvs);
+        assert_int_equal(s.shapes[i].material, 0);
+        assert_vector_equal(s.shapes[i].normals[0], -0.5 * c, 0, c);
+    }
+    assert_vector_equal(s.shapes[1].normals[2], -0.5 * c, 0, c);
+    assert_double_equal(s.shapes[1].uvs[2][0], 0, 0);
+    assert_double_equal(s.shapes[1].uvs[2][1], 1, 0);
+    scene_free(&s);
+}
+
+static void test_triangle_normal_and_uv_errors(void **state)
+{
+    (void)state;
+    const char *m = "material m lambertian 1 1 1\n";
+    char text[512];
+#define TRIANGLE_ERROR(rest, prefix, phrase)                                  \
+    do {                                                                      \
+        snprintf(text, sizeof text, "%striangle 0 0 0 1 0 0 0 1 0 %s", m, rest); \
+        assert_parse_error(text, prefix, phrase);                             \
+    } while (0)
+    /* "triangle 0 0 0 1 0 0 0 1 0 " is 27 bytes: the clause word is at column 28, its
+     * first number at 36 (normals) or 32 (uvs); a missing number is reported just after
+     * the last token. */
+    TRIANGLE_ERROR("normals 0 0 0  0 0 1  0 0 1 m", "s.txt:2:36: ",
+                   "the triangle's first normal is zero (0 0 0), so it has no direction");
+    TRIANGLE_ERROR("normals 0 0 1  0 0 1  -0 0 0 m", "s.txt:2:50: ", "the triangle's third normal is zero");
+    TRIANGLE_ERROR("normals 0 0 1  nan 0 1  0 0 1 m", "s.txt:2:43: ",
+                   "expected a number for the triangle's second normal x, found 'nan' (NaN and infinity are not "
+                   "allowed)");
+    TRIANGLE_ERROR("normals 0 0 1  0 0 1  0 0 -inf m", "s.txt:2:54: ",
+                   "expected a number for the triangle's third normal z, found '-inf' (NaN and infinity");
+    TRIANGLE_ERROR("normals 0 0 1e999  0 0 1  0 0 1 m", "s.txt:2:40: ",
+                   "expected a finite number for the triangle's first normal z, found '1e999' (out of range)");
+    TRIANGLE_ERROR("normals 0 0 1e39  0 0 1  0 0 1 m", "s.txt:2:40: ",
+                   "the triangle's first normal z is 1e+39, too large for the renderer's 32-bit floats");
+    TRIANGLE_ERROR("normals 0 (0/0) 1  0 0 1  0 0 1 m", "s.txt:2:40: ", "division by zero");
+    TRIANGLE_ERROR("normals (10^400) 0 1  0 0 1  0 0 1 m", "s.txt:2:39: ", "the result of '^' is infinite (too large)");
+    TRIANGLE_ERROR("normals 0 0 1  0 0 1 m", "s.txt:2:49: ",
+                   "expected a number for the triangle's third normal x, found 'm'");
+    TRIANGLE_ERROR("normals 0 0 1  0 0 1  0 0", "s.txt:2:53: ",
+                   "expected a number for the triangle's third normal z, found end of line");
+    TRIANGLE_ERROR("normals", "s.txt:2:35: ", "expected a number for the triangle's first normal x, found end of line");
+    TRIANGLE_ERROR("uvs 0 nan  1 0  0 1 m", "s.txt:2:34: ",
+                   "expected a number for the triangle's first uv v, found 'nan' (NaN and infinity are not allowed)");
+    TRIANGLE_ERROR("uvs 0 0  1 0  infinity 1 m", "s.txt:2:42: ",
+                   "expected a number for the triangle's third uv u, found 'infinity'");
+    TRIANGLE_ERROR("uvs 0 0  1e39 0  0 1 m", "s.txt:2:37: ",
+                   "the triangle's second uv u is 1e+39, too large for the renderer's 32-bit floats");
+    TRIANGLE_ERROR("uvs 0 0  1 0  0 (1/0) m", "s.txt:2:46: ", "division by zero");
+    TRIANGLE_ERROR("uvs 0 0  1 0  0", "s.txt:2:43: ", "expected a number for the triangle's third uv v, found end of line");
+    TRIANGLE_ERROR("normals 0 0 1 0 0 1 0 0 1 normals 0 0 1 0 0 1 0 0 1 m", "s.txt:2:54: ",
+                   "triangle clause 'normals' given twice in one statement (first at column 28)");
+    TRIANGLE_ERROR("uvs 0 0 1 0 0 1 normals 0 0 1 0 0 1 0 0 1 uvs 0 0 1 0 0 1 m", "s.txt:2:70: ",
+                   "triangle clause 'uvs' given twice in one statement (first at column 28)");
+    TRIANGLE_ERROR("normal 0 0 1 0 0 1 0 0 1 m", "s.txt:2:28: ",
+                   "unknown triangle clause 'normal' (expected normals or uvs, or a material defined earlier as the "
+                   "last word)");
+    TRIANGLE_ERROR("m normals 0 0 1 0 0 1 0 0 1", "s.txt:2:30: ",
+                   "unexpected 'normals' after the triangle (expected end of line)");
+    TRIANGLE_ERROR("uvs 0 0 1 0 0 1 nope", "s.txt:2:44: ", "the triangle's material 'nope' is not defined");
+    /* At the top level the material is still needed after the clauses. */
+    TRIANGLE_ERROR("uvs 0 0 1 0 0 1", "s.txt:2:43: ",
+                   "expected a material name for the triangle, found end of line (a shape needs a material outside "
+                   "a group)");
+#undef TRIANGLE_ERROR
+}
+
 /* ------------------------------------------------------------------ groups and transforms */
 
 static void test_transform_order(void **state)
@@ -2578,6 +2758,9 @@ int main(void)
         cmocka_unit_test(test_top_level_shapes_form_one_world_object),
         cmocka_unit_test(test_box_expands_to_six_outward_quads),
         cmocka_unit_test(test_shape_errors),
+        cmocka_unit_test(test_triangle_normals_and_uvs),
+        cmocka_unit_test(test_triangle_normal_and_uv_errors),
+        cmocka_unit_test(test_documented_triangle_example),
         cmocka_unit_test(test_transform_order),
         cmocka_unit_test(test_scale_matrix_and_rotate_forms),
         cmocka_unit_test(test_transform_errors),
