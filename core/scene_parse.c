@@ -2888,12 +2888,48 @@ static bool check_shape_materials(parser *p)
     return true;
 }
 
+/* A volume's boundary must be closed: crossing it is how a ray enters and leaves the
+ * medium. Whether a set of surfaces is closed is not cheap to know in general, but the flat
+ * shapes (triangles and quads) of one boundary object can only be closed among themselves
+ * (a sphere's curved surface never meets a straight edge), and no closed surface is made
+ * of fewer than 4 flat faces: so 1 to 3 of them in a volume's object are an open surface
+ * for certain (the common mistake: a single quad or triangle). Meshes are checked by the
+ * asset loader, which knows their triangles. */
+static bool check_volume_boundaries(parser *p)
+{
+    const scene *s = p->scene;
+    for (int i = 0; i < s->instance_count; i++) {
+        if (!s->instances[i].volume)
+            continue;
+        const scene_object *object = &s->objects[s->instances[i].object];
+        int flat = 0, first_flat = -1;
+        for (int k = object->first_shape; k < object->first_shape + object->shape_count; k++) {
+            if (s->shapes[k].type != SHAPE_TRIANGLE && s->shapes[k].type != SHAPE_QUAD)
+                continue;
+            if (first_flat < 0)
+                first_flat = k;
+            flat++;
+        }
+        if (flat == 0 || flat >= 4)
+            continue;
+        const char *noun = s->shapes[first_flat].type == SHAPE_QUAD ? "quad" : "triangle";
+        if (flat == 1)
+            return fail_at_position(p, &p->shape_positions[first_flat], "this %s is the only flat surface of a "
+                                    "volume's boundary, which must be closed: one %s encloses nothing (use a box, a "
+                                    "sphere or a closed mesh, or put the %s outside the volume)", noun, noun, noun);
+        return fail_at_position(p, &p->shape_positions[first_flat], "this %s is one of only %d flat surfaces "
+                                "(triangles and quads) of a volume's boundary, which must be closed: fewer than 4 "
+                                "flat faces enclose nothing (use a box, a sphere or a closed mesh)", noun, flat);
+    }
+    return true;
+}
+
 /* Shared end of both entry points: parses top (whose text the caller owns) and frees
  * everything on failure, leaving *out as scene_defaults(). */
 static rt_status parse_scene(parser *p, const source_file *top)
 {
     bool ok = apply_defines(p) && parse_source(p, top) && flush_block_shapes(p, &p->blocks[0]) &&
-              check_finished_scene(p) && check_shape_materials(p);
+              check_finished_scene(p) && check_shape_materials(p) && check_volume_boundaries(p);
     parser_free(p);
     if (!ok) {
         scene_free(p->scene);

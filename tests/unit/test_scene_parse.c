@@ -2057,6 +2057,45 @@ static void test_volumes(void **state)
                        "expected a number for the blue component of the volume's albedo, found end of line");
 }
 
+/* A volume's boundary must be closed: 1 to 3 flat shapes in one boundary object cannot
+ * be (a single quad is the usual mistake); 0 or 4 and more are not judged. */
+static void test_volume_boundary_must_be_closed(void **state)
+{
+    (void)state;
+    assert_parse_error("volume 1 1 1 1 {\n  quad 0 0 0  1 0 0  0 1 0\n}\n", "s.txt:2:3: ",
+                       "this quad is the only flat surface of a volume's boundary, which must be closed: one quad "
+                       "encloses nothing (use a box, a sphere or a closed mesh, or put the quad outside the volume)");
+    assert_parse_error("volume 1 1 1 1 {\n  translate 0 1 0\n  triangle 0 0 0  1 0 0  0 1 0\n}\n", "s.txt:3:3: ",
+                       "this triangle is the only flat surface of a volume's boundary");
+    assert_parse_error("volume 1 1 1 1 {\n  sphere 0 0 0 1\n  triangle 0 0 0  1 0 0  0 1 0\n"
+                       "  quad 0 0 0  1 0 0  0 1 0\n  triangle 0 0 0  1 0 0  0 0 1\n}\n", "s.txt:3:3: ",
+                       "this triangle is one of only 3 flat surfaces (triangles and quads) of a volume's boundary, "
+                       "which must be closed: fewer than 4 flat faces enclose nothing");
+    /* A group inside a volume is a boundary of its own (with a material: a pane in fog). */
+    assert_parse_error("material glass dielectric 1.5\nvolume 1 1 1 1 {\n  sphere 0 0 0 1\n"
+                       "  group material glass {\n    quad 0 0 0  1 0 0  0 1 0\n  }\n}\n", "s.txt:5:5: ",
+                       "this quad is the only flat surface of a volume's boundary");
+    /* Placed by an instance, the group's volume is the same object, reported once. */
+    assert_parse_error("group g {\n  volume 1 1 1 1 {\n    quad 0 0 0  1 0 0  0 1 0\n  }\n}\ninstance g {\n"
+                       "  translate 5 0 0\n}\n", "s.txt:3:5: ", "this quad is the only flat surface");
+
+    scene s;
+    /* A box (six quads), a tetrahedron's four triangles, spheres alone: accepted. */
+    parse_ok("volume 1 1 1 1 {\n  box 0 0 0 1 1 1\n}\n"
+             "volume 1 1 1 1 {\n"
+             "  triangle 0 0 0  0 1 0  1 0 0\n  triangle 0 0 0  1 0 0  0 0 1\n"
+             "  triangle 0 0 0  0 0 1  0 1 0\n  triangle 1 0 0  0 1 0  0 0 1\n}\n"
+             "volume 1 1 1 1 {\n  sphere 0 0 0 1\n  moving_sphere 0 0 0  1 0 0  1\n}\n", NULL, &s);
+    assert_int_equal(s.instance_count, 3);
+    assert_true(s.instances[0].volume && s.instances[1].volume && s.instances[2].volume);
+    scene_free(&s);
+    /* A single quad outside any volume is a surface as always. */
+    parse_ok("material m lambertian 1 1 1\nquad 0 0 0  1 0 0  0 1 0 m\nvolume 1 1 1 1 {\n  sphere 0 0 0 1\n}\n",
+             NULL, &s);
+    assert_int_equal(s.instance_count, 2);
+    scene_free(&s);
+}
+
 static void test_instance_forms_and_errors(void **state)
 {
     (void)state;
@@ -2769,6 +2808,7 @@ int main(void)
         cmocka_unit_test(test_shapes_without_any_material),
         cmocka_unit_test_setup_teardown(test_meshes, create_directory, remove_directory),
         cmocka_unit_test(test_volumes),
+        cmocka_unit_test(test_volume_boundary_must_be_closed),
         cmocka_unit_test(test_instance_forms_and_errors),
         cmocka_unit_test(test_braces),
         cmocka_unit_test(test_nesting_limit),
