@@ -346,6 +346,42 @@ struct memory_buffer : std::streambuf {
     }
 };
 
+/* The lines of a tinyobjloader message (warnings come several to a string, some with a
+ * stray "." line), trimmed of trailing spaces and dots, empty ones left out; each "line N"
+ * and "line: N" number less shift (1 for the OBJ file, whose text has our extra first
+ * line; 0 for an MTL file). */
+std::vector<std::string> tinyobj_lines(const std::string &message, unsigned long long shift)
+{
+    std::vector<std::string> lines;
+    size_t begin = 0;
+    while (begin <= message.size()) {
+        size_t end = message.find('\n', begin);
+        if (end == std::string::npos)
+            end = message.size();
+        std::string line = message.substr(begin, end - begin), out;
+        begin = end + 1;
+        size_t i = 0;
+        while (i < line.size()) {
+            size_t digits = line.compare(i, 5, "line ") == 0 ? i + 5 : line.compare(i, 6, "line: ") == 0 ? i + 6 : 0;
+            if (digits != 0 && digits < line.size() && isdigit((unsigned char)line[digits])) {
+                size_t j = digits;
+                unsigned long long number = 0;
+                while (j < line.size() && isdigit((unsigned char)line[j]))
+                    number = number * 10 + (unsigned long long)(line[j++] - '0');
+                out += line.substr(i, digits - i) + std::to_string(number > shift ? number - shift : 0);
+                i = j;
+            } else {
+                out += line[i++];
+            }
+        }
+        while (!out.empty() && (out.back() == ' ' || out.back() == '.' || out.back() == '\r'))
+            out.pop_back();
+        if (!out.empty())
+            lines.push_back(out);
+    }
+    return lines;
+}
+
 /* Loads the MTL files and adds the usemtl-only names, on its first call (our own first
  * mtllib line); later calls (the file's own mtllib lines) have nothing left to do. */
 class material_loader : public tinyobj::MaterialReader {
@@ -374,7 +410,7 @@ public:
     }
 
     size_t defined_count() const { return defined_count_; }
-    const std::string &warning() const { return warning_; }
+    const std::vector<std::string> &warnings() const { return warnings_; }
     const std::string &failure() const { return failure_; }
 
 private:
@@ -396,14 +432,15 @@ private:
                 why = strerror(errno ? errno : EIO);
         }
         if (why != nullptr) {
-            if (warning_.empty())
-                warning_ = "cannot read material library '" + path + "': " + why
-                           + "; its materials are left out";
+            add_unique(warnings_, "cannot read material library '" + path + "': " + why
+                                      + "; its materials are left out");
             return;
         }
         size_t first = materials->size();
         std::string warnings, errors;
         tinyobj::LoadMtl(map, materials, &stream, &warnings, &errors);
+        for (const std::string &warning : tinyobj_lines(warnings, 0))
+            add_unique(warnings_, "tinyobjloader, in '" + path + "': " + warning);
         for (size_t i = first; i < materials->size() && failure_.empty(); i++) {
             const tinyobj::material_t &m = (*materials)[i];
             float values[] = {m.diffuse[0],  m.diffuse[1],  m.diffuse[2],  m.specular[0],
@@ -420,32 +457,16 @@ private:
     const obj_summary &summary_;
     bool loaded_ = false;
     size_t defined_count_ = 0;
-    std::string warning_;
+    std::vector<std::string> warnings_;
     std::string failure_;
 };
 
-/* The first line of a tinyobjloader message, its "line N" numbers less one (our extra
- * first line). */
+/* The first line of a tinyobjloader error message, its line numbers corrected for our
+ * extra first line. */
 std::string tinyobj_message(const std::string &message)
 {
-    std::string first = message.substr(0, message.find('\n'));
-    std::string out;
-    size_t i = 0;
-    while (i < first.size()) {
-        if (first.compare(i, 5, "line ") == 0 && i + 5 < first.size() && isdigit((unsigned char)first[i + 5])) {
-            size_t j = i + 5;
-            unsigned long long number = 0;
-            while (j < first.size() && isdigit((unsigned char)first[j]))
-                number = number * 10 + (unsigned long long)(first[j++] - '0');
-            out += "line " + std::to_string(number > 0 ? number - 1 : 0);
-            i = j;
-        } else {
-            out += first[i++];
-        }
-    }
-    while (!out.empty() && (out.back() == ' ' || out.back() == '.'))
-        out.pop_back();
-    return out.empty() ? "tinyobjloader could not parse it" : "tinyobjloader: " + out;
+    std::vector<std::string> lines = tinyobj_lines(message, 1);
+    return lines.empty() ? "tinyobjloader could not parse it" : "tinyobjloader: " + lines[0];
 }
 
 /* One output vertex: a position with a normal (an index of the file's, or -2 - t for the
@@ -709,7 +730,12 @@ void load(const char *path, obj_mesh *out)
         fail(loader.failure());
     std::string().swap(source);
     build_mesh(attrib, shapes, materials, loader.defined_count(), out);
-    snprintf(out->warning, sizeof out->warning, "%s", loader.warning().c_str());
+    std::vector<std::string> found = loader.warnings();
+    for (const std::string &warning : tinyobj_lines(warnings, 1))
+        add_unique(found, "tinyobjloader: " + warning);
+    out->warning_count = found.size() > INT_MAX ? INT_MAX : (int)found.size();
+    for (size_t i = 0; i < found.size() && i < OBJ_MAX_WARNINGS; i++)
+        snprintf(out->warnings[i], sizeof out->warnings[i], "%s", found[i].c_str());
 }
 
 rt_status load_failed(rt_error *error, rt_status status, const char *path, const std::string &why)

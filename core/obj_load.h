@@ -20,7 +20,13 @@
  * MTL files: every file of every `mtllib` line is looked up relative to the OBJ file's
  * directory (absolute paths as they are) and all are loaded, wherever the `mtllib` line
  * stands. A missing MTL file is not an error: the mesh loads, the names its `usemtl`
- * lines use are still listed (defined = false), and warning says which file is missing.
+ * lines use are still listed (defined = false), and a warning says which file is missing.
+ *
+ * Warnings (warnings, warning_count): what does not stop the load but is worth telling:
+ * an unreadable MTL file ("cannot read material library 'PATH': REASON; its materials
+ * are left out"), and every warning tinyobjloader gives for the OBJ file or an MTL file,
+ * as "tinyobjloader: TEXT" (an MTL file's as "tinyobjloader, in 'MTL PATH': TEXT"), line
+ * numbers those of the file. Each once, in the order found; obj_load() prints nothing.
  *
  * Errors (RT_ERROR_INPUT, the message "OBJ: cannot read 'PATH': REASON", with "line N: "
  * in REASON where there is a line): a missing or unreadable file, a number that is not a
@@ -44,6 +50,8 @@ extern "C" {
 #endif
 
 #define OBJ_NAME_MAX 256
+#define OBJ_MAX_WARNINGS 8       /* warnings kept per mesh; more are only counted */
+#define OBJ_WARNING_MAX 256      /* bytes of one warning, with the NUL */
 
 /* One material: from an MTL file (defined), or only named by a `usemtl` (not defined:
  * no MTL file defines it; the colours are then tinyobjloader's defaults and meaningless). */
@@ -69,7 +77,8 @@ typedef struct obj_mesh {
     int vertex_count, triangle_count;   /* both >= 1 after a successful load */
     obj_material *materials;     /* NULL when material_count is 0 */
     int material_count;
-    char warning[256];           /* "" or the first thing worth a warning (a missing MTL) */
+    int warning_count;           /* warnings found; may exceed OBJ_MAX_WARNINGS */
+    char warnings[OBJ_MAX_WARNINGS][OBJ_WARNING_MAX];   /* the first of them (see above) */
 } obj_mesh;
 
 /* Reads the OBJ file at path into *out (zeroed first; on failure left zeroed). */

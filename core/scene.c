@@ -1,6 +1,8 @@
 /* scene.c: see scene.h. */
 #include "scene.h"
 
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,6 +44,7 @@ void scene_free(scene *s)
     for (int i = 0; i < s->image_count; i++)
         free(s->images[i].pixels);
     free(s->images);
+    free(s->warnings);
     scene_defaults(s);
 }
 
@@ -130,6 +133,18 @@ int scene_add_light(scene *s, const scene_light *light)
         return -1;
     s->lights[s->light_count] = *light;
     return s->light_count++;
+}
+
+int scene_add_warning(scene *s, const char *format, ...)
+{
+    if (grow((void **)&s->warnings, s->warning_count, &s->warning_capacity, sizeof *s->warnings))
+        return -1;
+    va_list arguments;
+    va_start(arguments, format);
+    vsnprintf(s->warnings[s->warning_count].message, sizeof s->warnings[s->warning_count].message, format,
+              arguments);
+    va_end(arguments);
+    return s->warning_count++;
 }
 
 scene_light scene_light_defaults(scene_light_type type)

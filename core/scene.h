@@ -12,7 +12,7 @@
  *   sky:     gradient from (1,1,1) at the horizon/below to (0.5,0.7,1.0) straight up,
  *            intensity 1, rotation 0, faces and environment -1
  *   materials added by hand should set the texture fields to -1 (scene_material_defaults)
- *   no materials, spheres, shapes, objects, instances or meshes
+ *   no materials, spheres, shapes, objects, instances, meshes or warnings
  */
 #ifndef RT_SCENE_H
 #define RT_SCENE_H
@@ -202,6 +202,15 @@ typedef struct scene_instance {
     float volume_albedo[3];      /* volume: colour of the isotropic scattering */
 } scene_instance;
 
+/* A warning recorded while the scene was read or its files loaded (scene_assets.h says
+ * which). The core prints nothing: the caller shows each message, e.g. as
+ * "rtspheres render: warning: MESSAGE". MESSAGE starts with the "file:line:column" of the
+ * statement concerned, like an error. */
+#define SCENE_WARNING_MAX 1024
+typedef struct scene_warning {
+    char message[SCENE_WARNING_MAX];
+} scene_warning;
+
 typedef struct scene {
     scene_camera camera;
     scene_render_settings render;
@@ -225,6 +234,8 @@ typedef struct scene {
     scene_light *lights;
     int light_count, light_capacity;
     float ambient[3];            /* Whitted integrator's ambient term; default 0.03 0.03 0.03 */
+    scene_warning *warnings;     /* things worth telling the user that do not stop the render */
+    int warning_count, warning_capacity;   /* (e.g. a mesh's missing MTL file), in the order found */
 } scene;
 
 /* Fills *s with the defaults above and empty arrays. Never fails; frees nothing. */
@@ -250,6 +261,10 @@ int scene_add_mesh(scene *s, const scene_mesh *mesh);
 int scene_add_texture(scene *s, const scene_texture *texture);
 int scene_add_image(scene *s, const scene_image *image);
 int scene_add_light(scene *s, const scene_light *light);
+
+/* Appends a warning whose message is the printf-style format (cut to SCENE_WARNING_MAX - 1
+ * bytes); returns its index, or -1 when memory runs out. */
+int scene_add_warning(scene *s, const char *format, ...) __attribute__((format(printf, 2, 3)));
 
 /* Returns a light of the given type with every default set (white, intensity 1,
  * inverse-square falloff, spot cone 25/30 degrees, sun 0.53 degrees, pointing down). */

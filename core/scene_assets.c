@@ -141,6 +141,22 @@ static rt_status load_mesh(scene *s, int index, int scene_materials, rt_error *e
         triangle_materials[t] = scene_index[k] >= 0 ? scene_index[k] : mesh->default_material;
     }
 
+    /* Warnings become the scene's, prefixed like errors; see scene_assets.h. */
+    for (int w = 0; w < obj.warning_count && w < OBJ_MAX_WARNINGS; w++) {
+        if (scene_add_warning(s, "%s: mesh '%s': %s", mesh->position, mesh->path, obj.warnings[w]) < 0) {
+            status = rt_error_set(error, RT_ERROR_RUNTIME, "%s: out of memory loading mesh '%s'",
+                                  mesh->position, mesh->path);
+            goto done;
+        }
+    }
+    if (obj.warning_count > OBJ_MAX_WARNINGS &&
+        scene_add_warning(s, "%s: mesh '%s': %d more warnings left out", mesh->position, mesh->path,
+                          obj.warning_count - OBJ_MAX_WARNINGS) < 0) {
+        status = rt_error_set(error, RT_ERROR_RUNTIME, "%s: out of memory loading mesh '%s'", mesh->position,
+                              mesh->path);
+        goto done;
+    }
+
     /* The scene takes the arrays over. */
     mesh->positions = obj.positions;
     mesh->normals = obj.normals;
@@ -162,6 +178,29 @@ done:
     return status;
 }
 
+static const char *const face_names[SKY_FACE_COUNT] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+
+/* A volume's boundary must be closed, and no closed surface has fewer than 4 triangles: a
+ * mesh of 1 to 3 placed as (part of) a volume's boundary is an open surface for certain.
+ * (Whether a larger mesh is closed is not checked; see docs/scene-format.md.) */
+static rt_status check_volume_mesh(const scene *s, int index, rt_error *error)
+{
+    const scene_mesh *mesh = &s->meshes[index];
+    if (mesh->positions == NULL || mesh->triangle_count >= 4)
+        return RT_OK;
+    for (int i = 0; i < s->instance_count; i++) {
+        const scene_instance *instance = &s->instances[i];
+        if (!instance->volume || instance->object < 0 || instance->object >= s->object_count ||
+            s->objects[instance->object].mesh != index)
+            continue;
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "%s: mesh '%s' is (part of) a volume's boundary, which must be closed, but it "
+                            "has only %d triangle%s: fewer than 4 enclose nothing", mesh->position,
+                            mesh->path, mesh->triangle_count, mesh->triangle_count == 1 ? "" : "s");
+    }
+    return RT_OK;
+}
+
 /* Returns the index of the channel of image called name (case-insensitive), or -1. */
 static int channel_named(const rt_image *image, const char *name)
 {
@@ -171,8 +210,10 @@ static int channel_named(const rt_image *image, const char *name)
     return -1;
 }
 
-/* Loads image index into the scene as linear RGBA. */
-static rt_status load_image(scene *s, int index, rt_error *error)
+/* Loads image index into the scene as linear RGBA. role says what the image is in messages:
+ * prefix ("" or "sky box: ") goes after the position, noun ("image" or "the +X face
+ * image") names it. */
+static rt_status load_image(scene *s, int index, const char *prefix, const char *noun, rt_error *error)
 {
     scene_image *target = &s->images[index];
     rt_image image;
@@ -182,11 +223,11 @@ static rt_status load_image(scene *s, int index, rt_error *error)
                                     : image_read_linear(target->path, SCENE_IMAGE_MAX_SIDE, &image, &inner);
     if (status == RT_OK && target->data && (image.width > SCENE_IMAGE_MAX_SIDE || image.height > SCENE_IMAGE_MAX_SIDE)) {
         image_free(&image);
-        return rt_error_set(error, RT_ERROR_INPUT, "%s: image '%s' is larger than %d pixels on a side", target->position,
-                            target->path, SCENE_IMAGE_MAX_SIDE);
+        return rt_error_set(error, RT_ERROR_INPUT, "%s: %s%s '%s' is larger than %d pixels on a side",
+                            target->position, prefix, noun, target->path, SCENE_IMAGE_MAX_SIDE);
     }
     if (status != RT_OK)
-        return rt_error_set(error, status, "%s: cannot read image '%s': %s", target->position,
+        return rt_error_set(error, status, "%s: %scannot read %s '%s': %s", target->position, prefix, noun,
                             target->path, reason_of(inner.message, "IMAGE", target->path));
 
     /* Where R, G, B and A come from (-1 for A: 1). */
@@ -210,8 +251,8 @@ static rt_status load_image(scene *s, int index, rt_error *error)
     float *pixels = malloc(count * 4 * sizeof *pixels);
     if (pixels == NULL) {
         image_free(&image);
-        return rt_error_set(error, RT_ERROR_RUNTIME, "%s: out of memory for image '%s' (%dx%d)",
-                            target->position, target->path, image.width, image.height);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "%s: %sout of memory for %s '%s' (%dx%d)",
+                            target->position, prefix, noun, target->path, image.width, image.height);
     }
     for (size_t i = 0; i < count; i++) {
         const float *in = &image.pixels[i * (size_t)image.channels];
@@ -222,9 +263,9 @@ static rt_status load_image(scene *s, int index, rt_error *error)
                 free(pixels);
                 image_free(&image);
                 return rt_error_set(error, RT_ERROR_INPUT,
-                                    "%s: image '%s' has a pixel that is not a finite number "
-                                    "(NaN or infinite) at x %d, y %d", target->position,
-                                    target->path, x, y);
+                                    "%s: %s%s '%s' has a pixel that is not a finite number "
+                                    "(NaN or infinite) at x %d, y %d", target->position, prefix,
+                                    noun, target->path, x, y);
             }
             pixels[i * 4 + (size_t)c] = value;
         }
@@ -236,7 +277,6 @@ static rt_status load_image(scene *s, int index, rt_error *error)
     return RT_OK;
 }
 
-static const char *const face_names[SKY_FACE_COUNT] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
 
 /* Checks that the six faces of a sky box are loaded, square and of one size. */
 static rt_status check_sky_box(const scene *s, rt_error *error)
@@ -274,10 +314,26 @@ rt_status scene_load_assets(scene *s, rt_error *error)
         if (status != RT_OK)
             return status;
     }
+    for (int i = 0; i < s->mesh_count; i++) {
+        rt_status status = check_volume_mesh(s, i, error);
+        if (status != RT_OK)
+            return status;
+    }
     for (int i = 0; i < s->image_count; i++) {
         if (s->images[i].pixels != NULL)
             continue;
-        rt_status status = load_image(s, i, error);
+        /* A sky box face is named as one, like the size checks name it: "the -Y face image"
+         * (faces sharing one file: "the +X/-X face image"). */
+        char faces[64] = "", noun[96] = "image";
+        for (int f = 0; s->sky.type == SKY_BOX && f < SKY_FACE_COUNT; f++) {
+            if (s->sky.faces[f] != i)
+                continue;
+            size_t used = strlen(faces);
+            snprintf(faces + used, sizeof faces - used, "%s%s", used > 0 ? "/" : "", face_names[f]);
+        }
+        if (faces[0] != '\0')
+            snprintf(noun, sizeof noun, "the %s face image", faces);
+        rt_status status = load_image(s, i, faces[0] != '\0' ? "sky box: " : "", noun, error);
         if (status != RT_OK)
             return status;
     }

@@ -34,13 +34,25 @@
  * more RGBA from the first four. A missing alpha is 1.
  *
  * Sky box (sky.type SKY_BOX): after loading, the six faces must be square and all the
- * size of the +X face.
+ * size of the +X face. Every message about a face's image names the face (+X, -X, +Y, -Y,
+ * +Z, -Z), also when the file cannot be read.
+ *
+ * Volumes: a mesh of fewer than 4 triangles placed as a volume's boundary cannot be closed
+ * and is an error (the parser checks the flat shapes the same way); larger meshes are
+ * not checked for being closed.
+ *
+ * Warnings: what obj_load() warns about (a missing or unreadable MTL file, tinyobjloader's
+ * warnings) is added to s->warnings (scene.h), one entry per warning, as
+ * "FILE:LINE:COLUMN: mesh 'PATH': WARNING" (the position of the statement naming the mesh;
+ * past OBJ_MAX_WARNINGS of a mesh, one more entry says how many were left out). Nothing
+ * is printed: the caller shows them.
  *
  * Errors: RT_ERROR_INPUT, prefixed with the position of the statement that named the
  * file, e.g. "scenes/x.txt:12:6: cannot read mesh 'scenes/y.obj': No such file or
  * directory", "...: cannot read image 'scenes/t.png': it is 20000x100 pixels, more than
  * 16384 on a side", "...: sky box: the +Y face 'scenes/py.png' is 256x256, the +X face is
- * 512x512". Mesh reasons are obj_load()'s (with "line N: " for a line of the OBJ file).
+ * 512x512", "...: sky box: cannot read the -Z face image 'scenes/nz.png': No such file or
+ * directory". Mesh reasons are obj_load()'s (with "line N: " for a line of the OBJ file).
  * An image with a NaN or infinite pixel is refused. Out of memory: RT_ERROR_RUNTIME.
  *
  * On failure the scene keeps what was loaded before the error (and the materials added

@@ -198,7 +198,7 @@ static void test_quad_becomes_two_triangles(void **state)
     assert_int_equal(mesh.material_count, 0);
     assert_int_equal(mesh.triangle_materials[0], -1);
     assert_int_equal(mesh.triangle_materials[1], -1);
-    assert_string_equal(mesh.warning, "");
+    assert_int_equal(mesh.warning_count, 0);
     assert_covers(&mesh, 1.0);
     /* all four corners are used */
     bool used[4] = {false};
@@ -521,7 +521,9 @@ static void test_missing_mtl_still_loads(void **state)
                             "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
                             "f 1 2 3\nusemtl red\nf 1 2 3\n");
     assert_int_equal(mesh.triangle_count, 2);
-    assert_contains(mesh.warning, "nothere.mtl");
+    assert_int_equal(mesh.warning_count, 1);
+    assert_contains(mesh.warnings[0], "cannot read material library '");
+    assert_contains(mesh.warnings[0], "nothere.mtl': No such file or directory; its materials are left out");
     assert_int_equal(mesh.material_count, 1);
     assert_string_equal(mesh.materials[0].name, "red");
     assert_false(mesh.materials[0].defined);
@@ -546,7 +548,97 @@ static void test_missing_mtl_in_a_scene(void **state)
     assert_int_equal(sc.meshes[0].triangle_count, 2);
     assert_int_equal(sc.meshes[0].triangle_materials[0], red);  /* the scene's, by name */
     assert_int_equal(sc.meshes[0].triangle_materials[1], -1);   /* no such material anywhere */
+    /* The warning is the scene's, for the caller to show, prefixed like an error. */
+    assert_int_equal(sc.warning_count, 1);
+    char expected[2048];
+    snprintf(expected, sizeof expected, POSITION ": mesh '%s': cannot read material library '%s/lost.mtl': No such "
+             "file or directory; its materials are left out", path, s->directory);
+    assert_string_equal(sc.warnings[0].message, expected);
+    /* A second call loads nothing again, so it warns nothing again. */
+    load_scene_ok(&sc);
+    assert_int_equal(sc.warning_count, 1);
     scene_free(&sc);
+    assert_int_equal(sc.warning_count, 0);
+    assert_null(sc.warnings);
+}
+
+/* tinyobjloader's own warnings are kept too, with the OBJ file's line numbers, and an MTL
+ * file's name its file; past OBJ_MAX_WARNINGS they are counted. */
+static void test_tinyobjloader_warnings_are_kept(void **state)
+{
+    scratch *s = *state;
+    write_file(s, "both.mtl", "newmtl glass\nKd 1 1 1\nd 0.5\nTr 0.2\n");
+    obj_mesh mesh = load_ok(s, "warn.obj",
+                            "mtllib both.mtl\n"
+                            "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                            "g \n"
+                            "usemtl glass\nf 1 2 3\n");
+    assert_int_equal(mesh.warning_count, 2);
+    char expected[2048];
+    snprintf(expected, sizeof expected, "tinyobjloader, in '%s/both.mtl': Both `d` and `Tr` parameters defined for "
+             "\"glass\"", s->directory);
+    assert_contains(mesh.warnings[0], expected);
+    assert_contains(mesh.warnings[0], "(line 4 in .mtl");
+    assert_string_equal(mesh.warnings[1], "tinyobjloader: Empty group name. line: 5");
+    obj_mesh_free(&mesh);
+    assert_int_equal(mesh.warning_count, 0);
+
+    /* Ten missing MTL files: eight warnings kept, ten counted; the scene says so. */
+    const char *path = write_file(s, "many.obj",
+                                  "mtllib a0.mtl a1.mtl a2.mtl a3.mtl a4.mtl a5.mtl a6.mtl a7.mtl a8.mtl a9.mtl\n"
+                                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    mesh = load_ok(s, "many.obj",
+                   "mtllib a0.mtl a1.mtl a2.mtl a3.mtl a4.mtl a5.mtl a6.mtl a7.mtl a8.mtl a9.mtl\n"
+                   "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert_int_equal(mesh.warning_count, 10);
+    assert_contains(mesh.warnings[OBJ_MAX_WARNINGS - 1], "a7.mtl'");
+    obj_mesh_free(&mesh);
+    scene sc;
+    scene_defaults(&sc);
+    add_mesh(&sc, path, -1);
+    load_scene_ok(&sc);
+    assert_int_equal(sc.warning_count, OBJ_MAX_WARNINGS + 1);
+    assert_contains(sc.warnings[0].message, "a0.mtl'");
+    snprintf(expected, sizeof expected, POSITION ": mesh '%s': 2 more warnings left out", path);
+    assert_string_equal(sc.warnings[OBJ_MAX_WARNINGS].message, expected);
+    scene_free(&sc);
+}
+
+/* A volume's boundary must be closed: a mesh of fewer than 4 triangles cannot be. */
+static void test_volume_mesh_too_small_to_close(void **state)
+{
+    scratch *s = *state;
+    static const char *const meshes[2] = {
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        /* a tetrahedron: the smallest closed mesh */
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    };
+    for (int closed = 0; closed < 2; closed++) {
+        const char *path = write_file(s, closed ? "tetrahedron.obj" : "one.obj", meshes[closed]);
+        scene sc;
+        scene_defaults(&sc);
+        int mesh = add_mesh(&sc, path, -1);
+        scene_object object = {.first_shape = 0, .shape_count = 0, .mesh = mesh};
+        scene_instance instance = {.object = scene_add_object(&sc, &object), .material = -1, .volume = true,
+                                   .density = 1, .volume_albedo = {1, 1, 1}};
+        scene_identity_transform(instance.object_to_world);
+        assert_true(scene_add_instance(&sc, &instance) >= 0);
+        rt_error error = {{0}};
+        rt_status status = scene_load_assets(&sc, &error);
+        if (closed) {
+            assert_int_equal(status, RT_OK);
+        } else {
+            assert_int_equal(status, RT_ERROR_INPUT);
+            char expected[2048];
+            snprintf(expected, sizeof expected, POSITION ": mesh '%s' is (part of) a volume's boundary, which must "
+                     "be closed, but it has only 1 triangle: fewer than 4 enclose nothing", path);
+            assert_string_equal(error.message, expected);
+        }
+        /* The same mesh placed as a surface is fine. */
+        sc.instances[0].volume = false;
+        load_scene_ok(&sc);
+        scene_free(&sc);
+    }
 }
 
 static void test_usemtl_names_scene_materials(void **state)
@@ -919,6 +1011,51 @@ static void test_sky_box_faces_must_match(void **state)
     scene_free(&sc);
 }
 
+/* An unreadable face is named as a face too, not only by its file and position. */
+static void test_sky_box_unreadable_face_is_named(void **state)
+{
+    scratch *s = *state;
+    scene sc;
+    make_sky_box(s, &sc, -1, 0, 0);
+    assert_int_equal(remove(in_scratch(s, "ny.png")), 0);
+    rt_error error;
+    assert_int_equal(scene_load_assets(&sc, &error), RT_ERROR_INPUT);
+    char expected[1024];
+    snprintf(expected, sizeof expected, POSITION ": sky box: cannot read the -Y face image '%s': No such file or "
+             "directory", in_scratch(s, "ny.png"));
+    assert_string_equal(error.message, expected);
+    scene_free(&sc);
+
+    /* One file for two faces: both are named. */
+    make_sky_box(s, &sc, -1, 0, 0);
+    assert_int_equal(remove(in_scratch(s, "pz.png")), 0);
+    sc.sky.faces[SKY_FACE_NEGATIVE_Z] = sc.sky.faces[SKY_FACE_POSITIVE_Z];
+    assert_int_equal(scene_load_assets(&sc, &error), RT_ERROR_INPUT);
+    snprintf(expected, sizeof expected, POSITION ": sky box: cannot read the +Z/-Z face image '%s': No such file or "
+             "directory", in_scratch(s, "pz.png"));
+    assert_string_equal(error.message, expected);
+    scene_free(&sc);
+
+    /* A face that is not an image at all. */
+    make_sky_box(s, &sc, -1, 0, 0);
+    write_file(s, "px.png", "not a png");
+    assert_int_equal(scene_load_assets(&sc, &error), RT_ERROR_INPUT);
+    snprintf(expected, sizeof expected, POSITION ": sky box: cannot read the +X face image '%s': ",
+             in_scratch(s, "px.png"));
+    assert_contains(error.message, expected);
+    scene_free(&sc);
+
+    /* The same file as a texture's image, with no sky box: an image, as before. */
+    assert_int_equal(remove(in_scratch(s, "ny.png")), 0);
+    scene_defaults(&sc);
+    add_image(&sc, in_scratch(s, "ny.png"));
+    assert_int_equal(scene_load_assets(&sc, &error), RT_ERROR_INPUT);
+    snprintf(expected, sizeof expected, POSITION ": cannot read image '%s': No such file or directory",
+             in_scratch(s, "ny.png"));
+    assert_string_equal(error.message, expected);
+    scene_free(&sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -938,6 +1075,8 @@ int main(void)
         T(test_missing_and_directory_files),
         T(test_missing_mtl_still_loads),
         T(test_missing_mtl_in_a_scene),
+        T(test_tinyobjloader_warnings_are_kept),
+        T(test_volume_mesh_too_small_to_close),
         T(test_usemtl_names_scene_materials),
         T(test_mtl_materials_become_scene_materials),
         T(test_mtl_non_finite_is_an_error),
@@ -948,6 +1087,7 @@ int main(void)
         T(test_image_errors_carry_the_position),
         T(test_exr_stays_linear),
         T(test_sky_box_faces_must_match),
+        T(test_sky_box_unreadable_face_is_named),
 #undef T
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
