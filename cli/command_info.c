@@ -3,6 +3,7 @@
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "commands.h"
 #include "gpu.h"
@@ -11,7 +12,41 @@
 static void print_help(FILE *stream)
 {
     fprintf(stream, "usage: rtspheres info [--device N]\n"
-                    "  --device N   use EGL device N (0-based, as listed here) instead of choosing\n");
+                    "  --device N   use EGL device N (0-based, as listed under \"EGL devices\") instead of choosing\n");
+}
+
+/* Lists the EGL devices with their numbers (what --device N takes) and what EGL tells of
+ * each, the one used marked with '*'. */
+static void print_devices(const gpu_info *info)
+{
+    if (info->device_count == 0) {
+        printf("EGL devices:      none (no EGL_EXT_platform_device driver; --device cannot be used)\n");
+        return;
+    }
+    printf("EGL devices:      %d (--device N uses device N; %s)\n", info->device_count,
+           info->device_index < 0 ? "none is used: the Mesa surfaceless platform is" : "* marks the one used");
+    for (int i = 0; i < info->device_count; i++) {
+        const gpu_device_description *d = &info->devices[i];
+        char known[1024] = "";
+        size_t used = 0;
+#define KNOWN(...) (used += (size_t)snprintf(known + used, used < sizeof known ? sizeof known - used : 0, __VA_ARGS__))
+        KNOWN("%s", d->software ? "software (EGL_MESA_device_software)" : "hardware");
+        if (d->vendor[0] != '\0')
+            KNOWN(", vendor %s", d->vendor);
+        if (d->renderer[0] != '\0')
+            KNOWN(", renderer %s", d->renderer);
+        if (d->driver[0] != '\0')
+            KNOWN(", driver %s", d->driver);
+        if (d->drm_device_file[0] != '\0')
+            KNOWN(", DRM %s", d->drm_device_file);
+        if (d->drm_render_node[0] != '\0')
+            KNOWN(", render node %s", d->drm_render_node);
+        if (d->software && info->device_index < 0 && strcmp(info->platform, "surfaceless") == 0)
+            KNOWN("; the surfaceless platform (the same llvmpipe) is preferred to it");
+#undef KNOWN
+        printf("  %c device %d:     %s\n", i == info->device_index ? '*' : ' ', i, known);
+        printf("      extensions: %s\n", d->extensions[0] != '\0' ? d->extensions : "(none)");
+    }
 }
 
 int command_info(int argc, char **argv)
@@ -63,6 +98,7 @@ int command_info(int argc, char **argv)
     else
         printf("EGL platform:     %s (Mesa), %d EGL device%s seen\n", info.platform, info.device_count,
                info.device_count == 1 ? "" : "s");
+    print_devices(&info);
     printf("EGL:              %s, %s\n", info.egl_vendor, info.egl_version);
     printf("GL vendor:        %s\n", info.gl_vendor);
     printf("GL renderer:      %s%s\n", info.gl_renderer, info.software ? " (software, on the CPU)" : "");

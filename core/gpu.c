@@ -100,6 +100,41 @@ static void copy_string(char *destination, size_t size, const char *source)
     snprintf(destination, size, "%s", source ? source : "");
 }
 
+/* Device query names newer than some epoxy headers (values from Khronos' eglext.h). */
+#ifndef EGL_DRM_RENDER_NODE_FILE_EXT
+#define EGL_DRM_RENDER_NODE_FILE_EXT 0x3377
+#endif
+#ifndef EGL_DRIVER_NAME_EXT
+#define EGL_DRIVER_NAME_EXT 0x335E
+#endif
+#ifndef EGL_RENDERER_EXT
+#define EGL_RENDERER_EXT 0x335F
+#endif
+
+/* Fills out with what EGL tells about device: its extensions, and each string that one of
+ * them says can be queried (nothing is asked that the device does not offer). */
+static void describe_device(EGLDeviceEXT device, gpu_device_description *out)
+{
+    memset(out, 0, sizeof *out);
+    const char *extensions = eglQueryDeviceStringEXT(device, EGL_EXTENSIONS);
+    copy_string(out->extensions, sizeof out->extensions, extensions);
+    out->software = has_extension(extensions, "EGL_MESA_device_software");
+    if (has_extension(extensions, "EGL_EXT_device_drm"))
+        copy_string(out->drm_device_file, sizeof out->drm_device_file,
+                    eglQueryDeviceStringEXT(device, EGL_DRM_DEVICE_FILE_EXT));
+    if (has_extension(extensions, "EGL_EXT_device_drm_render_node"))
+        copy_string(out->drm_render_node, sizeof out->drm_render_node,
+                    eglQueryDeviceStringEXT(device, EGL_DRM_RENDER_NODE_FILE_EXT));
+    if (has_extension(extensions, "EGL_EXT_device_query_name")) {
+        copy_string(out->vendor, sizeof out->vendor, eglQueryDeviceStringEXT(device, EGL_VENDOR));
+        copy_string(out->renderer, sizeof out->renderer, eglQueryDeviceStringEXT(device, EGL_RENDERER_EXT));
+    }
+    if (has_extension(extensions, "EGL_EXT_device_persistent_id"))
+        copy_string(out->driver, sizeof out->driver, eglQueryDeviceStringEXT(device, EGL_DRIVER_NAME_EXT));
+    /* A failed query of a string the device claims leaves only an EGL error behind. */
+    eglGetError();
+}
+
 static void GLAPIENTRY debug_message_callback(GLenum source, GLenum type, GLuint id, GLenum severity,
                                               GLsizei length, const GLchar *message, const void *user)
 {
@@ -255,19 +290,32 @@ rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *er
     rt_error attempt = {{0}};
     char tried[1024] = "";
 
-    EGLDeviceEXT devices[16];
+    EGLDeviceEXT devices[GPU_MAX_DEVICES];
     EGLint device_count = 0;
-    if (platform_device && !eglQueryDevicesEXT(16, devices, &device_count))
+    if (platform_device && !eglQueryDevicesEXT(GPU_MAX_DEVICES, devices, &device_count))
+        device_count = 0;
+    if (device_count < 0 || device_count > GPU_MAX_DEVICES)
         device_count = 0;
     context->info.device_count = device_count;
+    for (int index = 0; index < device_count; index++)
+        describe_device(devices[index], &context->info.devices[index]);
 
     if (context->options.device > 0) {
+        /* options.device is N + 1 for --device N (0 means "choose"). */
         int index = context->options.device - 1;
         if (index >= device_count) {
             free(context);
-            return rt_error_set(error, RT_ERROR_INPUT, "GPU: --device %d asked for, but there %s %d EGL device%s",
-                                context->options.device, device_count == 1 ? "is" : "are", (int)device_count,
-                                device_count == 1 ? "" : "s");
+            if (device_count == 0)
+                return rt_error_set(error, RT_ERROR_INPUT, "GPU: --device %d asked for, but there are no EGL devices "
+                                    "(%s)", index, platform_surfaceless
+                                        ? "leave --device out to use Mesa's surfaceless platform"
+                                        : "no driver offers EGL_EXT_platform_device");
+            if (device_count == 1)
+                return rt_error_set(error, RT_ERROR_INPUT, "GPU: --device %d asked for, but there is 1 EGL device "
+                                    "(device 0; `rtspheres info` lists it)", index);
+            return rt_error_set(error, RT_ERROR_INPUT, "GPU: --device %d asked for, but there are %d EGL devices "
+                                "(devices 0 to %d; `rtspheres info` lists them)", index, (int)device_count,
+                                (int)device_count - 1);
         }
         EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[index], NULL);
         char what[64];
@@ -278,13 +326,15 @@ rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *er
         if (status == RT_OK) {
             context->info.device_index = index;
             copy_string(context->info.platform, sizeof context->info.platform, "device");
+            copy_string(context->info.device_extensions, sizeof context->info.device_extensions,
+                        context->info.devices[index].extensions);
         }
     } else {
         /* Hardware devices first: a device without EGL_MESA_device_software is a real GPU. */
         for (int pass = 0; pass < 2 && status != RT_OK; pass++) {
             for (int index = 0; index < device_count && status != RT_OK; index++) {
-                const char *device_extensions = eglQueryDeviceStringEXT(devices[index], EGL_EXTENSIONS);
-                bool software = has_extension(device_extensions, "EGL_MESA_device_software");
+                const char *device_extensions = context->info.devices[index].extensions;
+                bool software = context->info.devices[index].software;
                 if (software != (pass == 1))
                     continue;
                 /* Mesa's software device is the same llvmpipe as the surfaceless platform;

@@ -30,10 +30,27 @@ typedef struct gpu_options {
     void *log_context;
 } gpu_options;
 
+/* The EGL devices of EGL_EXT_device_enumeration are listed (at most GPU_MAX_DEVICES), in
+ * EGL's order: --device N and gpu_options.device N + 1 pick devices[N]. */
+#define GPU_MAX_DEVICES 16
+
+/* What EGL tells about one device without opening it; "" where its driver does not say. */
+typedef struct gpu_device_description {
+    char extensions[512];        /* its EGL_EXTENSIONS, which name the driver's kind
+                                  * (EGL_MESA_device_software, EGL_EXT_device_drm, ...) */
+    bool software;               /* EGL_MESA_device_software: a CPU rasteriser (llvmpipe) */
+    char drm_device_file[128];   /* EGL_EXT_device_drm: e.g. "/dev/dri/card0" */
+    char drm_render_node[128];   /* EGL_EXT_device_drm_render_node: e.g. "/dev/dri/renderD128" */
+    char vendor[128];            /* EGL_EXT_device_query_name: EGL_VENDOR of the device */
+    char renderer[128];          /* EGL_EXT_device_query_name: EGL_RENDERER_EXT */
+    char driver[128];            /* EGL_EXT_device_persistent_id: EGL_DRIVER_NAME_EXT */
+} gpu_device_description;
+
 typedef struct gpu_info {
     char platform[64];           /* "device" or "surfaceless" */
     int device_index;            /* EGL device used (0-based), -1 for surfaceless */
-    int device_count;            /* EGL devices seen */
+    int device_count;            /* EGL devices seen (at most GPU_MAX_DEVICES) */
+    gpu_device_description devices[GPU_MAX_DEVICES];   /* devices[0 .. device_count - 1] */
     char device_extensions[512]; /* of the chosen device, "" for surfaceless */
     char egl_vendor[128], egl_version[128];
     char gl_vendor[128], gl_renderer[256], gl_version[128], glsl_version[128];
