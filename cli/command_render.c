@@ -817,6 +817,10 @@ static int render_frame(gpu_context *context, const render_request *request, int
         fprintf(stderr, "%s\n", error.message);
         return exit_code_for_status(status);
     }
+    /* Asset warnings (a missing MTL file, ...): once, with the first frame. */
+    bool first_frame = frame < 0 || frame == request->frames.frames[0];
+    for (int i = 0; i < s.warning_count && first_frame && !request->quiet; i++)
+        fprintf(stderr, "rtspheres render: warning: %s\n", s.warnings[i].message);
     if (request->spp) s.render.samples_per_pixel = (int)request->spp;
     if (request->width) { s.render.width = (int)request->width; s.render.height = (int)request->height; }
     if (request->max_depth) s.render.max_depth = (int)request->max_depth;

@@ -499,7 +499,7 @@ static GLuint build_tracer_program(const char *defines, rt_error *error)
 static void variant_defines(uint32_t omitted, int integrator, int sky_type, char *defines, size_t size)
 {
     static const char *const names[] = {"DIRECT_LIGHT", "VOLUMES", "TEXTURES", "SPHERES", "MOVING_SPHERES",
-                                        "FLAT", "INSTANCES", "EMITTERS"};
+                                        "TRIANGLES", "INSTANCES", "EMITTERS", "QUADS"};
     size_t used = 0;
     defines[0] = '\0';
     for (unsigned bit = 0; bit < sizeof names / sizeof names[0]; bit++)

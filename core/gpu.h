@@ -100,9 +100,10 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_TEXTURES        no texture and no normal map on any material
  *   GPU_OMIT_SPHERES         no sphere (moving or not) in any BVH
  *   GPU_OMIT_MOVING_SPHERES  no moving sphere
- *   GPU_OMIT_FLAT            no triangle and no quad
+ *   GPU_OMIT_TRIANGLES       no triangle
  *   GPU_OMIT_INSTANCES       no instance record: one BVH level
  *   GPU_OMIT_EMITTERS        no emissive material
+ *   GPU_OMIT_QUADS           no quad
  *   GPU_FIX_UNIFORMS         the integrator and the sky type compiled in as constants
  *                            (the values in the parameters), not read from uniforms */
 #define GPU_OMIT_DIRECT_LIGHT (1u << 0)
@@ -110,11 +111,12 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_TEXTURES (1u << 2)
 #define GPU_OMIT_SPHERES (1u << 3)
 #define GPU_OMIT_MOVING_SPHERES (1u << 4)
-#define GPU_OMIT_FLAT (1u << 5)
+#define GPU_OMIT_TRIANGLES (1u << 5)
 #define GPU_OMIT_INSTANCES (1u << 6)
 #define GPU_OMIT_EMITTERS (1u << 7)
-#define GPU_FIX_UNIFORMS (1u << 8)
-#define GPU_VARIANT_BITS 9
+#define GPU_OMIT_QUADS (1u << 8)
+#define GPU_FIX_UNIFORMS (1u << 9)
+#define GPU_VARIANT_BITS 10
 
 /* Per-render parameters of the tracer shader. Vectors are world space. */
 typedef struct gpu_tracer_parameters {

@@ -42,9 +42,8 @@ typedef struct pending_primitive {
     uint32_t type;
     uint32_t material;           /* PACKED_NONE: the instance's */
     uint32_t instance;           /* PRIMITIVE_INSTANCE */
-    int32_t mesh, triangle;      /* mesh triangles: where to read attributes; else -1 */
-    int32_t baked_instance;      /* a copy moved into the world by this scene instance's
-                                  * transform (its normals too); -1: as the scene has it */
+    uint32_t vertices[3];        /* triangles: indices into the packer's vertex list */
+    bool has_uvs;                /* triangles: the vertices carry uvs */
     float data[3][4];
     bvh_box box;
 } pending_primitive;
@@ -53,6 +52,37 @@ typedef struct primitive_list {
     pending_primitive *items;
     uint32_t count, capacity;
 } primitive_list;
+
+/* A triangle vertex on its way into the vertex section. */
+typedef struct pending_vertex {
+    float position[3];
+    float normal[3];
+    bool has_normal;
+    float uv[2];
+} pending_vertex;
+
+typedef struct vertex_list {
+    pending_vertex *items;
+    uint32_t count, capacity;
+} vertex_list;
+
+/* Appends a zeroed vertex; returns its index, or UINT32_MAX when memory runs out or the
+ * list would pass 32-bit indices. */
+static uint32_t vertex_push(vertex_list *list)
+{
+    if (list->count == list->capacity) {
+        if (list->capacity >= UINT32_MAX / 4)
+            return UINT32_MAX;
+        uint32_t capacity = list->capacity ? list->capacity * 2 : 256;
+        pending_vertex *grown = realloc(list->items, (size_t)capacity * sizeof *grown);
+        if (grown == NULL)
+            return UINT32_MAX;
+        list->items = grown;
+        list->capacity = capacity;
+    }
+    memset(&list->items[list->count], 0, sizeof list->items[0]);
+    return list->count++;
+}
 
 /* Appends an item; returns a pointer to it, or NULL when memory runs out. */
 static pending_primitive *list_push(primitive_list *list)
@@ -67,8 +97,6 @@ static pending_primitive *list_push(primitive_list *list)
     }
     pending_primitive *item = &list->items[list->count++];
     memset(item, 0, sizeof *item);
-    item->mesh = item->triangle = -1;
-    item->baked_instance = -1;
     item->material = PACKED_NONE;
     item->instance = PACKED_NONE;
     return item;
@@ -171,23 +199,6 @@ static void transform_shape(scene_shape *shape, const float m[3][4], float scale
     shape->radius *= scale;
 }
 
-/* Fills item from triangle t of a loaded mesh, moved by transform when it is not NULL. */
-static void pending_from_triangle(pending_primitive *item, const scene_mesh *mesh, int mesh_index, int t,
-                                  const float (*transform)[4])
-{
-    scene_shape shape = {.type = SHAPE_TRIANGLE};
-    for (int k = 0; k < 3; k++)
-        memcpy(shape.points[k], mesh->positions + 3 * (size_t)mesh->indices[3 * (size_t)t + k], 3 * sizeof(float));
-    if (transform != NULL)
-        transform_shape(&shape, transform, 1.0f);
-    int material = mesh->triangle_materials ? mesh->triangle_materials[t] : -1;
-    pending_from_shape(item, &shape, material >= 0 ? (uint32_t)material : PACKED_NONE);
-    if (mesh->normals != NULL || mesh->uvs != NULL) {
-        item->mesh = mesh_index;
-        item->triangle = t;
-    }
-}
-
 /* ---- transforms ---------------------------------------------------------------------- */
 
 /* Inverts the affine 3x4 matrix m into inverse. Returns false when it is singular. */
@@ -285,39 +296,6 @@ static void put_texel(uint32_t *texels, uint64_t index, uint32_t x, uint32_t y, 
     texels[4 * index + 3] = w;
 }
 
-/* The attribute record of a mesh triangle: vertex normals and uvs (zero where absent).
- * normal_transform, when not NULL, is the inverse of the placement that baked the
- * triangle into the world: normals move by its transpose, as the shader moves an
- * instance's normals (and, being linear, interpolate to the same shading normal). */
-static void write_attributes(uint32_t *texels, uint64_t base, const scene_mesh *mesh, int t,
-                             const float (*normal_transform)[4])
-{
-    float n[3][3] = {{0}}, uv[3][2] = {{0}};
-    uint32_t flags = 0;
-    for (int k = 0; k < 3; k++) {
-        uint32_t v = mesh->indices[3 * (size_t)t + k];
-        if (mesh->normals) {
-            memcpy(n[k], mesh->normals + 3 * (size_t)v, 3 * sizeof(float));
-            if (normal_transform != NULL) {
-                float moved[3];
-                for (int c = 0; c < 3; c++)
-                    moved[c] = normal_transform[0][c] * n[k][0] + normal_transform[1][c] * n[k][1]
-                               + normal_transform[2][c] * n[k][2];
-                memcpy(n[k], moved, sizeof moved);
-            }
-            flags |= ATTRIBUTE_HAS_NORMALS;
-        }
-        if (mesh->uvs) {
-            memcpy(uv[k], mesh->uvs + 2 * (size_t)v, 2 * sizeof(float));
-            flags |= ATTRIBUTE_HAS_UVS;
-        }
-    }
-    put_texel(texels, base + 0, float_bits(n[0][0]), float_bits(n[0][1]), float_bits(n[0][2]), float_bits(uv[0][0]));
-    put_texel(texels, base + 1, float_bits(n[1][0]), float_bits(n[1][1]), float_bits(n[1][2]), float_bits(uv[0][1]));
-    put_texel(texels, base + 2, float_bits(n[2][0]), float_bits(n[2][1]), float_bits(n[2][2]), float_bits(uv[1][0]));
-    put_texel(texels, base + 3, float_bits(uv[1][1]), float_bits(uv[2][0]), float_bits(uv[2][1]), flags);
-}
-
 /* ---- the whole scene ----------------------------------------------------------------- */
 
 typedef struct packer {
@@ -328,8 +306,87 @@ typedef struct packer {
     bool *object_needed;
     uint32_t *instance_of_scene; /* scene instance -> packed instance index or PACKED_NONE */
     uint32_t packed_instances;
+    vertex_list vertices;        /* every triangle's vertices, in the order they are stored */
+    uint32_t *mesh_first_vertex; /* per mesh: where its untransformed vertices start, or
+                                  * UINT32_MAX before a triangle needs them */
+    uint32_t *vertex_order;      /* vertex list index -> stored index (UINT32_MAX: unused) */
     packed_scene *out;
 } packer;
+
+/* Appends the vertices of a mesh to the packer's list, moved by transform when it is not
+ * NULL (normals by the inverse transpose, so that they interpolate to the normal the
+ * shader would compute for the placed mesh). Returns the index of the first one in
+ * *first, or an error. */
+static rt_status add_mesh_vertices(packer *p, const scene_mesh *mesh, const float (*transform)[4], uint32_t *first,
+                                   rt_error *error)
+{
+    float inverse[3][4];
+    if (transform != NULL && !invert_affine(transform, inverse))
+        return rt_error_set(error, RT_ERROR_INPUT, "PACK: a placement of mesh '%s' cannot be inverted", mesh->path);
+    *first = p->vertices.count;
+    for (int v = 0; v < mesh->vertex_count; v++) {
+        uint32_t index = vertex_push(&p->vertices);
+        if (index == UINT32_MAX)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory for the vertices of '%s'", mesh->path);
+        pending_vertex *vertex = &p->vertices.items[index];
+        const float *position = mesh->positions + 3 * (size_t)v;
+        for (int r = 0; r < 3; r++)
+            vertex->position[r] = transform == NULL ? position[r]
+                                                    : transform[r][0] * position[0] + transform[r][1] * position[1]
+                                                          + transform[r][2] * position[2] + transform[r][3];
+        if (mesh->normals != NULL) {
+            const float *normal = mesh->normals + 3 * (size_t)v;
+            for (int c = 0; c < 3; c++)
+                vertex->normal[c] = transform == NULL ? normal[c]
+                                                      : inverse[0][c] * normal[0] + inverse[1][c] * normal[1]
+                                                            + inverse[2][c] * normal[2];
+            vertex->has_normal = dot3(vertex->normal, vertex->normal) > 0;
+        }
+        if (mesh->uvs != NULL)
+            memcpy(vertex->uv, mesh->uvs + 2 * (size_t)v, sizeof vertex->uv);
+    }
+    return RT_OK;
+}
+
+/* Fills item from triangle t of a loaded mesh whose vertices start at first_vertex in
+ * the packer's list (moved there already when the placement is baked). */
+static void pending_from_triangle(packer *p, pending_primitive *item, const scene_mesh *mesh, int t,
+                                  uint32_t first_vertex)
+{
+    scene_shape shape = {.type = SHAPE_TRIANGLE};
+    for (int k = 0; k < 3; k++) {
+        item->vertices[k] = first_vertex + mesh->indices[3 * (size_t)t + k];
+        memcpy(shape.points[k], p->vertices.items[item->vertices[k]].position, 3 * sizeof(float));
+    }
+    int material = mesh->triangle_materials ? mesh->triangle_materials[t] : -1;
+    uint32_t vertices[3];
+    memcpy(vertices, item->vertices, sizeof vertices);
+    pending_from_shape(item, &shape, material >= 0 ? (uint32_t)material : PACKED_NONE);
+    memcpy(item->vertices, vertices, sizeof vertices);
+    item->has_uvs = mesh->uvs != NULL;
+}
+
+/* Gives a triangle shape (not of a mesh) its three vertices in the packer's list, with
+ * its corner normals and uvs when it has them. */
+static rt_status add_shape_vertices(packer *p, pending_primitive *item, const scene_shape *shape, rt_error *error)
+{
+    for (int k = 0; k < 3; k++) {
+        uint32_t index = vertex_push(&p->vertices);
+        if (index == UINT32_MAX)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory for triangle vertices");
+        pending_vertex *vertex = &p->vertices.items[index];
+        memcpy(vertex->position, shape->points[k], 3 * sizeof(float));
+        if (shape->has_normals) {
+            memcpy(vertex->normal, shape->normals[k], 3 * sizeof(float));
+            vertex->has_normal = dot3(vertex->normal, vertex->normal) > 0;
+        }
+        if (shape->has_uvs)
+            memcpy(vertex->uv, shape->uvs[k], 2 * sizeof(float));
+        item->vertices[k] = index;
+    }
+    item->has_uvs = shape->has_uvs;
+    return RT_OK;
+}
 
 /* Resolves a shape's material against an instance override: the shape's own, else the
  * override, else PACKED_NONE (the shader then uses the instance's or the default). */
@@ -357,26 +414,54 @@ static rt_status add_object_primitives(packer *p, int index, int override, primi
         const scene_mesh *mesh = &s->meshes[object->mesh];
         if (mesh->positions == NULL && mesh->triangle_count > 0)
             return rt_error_set(error, RT_ERROR_INPUT, "PACK: mesh '%s' was not loaded", mesh->path);
+        /* Untransformed vertices are shared by every use of the mesh; a baked placement
+         * gets its own, moved. */
+        uint32_t first = 0;
+        if (transform == NULL && p->mesh_first_vertex[object->mesh] != UINT32_MAX) {
+            first = p->mesh_first_vertex[object->mesh];
+        } else {
+            rt_status status = add_mesh_vertices(p, mesh, transform, &first, error);
+            if (status != RT_OK)
+                return status;
+            if (transform == NULL)
+                p->mesh_first_vertex[object->mesh] = first;
+        }
         for (int t = 0; t < mesh->triangle_count; t++) {
             pending_primitive *item = list_push(list);
             if (item == NULL)
                 return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
-            pending_from_triangle(item, mesh, object->mesh, t, transform);
-            item->baked_instance = baked_instance;
+            pending_from_triangle(p, item, mesh, t, first);
             if (item->material == PACKED_NONE && override >= 0)
                 item->material = (uint32_t)override;
         }
         return RT_OK;
     }
+    float inverse[3][4];
+    if (transform != NULL && !invert_affine(transform, inverse))
+        return rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d has a transform that cannot be inverted",
+                            baked_instance);
     for (int k = 0; k < object->shape_count; k++) {
         scene_shape shape = s->shapes[object->first_shape + k];
-        if (transform != NULL)
+        if (transform != NULL) {
             transform_shape(&shape, transform, scale);
+            /* Corner normals move by the inverse transpose, as a mesh's do. */
+            for (int corner = 0; corner < 3 && shape.has_normals; corner++) {
+                float moved[3];
+                for (int c = 0; c < 3; c++)
+                    moved[c] = inverse[0][c] * shape.normals[corner][0] + inverse[1][c] * shape.normals[corner][1]
+                               + inverse[2][c] * shape.normals[corner][2];
+                memcpy(shape.normals[corner], moved, sizeof moved);
+            }
+        }
         pending_primitive *item = list_push(list);
         if (item == NULL)
             return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
         pending_from_shape(item, &shape, resolve_material(shape.material, override));
-        item->baked_instance = baked_instance;
+        if (shape.type == SHAPE_TRIANGLE) {
+            rt_status status = add_shape_vertices(p, item, &shape, error);
+            if (status != RT_OK)
+                return status;
+        }
     }
     return RT_OK;
 }
@@ -467,7 +552,11 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     p.objects = calloc((size_t)s->object_count + 1, sizeof *p.objects);
     p.object_needed = calloc((size_t)s->object_count + 1, sizeof *p.object_needed);
     p.instance_of_scene = calloc((size_t)s->instance_count + 1, sizeof *p.instance_of_scene);
-    if (p.objects == NULL || p.object_needed == NULL || p.instance_of_scene == NULL) {
+    p.mesh_first_vertex = malloc(((size_t)s->mesh_count + 1) * sizeof *p.mesh_first_vertex);
+    if (p.mesh_first_vertex != NULL)
+        for (int m = 0; m < s->mesh_count; m++)
+            p.mesh_first_vertex[m] = UINT32_MAX;
+    if (p.objects == NULL || p.object_needed == NULL || p.instance_of_scene == NULL || p.mesh_first_vertex == NULL) {
         status = rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
         goto done;
     }
@@ -509,28 +598,65 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     /* Where everything goes: top level first (root node 0), then each object's BVH. */
     uint64_t node_count = p.top.primitives.count ? p.top.tree.node_count : 0;
     uint64_t primitive_count = p.top.primitives.count;
-    uint64_t attribute_count = 0;
-    for (uint32_t k = 0; k < p.top.primitives.count; k++)
-        attribute_count += p.top.primitives.items[k].mesh >= 0;
-    for (int o = 0; o < s->object_count; o++) {
-        if (!p.object_needed[o])
+    uint64_t shape_texels = 0;
+    for (int o = -1; o < s->object_count; o++) {
+        built_tree *built = o < 0 ? &p.top : &p.objects[o];
+        if (o >= 0 && !p.object_needed[o])
             continue;
-        p.objects[o].node_base = (uint32_t)node_count;
-        p.objects[o].primitive_base = (uint32_t)primitive_count;
-        node_count += p.objects[o].tree.node_count;
-        primitive_count += p.objects[o].primitives.count;
-        for (uint32_t k = 0; k < p.objects[o].primitives.count; k++)
-            attribute_count += p.objects[o].primitives.items[k].mesh >= 0;
+        if (o >= 0) {
+            built->node_base = (uint32_t)node_count;
+            built->primitive_base = (uint32_t)primitive_count;
+            node_count += built->tree.node_count;
+            primitive_count += built->primitives.count;
+        }
+        for (uint32_t k = 0; k < built->primitives.count; k++) {
+            uint32_t type = built->primitives.items[k].type;
+            shape_texels += type == PRIMITIVE_MOVING_SPHERE ? PACKED_MOVING_SPHERE_TEXELS
+                            : type == PRIMITIVE_QUAD        ? PACKED_QUAD_TEXELS
+                                                            : 0;
+        }
+    }
+    /* Vertices are stored in the order the triangles, in leaf order, first use them: a
+     * leaf's triangles then read neighbouring vertex texels (the 1.3M-triangle mesh
+     * traced about 1.3x slower with the loader's vertex order). Unused ones are dropped. */
+    p.vertex_order = malloc(((size_t)p.vertices.count + 1) * sizeof *p.vertex_order);
+    if (p.vertex_order == NULL) {
+        status = rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+        goto done;
+    }
+    for (uint32_t v = 0; v < p.vertices.count; v++)
+        p.vertex_order[v] = UINT32_MAX;
+    uint32_t vertex_count = 0;
+    for (int o = -1; o < s->object_count; o++) {
+        built_tree *built = o < 0 ? &p.top : &p.objects[o];
+        if (o >= 0 && !p.object_needed[o])
+            continue;
+        for (uint32_t slot = 0; slot < built->primitives.count; slot++) {
+            const pending_primitive *item = &built->primitives.items[built->tree.primitive_indices[slot]];
+            if (item->type != PRIMITIVE_TRIANGLE)
+                continue;
+            for (int k = 0; k < 3; k++)
+                if (p.vertex_order[item->vertices[k]] == UINT32_MAX)
+                    p.vertex_order[item->vertices[k]] = vertex_count++;
+        }
     }
     uint64_t image_pixels = 0;
     for (int i = 0; i < s->image_count; i++)
         image_pixels += (uint64_t)s->images[i].width * s->images[i].height;
 
     uint64_t material_count = (uint64_t)s->material_count + 1;
+    if (material_count >= PRIMITIVE_NO_MATERIAL) {
+        status = rt_error_set(error, RT_ERROR_INPUT, "PACK: %d materials, more than the %d a primitive can name",
+                              s->material_count, PRIMITIVE_NO_MATERIAL - 1);
+        goto done;
+    }
     uint64_t material_offset = PACKED_HEADER_TEXELS;
     uint64_t primitive_offset = material_offset + material_count * PACKED_MATERIAL_STRIDE;
-    uint64_t attribute_offset = primitive_offset + primitive_count * PACKED_PRIMITIVE_STRIDE;
-    uint64_t node_offset = attribute_offset + attribute_count * PACKED_ATTRIBUTE_STRIDE;
+    uint64_t info_offset = primitive_offset + primitive_count * PACKED_PRIMITIVE_STRIDE;
+    uint64_t shape_offset = info_offset + (primitive_count + 3) / 4;
+    uint64_t vertex_offset = shape_offset + shape_texels;
+    uint64_t uv_offset = vertex_offset + vertex_count;
+    uint64_t node_offset = uv_offset + (vertex_count + 1) / 2;
     uint64_t instance_offset = node_offset + node_count * PACKED_NODE_STRIDE;
     uint64_t texture_offset = instance_offset + (uint64_t)p.packed_instances * PACKED_INSTANCE_STRIDE;
     uint64_t image_offset = texture_offset + (uint64_t)s->texture_count * PACKED_TEXTURE_STRIDE;
@@ -546,6 +672,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             && s->materials[material].type == MATERIAL_EMISSIVE)
             light_count++;
     }
+    uint32_t area_light_count = light_count;
     light_count += (uint32_t)s->light_count;
     /* An equirectangular environment is a light too, importance-sampled by luminance. */
     const scene_image *environment = NULL;
@@ -576,10 +703,11 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     put_texel(texels, 0, PACKED_MAGIC, PACKED_LAYOUT_VERSION, (uint32_t)material_offset, (uint32_t)material_count);
     put_texel(texels, 1, (uint32_t)primitive_offset, (uint32_t)primitive_count, (uint32_t)node_offset,
               (uint32_t)node_count);
-    put_texel(texels, 2, (uint32_t)instance_offset, p.packed_instances, (uint32_t)attribute_offset, default_material);
+    put_texel(texels, 2, (uint32_t)instance_offset, p.packed_instances, (uint32_t)info_offset, default_material);
     put_texel(texels, 3, (uint32_t)texture_offset, (uint32_t)s->texture_count, (uint32_t)image_offset,
               (uint32_t)s->image_count);
-    put_texel(texels, 4, (uint32_t)light_offset, light_count, (uint32_t)environment_offset, 0);
+    put_texel(texels, 4, (uint32_t)light_offset, light_count, (uint32_t)environment_offset, area_light_count);
+    put_texel(texels, 5, (uint32_t)shape_offset, (uint32_t)vertex_offset, (uint32_t)uv_offset, (uint32_t)vertex_count);
 
     /* Materials, and the default grey one last. */
     for (uint64_t i = 0; i < material_count; i++) {
@@ -610,8 +738,8 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
                   float_bits(specular[0]), float_bits(specular[1]), float_bits(specular[2]));
     }
 
-    /* Primitives, attributes and nodes of every BVH. */
-    uint64_t next_attribute = 0;
+    /* Primitives (record and info), their shape records, and the nodes of every BVH. */
+    uint64_t next_shape = shape_offset;
     built_tree *trees[1] = {&p.top};
     for (int o = -1; o < s->object_count; o++) {
         built_tree *built = o < 0 ? trees[0] : &p.objects[o];
@@ -621,21 +749,33 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             continue;
         for (uint32_t slot = 0; slot < built->primitives.count; slot++) {
             const pending_primitive *item = &built->primitives.items[built->tree.primitive_indices[slot]];
-            uint64_t base = primitive_offset + ((uint64_t)built->primitive_base + slot) * PACKED_PRIMITIVE_STRIDE;
-            uint32_t attribute = PACKED_NONE;
-            if (item->mesh >= 0) {
-                attribute = (uint32_t)next_attribute;
-                float inverse[3][4];
-                bool baked = item->baked_instance >= 0
-                             && invert_affine(s->instances[item->baked_instance].object_to_world, inverse);
-                write_attributes(texels, attribute_offset + next_attribute * PACKED_ATTRIBUTE_STRIDE,
-                                 &s->meshes[item->mesh], item->triangle, baked ? (const float (*)[4])inverse : NULL);
-                next_attribute++;
+            uint64_t global_slot = (uint64_t)built->primitive_base + slot;
+            uint64_t base = primitive_offset + global_slot * PACKED_PRIMITIVE_STRIDE;
+            const float (*d)[4] = item->data;
+            switch (item->type) {
+            case PRIMITIVE_SPHERE:
+                put_texel(texels, base, float_bits(d[0][0]), float_bits(d[0][1]), float_bits(d[0][2]),
+                          float_bits(d[0][3]));
+                break;
+            case PRIMITIVE_TRIANGLE:
+                put_texel(texels, base, p.vertex_order[item->vertices[0]], p.vertex_order[item->vertices[1]],
+                          p.vertex_order[item->vertices[2]], PRIMITIVE_RECORD_TAG + PRIMITIVE_TRIANGLE);
+                break;
+            case PRIMITIVE_INSTANCE:
+                put_texel(texels, base, item->instance, 0, 0, PRIMITIVE_RECORD_TAG + PRIMITIVE_INSTANCE);
+                break;
+            default: { /* moving sphere, quad: the record points at its shape texels */
+                int count = item->type == PRIMITIVE_QUAD ? PACKED_QUAD_TEXELS : PACKED_MOVING_SPHERE_TEXELS;
+                put_texel(texels, base, (uint32_t)next_shape, 0, 0, PRIMITIVE_RECORD_TAG + item->type);
+                for (int k = 0; k < count; k++)
+                    put_texel(texels, next_shape + k, float_bits(d[k][0]), float_bits(d[k][1]), float_bits(d[k][2]),
+                              float_bits(d[k][3]));
+                next_shape += count;
             }
-            put_texel(texels, base, item->type, item->material, attribute, item->instance);
-            for (int k = 0; k < 3; k++)
-                put_texel(texels, base + 1 + k, float_bits(item->data[k][0]), float_bits(item->data[k][1]),
-                          float_bits(item->data[k][2]), float_bits(item->data[k][3]));
+            }
+            uint32_t material = item->material == PACKED_NONE ? PRIMITIVE_NO_MATERIAL : item->material;
+            texels[4 * (info_offset + global_slot / 4) + global_slot % 4] =
+                item->type << PRIMITIVE_INFO_TYPE_SHIFT | (item->has_uvs ? PRIMITIVE_INFO_HAS_UVS : 0) | material;
             out->triangle_count += item->type == PRIMITIVE_TRIANGLE;
         }
         for (uint32_t n = 0; n < built->tree.node_count; n++) {
@@ -647,6 +787,19 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             put_texel(texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
                       float_bits(node->box.max[2]), node->count);
         }
+    }
+
+    /* Vertices: position and octahedron-encoded normal; uvs two to a texel. */
+    for (uint32_t old = 0; old < p.vertices.count; old++) {
+        uint32_t v = p.vertex_order[old];
+        if (v == UINT32_MAX)
+            continue;
+        const pending_vertex *vertex = &p.vertices.items[old];
+        put_texel(texels, vertex_offset + v, float_bits(vertex->position[0]), float_bits(vertex->position[1]),
+                  float_bits(vertex->position[2]),
+                  vertex->has_normal ? packed_encode_normal(vertex->normal) : VERTEX_NO_NORMAL);
+        texels[4 * (uv_offset + v / 2) + 2 * (v % 2)] = float_bits(vertex->uv[0]);
+        texels[4 * (uv_offset + v / 2) + 2 * (v % 2) + 1] = float_bits(vertex->uv[1]);
     }
 
     /* Lights, chosen by power: emission luminance x area (x pi for the cosine lobe). */
@@ -682,9 +835,9 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
             /* A light of no power is still listed (for MIS weights) but never chosen. */
             total += power[light];
             uint64_t base = light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
+            /* Slots ascend with light: the shader finds a primitive's light by a binary
+             * search of the first area_light_count lights. */
             put_texel(texels, base, type, (uint32_t)slot, 0, 0);
-            /* The primitive learns its light index (texel 0 .w) for MIS weights. */
-            texels[4 * (primitive_offset + (uint64_t)slot * PACKED_PRIMITIVE_STRIDE) + 3] = light;
             light++;
         }
         /* Point, spot and sun lights after the area lights. A sun's power is its
@@ -834,8 +987,13 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     out->default_material = default_material;
     out->primitive_offset = (uint32_t)primitive_offset;
     out->primitive_count = (uint32_t)primitive_count;
-    out->attribute_offset = (uint32_t)attribute_offset;
-    out->attribute_count = (uint32_t)attribute_count;
+    out->info_offset = (uint32_t)info_offset;
+    out->shape_offset = (uint32_t)shape_offset;
+    out->shape_texels = (uint32_t)shape_texels;
+    out->vertex_offset = (uint32_t)vertex_offset;
+    out->vertex_count = (uint32_t)vertex_count;
+    out->uv_offset = (uint32_t)uv_offset;
+    out->area_light_count = area_light_count;
     out->node_offset = (uint32_t)node_offset;
     out->node_count = (uint32_t)node_count;
     out->instance_offset = (uint32_t)instance_offset;
@@ -859,6 +1017,9 @@ done:
     free(p.objects);
     free(p.object_needed);
     free(p.instance_of_scene);
+    free(p.mesh_first_vertex);
+    free(p.vertex_order);
+    free(p.vertices.items);
     if (status != RT_OK) {
         double seconds = out->bvh_build_seconds;
         memset(out, 0, sizeof *out);
@@ -883,18 +1044,94 @@ float packed_float(const packed_scene *packed, uint32_t texel, int component)
     return bits_float(packed_uint(packed, texel, component));
 }
 
+uint32_t packed_encode_normal(const float normal[3])
+{
+    float sum = fabsf(normal[0]) + fabsf(normal[1]) + fabsf(normal[2]);
+    float x = sum > 0 ? normal[0] / sum : 0, y = sum > 0 ? normal[1] / sum : 0;
+    if (sum > 0 && normal[2] < 0) {
+        float folded_x = (1 - fabsf(y)) * (x >= 0 ? 1.0f : -1.0f);
+        y = (1 - fabsf(x)) * (y >= 0 ? 1.0f : -1.0f);
+        x = folded_x;
+    }
+    int16_t qx = (int16_t)lrintf(fmaxf(-1.0f, fminf(1.0f, x)) * 32767.0f);
+    int16_t qy = (int16_t)lrintf(fmaxf(-1.0f, fminf(1.0f, y)) * 32767.0f);
+    return (uint32_t)(uint16_t)qx | (uint32_t)(uint16_t)qy << 16;
+}
+
+void packed_decode_normal(uint32_t bits, float normal[3])
+{
+    /* As GLSL's unpackSnorm2x16, then the octahedron unfolded. */
+    float x = fmaxf(-1.0f, (float)(int16_t)(bits & 0xffffu) / 32767.0f);
+    float y = fmaxf(-1.0f, (float)(int16_t)(bits >> 16) / 32767.0f);
+    float z = 1 - fabsf(x) - fabsf(y);
+    float t = fmaxf(-z, 0.0f);
+    x += x >= 0 ? -t : t;
+    y += y >= 0 ? -t : t;
+    float length = sqrtf(x * x + y * y + z * z);
+    normal[0] = x / length, normal[1] = y / length, normal[2] = z / length;
+}
+
+void packed_vertex_position(const packed_scene *packed, uint32_t vertex, float position[3])
+{
+    for (int i = 0; i < 3; i++)
+        position[i] = packed_float(packed, packed->vertex_offset + vertex, i);
+}
+
+bool packed_vertex_normal(const packed_scene *packed, uint32_t vertex, float normal[3])
+{
+    uint32_t bits = packed_uint(packed, packed->vertex_offset + vertex, 3);
+    if (bits == VERTEX_NO_NORMAL)
+        return false;
+    packed_decode_normal(bits, normal);
+    return true;
+}
+
+uint32_t packed_primitive_type(const packed_scene *packed, uint32_t slot)
+{
+    return packed_uint(packed, packed->info_offset + slot / 4, (int)(slot % 4)) >> PRIMITIVE_INFO_TYPE_SHIFT;
+}
+
 packed_primitive packed_primitive_at(const packed_scene *packed, uint32_t slot)
 {
     uint32_t base = packed->primitive_offset + slot * PACKED_PRIMITIVE_STRIDE;
+    uint32_t info = packed_uint(packed, packed->info_offset + slot / 4, (int)(slot % 4));
+    uint32_t material = info & PRIMITIVE_INFO_MATERIAL_MASK;
     packed_primitive primitive = {
-        .type = packed_uint(packed, base, 0),
-        .material = packed_uint(packed, base, 1),
-        .attribute = packed_uint(packed, base, 2),
-        .instance = packed_uint(packed, base, 3),
+        .type = info >> PRIMITIVE_INFO_TYPE_SHIFT,
+        .material = material == PRIMITIVE_NO_MATERIAL ? PACKED_NONE : material,
+        .has_uvs = (info & PRIMITIVE_INFO_HAS_UVS) != 0,
+        .instance = PACKED_NONE,
+        .vertices = {PACKED_NONE, PACKED_NONE, PACKED_NONE},
     };
-    for (int k = 0; k < 3; k++)
+    switch (primitive.type) {
+    case PRIMITIVE_SPHERE:
         for (int i = 0; i < 4; i++)
-            primitive.data[k][i] = packed_float(packed, base + 1 + k, i);
+            primitive.data[0][i] = packed_float(packed, base, i);
+        break;
+    case PRIMITIVE_TRIANGLE: {
+        float v[3][3];
+        for (int k = 0; k < 3; k++) {
+            primitive.vertices[k] = packed_uint(packed, base, k);
+            packed_vertex_position(packed, primitive.vertices[k], v[k]);
+        }
+        for (int i = 0; i < 3; i++) {
+            primitive.data[0][i] = v[0][i];
+            primitive.data[1][i] = v[1][i] - v[0][i];
+            primitive.data[2][i] = v[2][i] - v[0][i];
+        }
+        break;
+    }
+    case PRIMITIVE_INSTANCE:
+        primitive.instance = packed_uint(packed, base, 0);
+        break;
+    default: {
+        uint32_t shape = packed_uint(packed, base, 0);
+        int count = primitive.type == PRIMITIVE_QUAD ? PACKED_QUAD_TEXELS : PACKED_MOVING_SPHERE_TEXELS;
+        for (int k = 0; k < count; k++)
+            for (int i = 0; i < 4; i++)
+                primitive.data[k][i] = packed_float(packed, shape + k, i);
+    }
+    }
     return primitive;
 }
 

@@ -33,25 +33,33 @@ typedef struct packed_scene {
     uint32_t texel_count;
     uint32_t material_offset, material_count;   /* material_count includes the default */
     uint32_t primitive_offset, primitive_count;
-    uint32_t attribute_offset, attribute_count;
+    uint32_t info_offset;                       /* primitive info, four to a texel */
+    uint32_t shape_offset, shape_texels;        /* moving sphere and quad records */
+    uint32_t vertex_offset, vertex_count;
+    uint32_t uv_offset;                         /* two vertices' uvs to a texel */
     uint32_t node_offset, node_count;
     uint32_t instance_offset, instance_count;
     uint32_t texture_offset, texture_count;
     uint32_t image_offset, image_count;
     uint32_t light_offset, light_count;
+    uint32_t area_light_count;                  /* the first lights: emissive primitives */
     uint32_t default_material;
     uint32_t triangle_count;     /* triangles stored (mesh triangles once per object) */
     int bvh_depth;               /* deepest level of any BVH */
     double bvh_build_seconds;    /* all BVH builds together */
 } packed_scene;
 
-/* A decoded primitive record, for tests and CPU tools. */
+/* A decoded primitive, for tests and CPU tools: its record, info and the geometry they
+ * point to, as the layout of before (one record with the geometry inline). */
 typedef struct packed_primitive {
     uint32_t type;
     uint32_t material;           /* PACKED_NONE: the instance's */
-    uint32_t attribute;          /* PACKED_NONE: none */
+    bool has_uvs;                /* triangles: the vertices carry uvs */
     uint32_t instance;           /* PRIMITIVE_INSTANCE only */
-    float data[3][4];            /* texels 1..3 as floats */
+    uint32_t vertices[3];        /* triangles: vertex indices */
+    float data[3][4];            /* sphere: (centre, radius); moving sphere: (centre at 0,
+                                  * radius), (centre at 1, 0); triangle: (v0, 0), (v1 - v0,
+                                  * 0), (v2 - v0, 0); quad: (Q, 0), (u, 0), (v, 0) */
 } packed_primitive;
 
 /* A nearest hit found by packed_intersect_nearest(). */
@@ -79,6 +87,18 @@ float packed_float(const packed_scene *packed, uint32_t texel, int component);
 
 /* Decodes the primitive in slot (0 .. primitive_count-1). */
 packed_primitive packed_primitive_at(const packed_scene *packed, uint32_t slot);
+
+/* The type tag (PRIMITIVE_*) of the primitive in slot. */
+uint32_t packed_primitive_type(const packed_scene *packed, uint32_t slot);
+
+/* Vertex index's position, and its normal (false when it has none). */
+void packed_vertex_position(const packed_scene *packed, uint32_t vertex, float position[3]);
+bool packed_vertex_normal(const packed_scene *packed, uint32_t vertex, float normal[3]);
+
+/* The octahedral encoding of a unit normal in 32 bits, as the vertex section stores it
+ * (two signed 16-bit fractions, x low), and its decoding (a unit vector). */
+uint32_t packed_encode_normal(const float normal[3]);
+void packed_decode_normal(uint32_t bits, float normal[3]);
 
 /* Nearest hit of a world-space ray (any direction length) at the given time (for moving
  * spheres), walking the packed BVHs exactly as the shader does (nearer child first, into

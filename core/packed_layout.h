@@ -22,8 +22,11 @@
  * Sections (offsets and counts in the header):
  *   header      PACKED_HEADER_TEXELS texels at texel 0
  *   materials   PACKED_MATERIAL_STRIDE texels each
- *   primitives  PACKED_PRIMITIVE_STRIDE texels each, in BVH leaf order per BVH
- *   attributes  PACKED_ATTRIBUTE_STRIDE texels each: per-triangle vertex normals and uvs
+ *   primitives  one texel each, in BVH leaf order per BVH: what a ray test reads first
+ *   info        one uint per primitive, four to a texel: type tag and material
+ *   shapes      the further texels of moving spheres and quads
+ *   vertices    one texel per triangle vertex: position and normal
+ *   uvs         (u, v) per vertex, two vertices to a texel
  *   nodes       PACKED_NODE_STRIDE texels each; the two children of an interior node are
  *               contiguous (left = first, right = first + 1)
  *   instances   PACKED_INSTANCE_STRIDE texels each
@@ -36,12 +39,12 @@
 #define RT_PACKED_LAYOUT_H
 
 /* Bumped whenever a record below changes meaning. */
-#define PACKED_LAYOUT_VERSION 2
+#define PACKED_LAYOUT_VERSION 3
 #define PACKED_NONE 4294967295u
 
-/* ---- header (4 texels), field i is component i % 4 of texel i / 4 */
+/* ---- header (6 texels), field i is component i % 4 of texel i / 4 */
 #define PACKED_MAGIC 1381258067
-#define PACKED_HEADER_TEXELS 5
+#define PACKED_HEADER_TEXELS 6
 #define PACKED_HEADER_MAGIC 0
 #define PACKED_HEADER_VERSION 1
 #define PACKED_HEADER_MATERIAL_OFFSET 2
@@ -52,7 +55,7 @@
 #define PACKED_HEADER_NODE_COUNT 7
 #define PACKED_HEADER_INSTANCE_OFFSET 8
 #define PACKED_HEADER_INSTANCE_COUNT 9
-#define PACKED_HEADER_ATTRIBUTE_OFFSET 10
+#define PACKED_HEADER_INFO_OFFSET 10
 #define PACKED_HEADER_DEFAULT_MATERIAL 11
 #define PACKED_HEADER_TEXTURE_OFFSET 12
 #define PACKED_HEADER_TEXTURE_COUNT 13
@@ -61,6 +64,11 @@
 #define PACKED_HEADER_LIGHT_OFFSET 16
 #define PACKED_HEADER_LIGHT_COUNT 17
 #define PACKED_HEADER_ENVIRONMENT_OFFSET 18
+#define PACKED_HEADER_AREA_LIGHT_COUNT 19
+#define PACKED_HEADER_SHAPE_OFFSET 20
+#define PACKED_HEADER_VERTEX_OFFSET 21
+#define PACKED_HEADER_UV_OFFSET 22
+#define PACKED_HEADER_VERTEX_COUNT 23
 
 /* ---- materials: 4 texels
  *   texel 0 = (type tag, albedo.r, albedo.g, albedo.b)
@@ -75,29 +83,46 @@
 #define MATERIAL_EMISSIVE 3
 #define MATERIAL_TYPE_COUNT 4
 
-/* ---- primitives: 4 texels
- *   texel 0 = (type tag, material index or PACKED_NONE (the instance's), attribute record
- *              index or PACKED_NONE, instance index for PRIMITIVE_INSTANCE, else the light
- *              index of an emissive world primitive or PACKED_NONE)
- *   sphere:         texel 1 = (centre.xyz, radius)
- *   moving sphere:  texel 1 = (centre at time 0 .xyz, radius), texel 2 = (centre at time 1 .xyz, 0)
- *   triangle:       texel 1 = (v0.xyz, 0), texel 2 = (v1 - v0 .xyz, 0), texel 3 = (v2 - v0 .xyz, 0)
- *   quad:           texel 1 = (corner Q.xyz, 0), texel 2 = (edge u.xyz, 0), texel 3 = (edge v.xyz, 0)
- *   instance:       (only in top-level leaves) texel 0 .w = instance index */
-#define PACKED_PRIMITIVE_STRIDE 4
+/* ---- primitives: one texel each (a leaf's primitives are contiguous)
+ *   sphere:         (centre.xyz, radius)
+ *   moving sphere:  (first texel of its shape record, 0, 0, tag); the record is 2 texels:
+ *                   (centre at time 0 .xyz, radius), (centre at time 1 .xyz, 0)
+ *   triangle:       (vertex 0, vertex 1, vertex 2, tag): indices into the vertex section
+ *   quad:           (first texel of its shape record, 0, 0, tag); the record is 3 texels:
+ *                   (corner Q.xyz, 0), (edge u.xyz, 0), (edge v.xyz, 0)
+ *   instance:       (instance index, 0, 0, tag)   (only in top-level leaves)
+ * tag = PRIMITIVE_RECORD_TAG + type tag: no sphere's w (a positive float's bits, below
+ * 2139095040) is that large, so a ray test reads the type from the record itself.
+ * The emissive world primitives are the first PACKED_HEADER_AREA_LIGHT_COUNT lights, in
+ * primitive order: a primitive's light is found by a binary search over them. */
+#define PACKED_PRIMITIVE_STRIDE 1
 #define PRIMITIVE_SPHERE 0
 #define PRIMITIVE_MOVING_SPHERE 1
 #define PRIMITIVE_TRIANGLE 2
 #define PRIMITIVE_QUAD 3
 #define PRIMITIVE_INSTANCE 4
 #define PRIMITIVE_TYPE_COUNT 5
+#define PRIMITIVE_RECORD_TAG 4294967280u
+#define PACKED_MOVING_SPHERE_TEXELS 2
+#define PACKED_QUAD_TEXELS 3
 
-/* ---- triangle attributes: 4 texels (meshes with normals or uvs)
- *   texel 0 = (n0.xyz, uv0.x)  texel 1 = (n1.xyz, uv0.y)  texel 2 = (n2.xyz, uv1.x)
- *   texel 3 = (uv1.y, uv2.x, uv2.y, flags: ATTRIBUTE_HAS_NORMALS | ATTRIBUTE_HAS_UVS) */
-#define PACKED_ATTRIBUTE_STRIDE 4
-#define ATTRIBUTE_HAS_NORMALS 1
-#define ATTRIBUTE_HAS_UVS 2
+/* ---- primitive info: one uint per primitive; primitive i's is component i % 4 of info
+ * texel i / 4:
+ *   type tag << PRIMITIVE_INFO_TYPE_SHIFT | PRIMITIVE_INFO_HAS_UVS (triangles whose
+ *   vertices carry uvs; otherwise uv is the barycentric or edge coordinates) | material
+ *   index (PRIMITIVE_NO_MATERIAL: the instance's, else the default) */
+#define PRIMITIVE_INFO_TYPE_SHIFT 29
+#define PRIMITIVE_INFO_HAS_UVS 268435456
+#define PRIMITIVE_INFO_MATERIAL_MASK 268435455
+#define PRIMITIVE_NO_MATERIAL 268435455
+
+/* ---- vertices: one texel each: (position.xyz, normal), the normal a unit vector
+ * octahedron-mapped to two signed 16-bit fractions (GLSL unpackSnorm2x16: x low half), or
+ * VERTEX_NO_NORMAL (flat shading). Mesh vertices are stored once per mesh however often it
+ * is placed (and once more per placement baked into the world).
+ * ---- uvs: vertex i's (u, v) are components 2 (i % 2) and 2 (i % 2) + 1 of uv texel
+ * i / 2; v points up (v = 1: an image's top row). */
+#define VERTEX_NO_NORMAL 4294967295u
 
 /* ---- BVH nodes: 2 texels
  *   texel 0 = (box_min.x, box_min.y, box_min.z, first)
@@ -138,8 +163,8 @@
  *   point, spot, sun: texel 0 .yzw = polynomial attenuation c, l, q (all 0: inverse square),
  *   texel 1 .xyz = position (point, spot) or the direction towards the sun, texel 2 .w = cos
  *   of the spot's outer half-angle or of the sun's angular radius.
- * Area lights are emissive world primitives (spheres, quads, triangles): their radiance is
- * their material's emission.
+ * Area lights are emissive world primitives (spheres, quads, triangles), listed first and
+ * in primitive order (see primitives): their radiance is their material's emission.
  * environment (an equirectangular sky): texel 0 = (LIGHT_ENVIRONMENT, image width, image
  * height, 0); it is importance-sampled by the environment section: one float per texel
  * (in .x): the cumulative distribution over rows (height values), then for each row the

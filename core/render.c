@@ -105,7 +105,7 @@ static uint32_t omitted_features(const scene *s, const packed_scene *packed, con
         omitted |= GPU_OMIT_TEXTURES;
     bool present[PRIMITIVE_TYPE_COUNT] = {false};
     for (uint32_t slot = 0; slot < packed->primitive_count; slot++) {
-        uint32_t type = packed_uint(packed, packed->primitive_offset + slot * PACKED_PRIMITIVE_STRIDE, 0);
+        uint32_t type = packed_primitive_type(packed, slot);
         if (type < PRIMITIVE_TYPE_COUNT)
             present[type] = true;
     }
@@ -113,8 +113,10 @@ static uint32_t omitted_features(const scene *s, const packed_scene *packed, con
         omitted |= GPU_OMIT_SPHERES;
     if (!present[PRIMITIVE_MOVING_SPHERE])
         omitted |= GPU_OMIT_MOVING_SPHERES;
-    if (!present[PRIMITIVE_TRIANGLE] && !present[PRIMITIVE_QUAD])
-        omitted |= GPU_OMIT_FLAT;
+    if (!present[PRIMITIVE_TRIANGLE])
+        omitted |= GPU_OMIT_TRIANGLES;
+    if (!present[PRIMITIVE_QUAD])
+        omitted |= GPU_OMIT_QUADS;
     if (!present[PRIMITIVE_INSTANCE])
         omitted |= GPU_OMIT_INSTANCES;
     bool emitters = false;

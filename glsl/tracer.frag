@@ -97,8 +97,15 @@ const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 
 // Variants (gpu.h GPU_OMIT_*): code for what the scene lacks is left out, because
 // llvmpipe runs both sides of every branch and so pays for all code in a loop.
-#if defined(RTSPHERES_OMIT_FLAT) && defined(RTSPHERES_OMIT_MOVING_SPHERES) && defined(RTSPHERES_OMIT_INSTANCES)
+#if defined(RTSPHERES_OMIT_TRIANGLES) && defined(RTSPHERES_OMIT_QUADS) && defined(RTSPHERES_OMIT_MOVING_SPHERES) \
+    && defined(RTSPHERES_OMIT_INSTANCES)
 #define RTSPHERES_ONLY_SPHERES 1
+#endif
+#if defined(RTSPHERES_OMIT_SPHERES) && defined(RTSPHERES_OMIT_QUADS) && defined(RTSPHERES_OMIT_INSTANCES)
+#define RTSPHERES_ONLY_TRIANGLES 1
+#endif
+#if defined(RTSPHERES_OMIT_TRIANGLES) && defined(RTSPHERES_OMIT_QUADS)
+#define RTSPHERES_OMIT_FLAT 1
 #endif
 
 // ---- the work bound ----------------------------------------------------------------
@@ -136,12 +143,27 @@ uvec4 packed_texel(uint index)
 vec3 packed_xyz(uvec4 texel) { return uintBitsToFloat(texel.xyz); }
 vec4 packed_vec4(uint index) { return uintBitsToFloat(packed_texel(index)); }
 
+// A vertex normal from its octahedral encoding (pack.c packed_encode_normal).
+vec3 decode_normal(uint bits)
+{
+    vec2 f = unpackSnorm2x16(bits);
+    vec3 n = vec3(f, 1.0 - abs(f.x) - abs(f.y));
+    float t = max(-n.z, 0.0);
+    n.x += n.x >= 0.0 ? -t : t;
+    n.y += n.y >= 0.0 ? -t : t;
+    return normalize(n);
+}
+
 uint material_offset;
 uint primitive_offset;
 uint node_offset;
 uint node_count;
 uint instance_offset;
-uint attribute_offset;
+uint info_offset;
+uint shape_offset;
+uint vertex_offset;
+uint uv_offset;
+uint area_light_count;
 uint default_material;
 uint texture_offset;
 uint image_offset;
@@ -240,33 +262,104 @@ float node_entry_distance(uint node, vec3 origin, vec3 inverse_direction, float 
                          inverse_direction, t_max);
 }
 
-// Tests one primitive (by slot) of the current level; on a nearer hit updates hit.
-void intersect_primitive(uint slot, uvec4 head, vec3 origin, vec3 direction, float time, uint instance,
+// ---- primitive records (packed_layout.h "primitives") ------------------------------
+
+// The info word of a primitive: type tag, uvs flag, material.
+uint primitive_info(uint slot)
+{
+    return packed_texel(info_offset + slot / 4u)[slot % 4u];
+}
+
+uint primitive_type(uint info) { return info >> uint(PRIMITIVE_INFO_TYPE_SHIFT); }
+
+// The type of a primitive from its record (packed_layout.h: every record but a sphere's
+// has a tag in w), known at compile time in the variants with one kind of primitive.
+uint record_type(uvec4 record)
+{
+#if defined(RTSPHERES_ONLY_SPHERES)
+    return uint(PRIMITIVE_SPHERE);
+#elif defined(RTSPHERES_ONLY_TRIANGLES)
+    return uint(PRIMITIVE_TRIANGLE);
+#else
+    return record.w >= PRIMITIVE_RECORD_TAG ? record.w - PRIMITIVE_RECORD_TAG : uint(PRIMITIVE_SPHERE);
+#endif
+}
+
+// A primitive's geometry as the layout of the tests has it: sphere (centre, radius) in a;
+// moving sphere (centre at time 0, radius) in a, (centre at time 1) in b; triangle and
+// quad: corner in a, edges in b and c; for a triangle, normal_words are its vertices'
+// encoded normals. The texels behind the record are fetched in one place for every type
+// (a triangle's vertices, a shape record): llvmpipe runs every branch, so per-type
+// fetches would all be paid.
+void primitive_geometry(uvec4 record, uint type, out vec4 a, out vec4 b, out vec4 c, out uvec3 normal_words)
+{
+    a = uintBitsToFloat(record);
+    b = vec4(0.0);
+    c = vec4(0.0);
+    normal_words = uvec3(VERTEX_NO_NORMAL);
+#ifndef RTSPHERES_ONLY_SPHERES
+    bool triangle = type == uint(PRIMITIVE_TRIANGLE);
+    bool behind = type != uint(PRIMITIVE_SPHERE) && type != uint(PRIMITIVE_INSTANCE);
+    uvec3 address = triangle ? uvec3(vertex_offset) + record.xyz : uvec3(record.x, record.x + 1u, record.x + 2u);
+    address = behind ? address : uvec3(0u);
+    uvec4 g0 = packed_texel(address.x), g1 = packed_texel(address.y);
+#ifdef RTSPHERES_OMIT_FLAT
+    uvec4 g2 = uvec4(0u);
+#else
+    uvec4 g2 = packed_texel(address.z);
+#endif
+    if (behind) {
+        vec4 f0 = uintBitsToFloat(g0), f1 = uintBitsToFloat(g1), f2 = uintBitsToFloat(g2);
+        a = triangle ? vec4(f0.xyz, 0.0) : f0;
+        b = triangle ? vec4(f1.xyz - f0.xyz, 0.0) : f1;
+        c = triangle ? vec4(f2.xyz - f0.xyz, 0.0) : f2;
+        if (triangle)
+            normal_words = uvec3(g0.w, g1.w, g2.w);
+    }
+#endif
+}
+
+// The vertex normals of a triangle whose vertex texels' w are bits (false when a vertex
+// has none: then it is shaded flat).
+bool vertex_normals(uvec3 bits, out vec3 n0, out vec3 n1, out vec3 n2)
+{
+    n0 = decode_normal(bits.x);
+    n1 = decode_normal(bits.y);
+    n2 = decode_normal(bits.z);
+    return all(notEqual(bits, uvec3(VERTEX_NO_NORMAL)));
+}
+
+vec2 vertex_uv(uint vertex)
+{
+    uvec4 texel = packed_texel(uv_offset + vertex / 2u);
+    return uintBitsToFloat((vertex & 1u) == 0u ? texel.xy : texel.zw);
+}
+
+// Tests one primitive (by slot, its record already read) of the current level; on a
+// nearer hit updates hit.
+void intersect_primitive(uint slot, uvec4 record, uint type, vec3 origin, vec3 direction, float time, uint instance,
                          inout Hit hit)
 {
-    uint base = primitive_offset + slot * uint(PACKED_PRIMITIVE_STRIDE);
-    vec4 a = packed_vec4(base + 1u);
+    vec4 a, b, c;
+    uvec3 normal_words;
+    primitive_geometry(record, type, a, b, c, normal_words);
     float t = INFINITY;
     vec2 coordinates = vec2(0.0);
 #ifdef RTSPHERES_ONLY_SPHERES
     t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
 #else
-    bool flat_primitive = head.x == uint(PRIMITIVE_TRIANGLE) || head.x == uint(PRIMITIVE_QUAD);
+    bool flat_primitive = type == uint(PRIMITIVE_TRIANGLE) || type == uint(PRIMITIVE_QUAD);
 #ifndef RTSPHERES_OMIT_MOVING_SPHERES
-    if (head.x == uint(PRIMITIVE_MOVING_SPHERE))
-        a.xyz = mix(a.xyz, packed_vec4(base + 2u).xyz, time);
+    if (type == uint(PRIMITIVE_MOVING_SPHERE))
+        a.xyz = mix(a.xyz, b.xyz, time);
 #endif
 #ifndef RTSPHERES_OMIT_SPHERES
     if (!flat_primitive)
         t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
 #endif
 #ifndef RTSPHERES_OMIT_FLAT
-    if (flat_primitive) {
-        vec3 edge1 = packed_vec4(base + 2u).xyz;
-        vec3 edge2 = packed_vec4(base + 3u).xyz;
-        t = intersect_flat(a.xyz, edge1, edge2, head.x == uint(PRIMITIVE_QUAD), origin, direction, hit.t,
-                           coordinates);
-    }
+    if (flat_primitive)
+        t = intersect_flat(a.xyz, b.xyz, c.xyz, type == uint(PRIMITIVE_QUAD), origin, direction, hit.t, coordinates);
 #endif
 #endif
     if (t < hit.t) {
@@ -337,17 +430,14 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
         if (node_entry < hit.t) {
             if (count > 0u) {
                 for (uint slot = first; slot < first + count && count_work(); slot++) {
-#ifdef RTSPHERES_ONLY_SPHERES
-                    uvec4 head = uvec4(uint(PRIMITIVE_SPHERE), 0u, 0u, 0u);   // no record to look at
-#else
-                    uvec4 head = packed_texel(primitive_offset + slot * uint(PACKED_PRIMITIVE_STRIDE));
-#endif
+                    uvec4 record = packed_texel(primitive_offset + slot);
+                    uint type = record_type(record);
 #ifndef RTSPHERES_OMIT_INSTANCES
-                    if (head.x == uint(PRIMITIVE_INSTANCE)) {
+                    if (type == uint(PRIMITIVE_INSTANCE)) {
                         if (stack_size + 2 <= STACK_SIZE) {
                             stack_count[stack_size] = LEAVE_INSTANCE_MARK;
                             stack_entry[stack_size] = -INFINITY;
-                            stack_first[stack_size + 1] = head.w;
+                            stack_first[stack_size + 1] = record.x;
                             stack_count[stack_size + 1] = ENTER_INSTANCE_MARK;
                             stack_entry[stack_size + 1] = -INFINITY;
                             stack_size += 2;
@@ -357,7 +447,7 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
                     } else
 #endif
                     {
-                        intersect_primitive(slot, head, origin, direction, time, instance, hit);
+                        intersect_primitive(slot, record, type, origin, direction, time, instance, hit);
                     }
                 }
             } else {
@@ -592,9 +682,12 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
     surface.position = origin + hit.t * direction;
     surface.instance = hit.instance;
     surface.volume_boundary = false;
-    uint base = primitive_offset + hit.primitive * uint(PACKED_PRIMITIVE_STRIDE);
-    uvec4 head = packed_texel(base);
-    vec4 a = packed_vec4(base + 1u);
+    uvec4 record = packed_texel(primitive_offset + hit.primitive);
+    uint info = primitive_info(hit.primitive);
+    uint type = primitive_type(info);
+    vec4 a, b, c;
+    uvec3 normal_words;
+    primitive_geometry(record, type, a, b, c, normal_words);
     vec3 object_point = surface.position;
     mat3 normal_to_world = mat3(1.0);
     uint instance_material = NONE;
@@ -615,7 +708,9 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
         normal_to_world = mat3(row0.xyz, row1.xyz, row2.xyz);
     }
 #endif
-    surface.material = head.y != NONE ? head.y : instance_material != NONE ? instance_material : default_material;
+    uint own_material = info & uint(PRIMITIVE_INFO_MATERIAL_MASK);
+    surface.material = own_material != uint(PRIMITIVE_NO_MATERIAL) ? own_material
+                     : instance_material != NONE ? instance_material : default_material;
 #ifdef RTSPHERES_OMIT_TEXTURES
     uint normal_map = NONE;
 #else
@@ -626,7 +721,7 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
     vec3 tangent = vec3(0.0);     // object-space direction of increasing u (for normal maps)
     float handedness = 1.0;
     vec2 uv = hit.barycentric;
-    bool flat_primitive = head.x == uint(PRIMITIVE_TRIANGLE) || head.x == uint(PRIMITIVE_QUAD);
+    bool flat_primitive = type == uint(PRIMITIVE_TRIANGLE) || type == uint(PRIMITIVE_QUAD);
 #ifdef RTSPHERES_OMIT_SPHERES
     flat_primitive = true;
 #endif
@@ -637,8 +732,8 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
     if (!flat_primitive) {
         vec3 center = a.xyz;
 #ifndef RTSPHERES_OMIT_MOVING_SPHERES
-        if (head.x == uint(PRIMITIVE_MOVING_SPHERE))
-            center = mix(a.xyz, packed_vec4(base + 2u).xyz, time);
+        if (type == uint(PRIMITIVE_MOVING_SPHERE))
+            center = mix(a.xyz, b.xyz, time);
 #endif
         normal = (object_point - center) / a.w;
         shading_normal = normal;
@@ -652,25 +747,23 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
 #endif
 #ifndef RTSPHERES_OMIT_FLAT
     if (flat_primitive) {
-        vec3 edge1 = packed_vec4(base + 2u).xyz;
-        vec3 edge2 = packed_vec4(base + 3u).xyz;
+        vec3 edge1 = b.xyz, edge2 = c.xyz;
         normal = cross(edge1, edge2);
         shading_normal = normal;
         tangent = edge1;      // quads and bare triangles: u runs along the first edge
-        if (head.z != NONE) {
-            // Mesh triangle with vertex attributes: interpolate by barycentrics.
-            uint attribute_base = attribute_offset + head.z * uint(PACKED_ATTRIBUTE_STRIDE);
-            vec4 t0 = packed_vec4(attribute_base), t1 = packed_vec4(attribute_base + 1u), t2 = packed_vec4(attribute_base + 2u);
-            uvec4 t3_bits = packed_texel(attribute_base + 3u);
-            vec4 t3 = uintBitsToFloat(t3_bits);
+#ifndef RTSPHERES_OMIT_TRIANGLES
+        if (type == uint(PRIMITIVE_TRIANGLE)) {
+            // Vertex normals and uvs, interpolated by barycentrics.
             vec3 weights = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
-            if ((t3_bits.w & uint(ATTRIBUTE_HAS_NORMALS)) != 0u) {
-                vec3 interpolated = weights.x * t0.xyz + weights.y * t1.xyz + weights.z * t2.xyz;
+            vec3 n0, n1, n2;
+            if (vertex_normals(normal_words, n0, n1, n2)) {
+                vec3 interpolated = weights.x * n0 + weights.y * n1 + weights.z * n2;
                 if (dot(interpolated, interpolated) > 0.0)
                     shading_normal = interpolated;
             }
-            if ((t3_bits.w & uint(ATTRIBUTE_HAS_UVS)) != 0u) {
-                vec2 uv0 = vec2(t0.w, t1.w), uv1 = vec2(t2.w, t3.x), uv2 = t3.yz;
+#ifndef RTSPHERES_OMIT_TEXTURES
+            if ((info & uint(PRIMITIVE_INFO_HAS_UVS)) != 0u) {
+                vec2 uv0 = vertex_uv(record.x), uv1 = vertex_uv(record.y), uv2 = vertex_uv(record.z);
                 uv = weights.x * uv0 + weights.y * uv1 + weights.z * uv2;
                 // The tangent follows the uv layout: solve edge = du * T + dv * B.
                 vec2 duv1 = uv1 - uv0, duv2 = uv2 - uv0;
@@ -681,7 +774,9 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
                     handedness = dot(cross(normal, tangent), bitangent) < 0.0 ? -1.0 : 1.0;
                 }
             }
+#endif
         }
+#endif
     }
 #endif
     if (normal_map != NONE) {
@@ -750,11 +845,39 @@ uint choose_light(float u)
 
 // Solid-angle density, seen from p, of the direction light sampling would pick towards
 // point x on the light (normal n there). Spheres are sampled by their visible cone.
+// The light record head of an area light and its primitive's geometry (sphere: centre
+// and radius in a; quad and triangle: corner in a, edges in b and c).
+void area_light_geometry(uint light, out uvec4 head, out vec4 a, out vec4 b, out vec4 c)
+{
+    head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
+    uint type = head.x == uint(LIGHT_SPHERE) ? uint(PRIMITIVE_SPHERE)
+              : head.x == uint(LIGHT_QUAD) ? uint(PRIMITIVE_QUAD) : uint(PRIMITIVE_TRIANGLE);
+    uvec3 normal_words;
+    primitive_geometry(packed_texel(primitive_offset + head.y), type, a, b, c, normal_words);
+}
+
+// The area light of an emissive world primitive (by slot), or NONE: the area lights
+// come first in the light list, in primitive order (packed_layout.h), so a binary search.
+uint area_light_of(uint slot)
+{
+    uint low = 0u, high = area_light_count;
+    while (low < high) {
+        work++;
+        uint middle = (low + high) / 2u;
+        if (packed_texel(light_offset + middle * uint(PACKED_LIGHT_STRIDE)).y < slot)
+            low = middle + 1u;
+        else
+            high = middle;
+    }
+    return low < area_light_count && packed_texel(light_offset + low * uint(PACKED_LIGHT_STRIDE)).y == slot ? low
+                                                                                                           : NONE;
+}
+
 float light_direction_pdf(uint light, vec3 p, vec3 x, vec3 n)
 {
-    uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
-    uint base = primitive_offset + head.y * uint(PACKED_PRIMITIVE_STRIDE);
-    vec4 a = packed_vec4(base + 1u);
+    uvec4 head;
+    vec4 a, edge1, edge2;
+    area_light_geometry(light, head, a, edge1, edge2);
     if (head.x == uint(LIGHT_SPHERE)) {
         float distance_squared = dot(a.xyz - p, a.xyz - p);
         if (distance_squared <= a.w * a.w)
@@ -762,8 +885,7 @@ float light_direction_pdf(uint light, vec3 p, vec3 x, vec3 n)
         float cos_max = sqrt(max(0.0, 1.0 - a.w * a.w / distance_squared));
         return 1.0 / (2.0 * PI * max(1.0 - cos_max, 1e-12));
     }
-    vec3 edge1 = packed_vec4(base + 2u).xyz, edge2 = packed_vec4(base + 3u).xyz;
-    float area = length(cross(edge1, edge2)) * (head.x == uint(LIGHT_QUAD) ? 1.0 : 0.5);
+    float area = length(cross(edge1.xyz, edge2.xyz)) * (head.x == uint(LIGHT_QUAD) ? 1.0 : 0.5);
     vec3 to_light = x - p;
     float distance_squared = dot(to_light, to_light);
     float cosine = abs(dot(n, to_light)) * inversesqrt(distance_squared);
@@ -776,10 +898,9 @@ float light_direction_pdf(uint light, vec3 p, vec3 x, vec3 n)
 bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float distance, out vec3 emitted,
                   out float pdf)
 {
-    uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
-    uint base = primitive_offset + head.y * uint(PACKED_PRIMITIVE_STRIDE);
-    uvec4 primitive_head = packed_texel(base);
-    vec4 a = packed_vec4(base + 1u);
+    uvec4 head;
+    vec4 a, edge1, edge2;
+    area_light_geometry(light, head, a, edge1, edge2);
     vec3 x, n;
     vec2 uv = u;
     direction = vec3(0.0, 1.0, 0.0);
@@ -809,11 +930,10 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
         uv = vec2(0.5 + atan(-n.z, n.x) / (2.0 * PI), acos(clamp(-n.y, -1.0, 1.0)) / PI);
         pdf = 1.0 / (2.0 * PI * max(1.0 - cos_max, 1e-12));
     } else {
-        vec3 edge1 = packed_vec4(base + 2u).xyz, edge2 = packed_vec4(base + 3u).xyz;
         if (head.x == uint(LIGHT_TRIANGLE) && u.x + u.y > 1.0)
             uv = vec2(1.0) - u;   // fold the square onto the triangle: still uniform
-        x = a.xyz + uv.x * edge1 + uv.y * edge2;
-        n = normalize(cross(edge1, edge2));
+        x = a.xyz + uv.x * edge1.xyz + uv.y * edge2.xyz;
+        n = normalize(cross(edge1.xyz, edge2.xyz));
         vec3 to_light = x - p;
         distance = length(to_light);
         if (distance < 1e-12)
@@ -823,7 +943,8 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
         if (pdf == 0.0)
             return false;
     }
-    uint material = material_offset + primitive_head.y * uint(PACKED_MATERIAL_STRIDE);
+    uint material = material_offset + (primitive_info(head.y) & uint(PRIMITIVE_INFO_MATERIAL_MASK))
+                                      * uint(PACKED_MATERIAL_STRIDE);
     emitted = uintBitsToFloat(packed_texel(material + 1u).xyz);
     uint emission_texture = packed_texel(material + 2u).z;
     if (emission_texture != NONE)
@@ -1068,28 +1189,36 @@ vec3 direct_light(int mode, vec3 p, vec3 normal, vec3 shading, vec3 view, vec3 a
     return result;
 }
 
-#ifdef RTSPHERES_AOV_PASS
-// Reads the packed scene's header into the globals every function uses.
+// Reads the packed scene's header (packed_layout.h) into the globals every function
+// uses; light_count is the scene's, which main narrows to what the render samples.
 void read_header()
 {
     uvec4 header0 = packed_texel(0u), header1 = packed_texel(1u), header2 = packed_texel(2u),
-          header3 = packed_texel(3u), header4 = packed_texel(4u);
+          header3 = packed_texel(3u), header4 = packed_texel(4u), header5 = packed_texel(5u);
     material_offset = header0.z;
     primitive_offset = header1.x;
     node_offset = header1.z;
     node_count = header1.w;
     instance_offset = header2.x;
-    attribute_offset = header2.z;
+    info_offset = header2.z;
     default_material = header2.w;
     texture_offset = header3.x;
     image_offset = header3.z;
     light_offset = header4.x;
-    light_count = 0u;
+    light_count = header4.y;
+    environment_offset = header4.z;
+    area_light_count = header4.w;
+    shape_offset = header5.x;
+    vertex_offset = header5.y;
+    uv_offset = header5.z;
 }
+
+#ifdef RTSPHERES_AOV_PASS
 
 void main()
 {
     read_header();
+    light_count = 0u;
     ivec2 frag_pixel = ivec2(gl_FragCoord.xy);
     ivec2 image_pixel = ivec2(region_origin.x + frag_pixel.x, region_origin.y + (image_size.y - 1 - frag_pixel.y));
     vec2 film_pixel = vec2(float(image_pixel.x), float(full_size.y - 1 - image_pixel.y));
@@ -1163,25 +1292,12 @@ void main()
     uint bounce = counters.y;
     uint media = counters.z;
 
-    uvec4 header0 = packed_texel(0u), header1 = packed_texel(1u), header2 = packed_texel(2u),
-          header3 = packed_texel(3u);
-    material_offset = header0.z;
-    primitive_offset = header1.x;
-    node_offset = header1.z;
-    node_count = header1.w;
-    instance_offset = header2.x;
-    attribute_offset = header2.z;
-    default_material = header2.w;
-    texture_offset = header3.x;
-    image_offset = header3.z;
-    uvec4 header4 = packed_texel(4u);
-    light_offset = header4.x;
+    read_header();
 #ifdef RTSPHERES_OMIT_DIRECT_LIGHT
     light_count = 0u;       // the host left light sampling out: nothing to sample
 #else
-    light_count = light_sampling != 0 || integrator == 1 ? header4.y : 0u;
+    light_count = light_sampling != 0 || integrator == 1 ? light_count : 0u;
 #endif
-    environment_offset = header4.z;
 
     // Full-image pixel, row 0 at the top: a crop or tile renders exactly the pixels
     // (and random numbers) of the full render.
@@ -1331,8 +1447,8 @@ void main()
 #endif
                     // Light sampling could have found this emitter too: weight by MIS.
                     float weight = 1.0;
-                    uint light = packed_texel(primitive_offset + hit.primitive * uint(PACKED_PRIMITIVE_STRIDE)).w;
-                    if (previous_pdf > 0.0 && hit.instance == NONE && light != NONE && light < light_count) {
+                    uint light = previous_pdf > 0.0 && hit.instance == NONE ? area_light_of(hit.primitive) : NONE;
+                    if (light != NONE && light < light_count) {
                         vec3 vertex = origin - since_vertex * direction;
                         float light_pdf = light_probability(light) * light_direction_pdf(light, vertex, p, surface.geometric);
                         weight = power_heuristic(previous_pdf, light_pdf);

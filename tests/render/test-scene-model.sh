@@ -113,7 +113,7 @@ group {
 SCENE
 if "$program" render "$scratch/instanced.txt" -o "$scratch/instanced.exr" --quiet &&
    "$program" render "$scratch/copies.txt" -o "$scratch/copies.exr" --quiet; then
-    if "$program" diff "$scratch/instanced.exr" "$scratch/copies.exr" --fail 0.001 --failpercent 0.5 >"$scratch/d.txt"; then
+    if "$program" diff "$scratch/instanced.exr" "$scratch/copies.exr" --fail 0 --failpercent 0 >"$scratch/d.txt"; then
         pass "a mesh instanced twice renders as two copies ($(grep '^max error' "$scratch/d.txt"))"
     else
         fail "a mesh instanced twice renders as two copies" "$(tr '\n' ' ' <"$scratch/d.txt")"
@@ -179,4 +179,18 @@ printf 'material m lambertian 1 1 1\nmesh "missing.obj" m\n' >"$scratch/missing.
 code=$?
 if [ "$code" = 2 ] && grep -q "missing.obj" "$scratch/missing.err"; then pass "a missing OBJ is an error naming it"
 else fail "a missing OBJ" "exit $code: $(cat "$scratch/missing.err")"; fi
+# An OBJ whose material library is missing renders (its faces get the scene's material)
+# and the CLI says so once, not under --quiet.
+printf 'mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$scratch/nomtl.obj"
+printf 'camera from 0 0 3 at 0 0 0 up 0 1 0 fov 40\nmaterial m lambertian 0.5 0.5 0.5\nmesh "nomtl.obj" m\n' \
+    >"$scratch/nomtl.txt"
+if "$program" render "$scratch/nomtl.txt" -o "$scratch/nomtl-%d.png" --size 8x8 --spp 1 --frames 0-2 \
+        2>"$scratch/nomtl.err" && [ "$(grep -c "warning: .*nomtl.txt:3:.*missing.mtl" "$scratch/nomtl.err")" = 1 ] &&
+   "$program" render "$scratch/nomtl.txt" -o "$scratch/nomtl.png" --size 8x8 --spp 1 --quiet 2>"$scratch/quiet.err" &&
+   [ ! -s "$scratch/quiet.err" ]; then
+    pass "a missing MTL file is one warning with the statement's position, none under --quiet"
+else
+    fail "missing MTL warning" "$(head -c 300 "$scratch/nomtl.err") / quiet: $(head -c 200 "$scratch/quiet.err")"
+fi
+
 finish

@@ -72,15 +72,33 @@ static void header_and_materials_round_trip(void **state)
     assert_int_equal(packed_uint(&packed, 1, 3), packed.node_count);
     assert_int_equal(packed_uint(&packed, 2, 0), packed.instance_offset);
     assert_int_equal(packed_uint(&packed, 2, 1), 0);
-    assert_int_equal(packed_uint(&packed, 2, 2), packed.attribute_offset);
+    assert_int_equal(packed_uint(&packed, 2, 2), packed.info_offset);
     assert_int_equal(packed_uint(&packed, 2, 3), 4);
     assert_int_equal(packed.material_offset, PACKED_HEADER_TEXELS);
     assert_int_equal(packed.primitive_offset, packed.material_offset + 5 * PACKED_MATERIAL_STRIDE);
-    assert_int_equal(packed.attribute_offset, packed.primitive_offset + 37 * PACKED_PRIMITIVE_STRIDE);
-    assert_int_equal(packed.node_offset, packed.attribute_offset);
+    /* Spheres only: 37 records, their info (four to a texel), no shapes, no vertices. */
+    assert_int_equal(packed.info_offset, packed.primitive_offset + 37 * PACKED_PRIMITIVE_STRIDE);
+    assert_int_equal(packed.shape_offset, packed.info_offset + (37 + 3) / 4);
+    assert_int_equal(packed.shape_texels, 0);
+    assert_int_equal(packed.vertex_offset, packed.shape_offset);
+    assert_int_equal(packed.vertex_count, 0);
+    assert_int_equal(packed.uv_offset, packed.vertex_offset);
+    assert_int_equal(packed.node_offset, packed.uv_offset);
     assert_int_equal(packed.light_offset, packed.node_offset + packed.node_count * PACKED_NODE_STRIDE);
     assert_int_equal(packed_uint(&packed, 4, 0), packed.light_offset);
     assert_int_equal(packed_uint(&packed, 4, 1), packed.light_count);
+    assert_int_equal(packed_uint(&packed, 4, 3), packed.area_light_count);
+    assert_int_equal(packed_uint(&packed, 5, 0), packed.shape_offset);
+    assert_int_equal(packed_uint(&packed, 5, 1), packed.vertex_offset);
+    assert_int_equal(packed_uint(&packed, 5, 2), packed.uv_offset);
+    assert_int_equal(packed_uint(&packed, 5, 3), packed.vertex_count);
+    /* A sphere's record is its centre and radius; its info its type and material. */
+    for (uint32_t slot = 0; slot < packed.primitive_count; slot++) {
+        uint32_t info = packed_uint(&packed, packed.info_offset + slot / 4, (int)(slot % 4));
+        assert_int_equal(info >> PRIMITIVE_INFO_TYPE_SHIFT, PRIMITIVE_SPHERE);
+        assert_true((info & PRIMITIVE_INFO_MATERIAL_MASK) < 4);
+        assert_true(packed_float(&packed, packed.primitive_offset + slot, 3) > 0);
+    }
     assert_int_equal(packed.texel_count, packed.light_offset + packed.light_count * PACKED_LIGHT_STRIDE);
     /* The default material is grey Lambertian. */
     uint32_t default_base = packed.material_offset + 4 * PACKED_MATERIAL_STRIDE;
@@ -543,7 +561,10 @@ static void emissive_spheres_become_lights(void **state)
         assert_int_equal(packed_uint(&packed, base, 0), LIGHT_SPHERE);
         uint32_t slot = packed_uint(&packed, base, 1);
         packed_primitive primitive = packed_primitive_at(&packed, slot);
-        assert_int_equal(primitive.instance, l); /* texel 0 .w: the light index */
+        /* Area lights come first and in slot order: the shader's binary search. */
+        assert_true(l < packed.area_light_count);
+        if (l > 0)
+            assert_true(slot > packed_uint(&packed, base - PACKED_LIGHT_STRIDE, 1));
         const float *e = s.materials[primitive.material].emission;
         double power = (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]) * primitive.data[0][3] * primitive.data[0][3];
         float cdf = packed_float(&packed, base + 1, 3);
@@ -634,6 +655,106 @@ static void placed_emitters_become_lights(void **state)
     scene_free(&s);
 }
 
+/* Vertex normals are stored octahedron-encoded in 32 bits: any unit vector comes back
+ * within 1e-4 radians (two 16-bit fractions), the axes exactly. */
+static void normals_survive_the_encoding(void **state)
+{
+    (void)state;
+    random_state = 77;
+    const float axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int i = 0; i < 6; i++) {
+        float back[3];
+        packed_decode_normal(packed_encode_normal(axes[i]), back);
+        for (int c = 0; c < 3; c++)
+            assert_float_equal(back[c], axes[i][c], 1e-6);
+    }
+    double worst = 0;
+    for (int i = 0; i < 100000; i++) {
+        float n[3], back[3];
+        double z = 2 * random_unit() - 1, phi = 2 * M_PI * random_unit(), r = sqrt(1 - z * z);
+        n[0] = (float)(r * cos(phi)), n[1] = (float)(r * sin(phi)), n[2] = (float)z;
+        packed_decode_normal(packed_encode_normal(n), back);
+        /* The chord |n - back| is the angle for angles this small (acos of a float dot
+         * product near 1 would measure float rounding instead). */
+        double dx = (double)n[0] - back[0], dy = (double)n[1] - back[1], dz = (double)n[2] - back[2];
+        double angle = sqrt(dx * dx + dy * dy + dz * dz);
+        if (angle > worst)
+            worst = angle;
+        assert_true(packed_encode_normal(n) != VERTEX_NO_NORMAL);
+    }
+    assert_true(worst < 1e-4);
+}
+
+/* Triangles are three vertex indices: a mesh placed with the identity (copied into the
+ * top level) and with a transform (its own BVH) shares one set of vertices; records,
+ * normals, uvs and the uvs flag decode to the mesh's. */
+static void mesh_vertices_are_stored_once(void **state)
+{
+    (void)state;
+    scene s;
+    scene_defaults(&s);
+    add_material(&s, "grey", MATERIAL_LAMBERTIAN, 0.5f, 0.5f, 0.5f);
+    /* A tetrahedron with normals and uvs. */
+    scene_mesh mesh = {.default_material = -1, .vertex_count = 4, .triangle_count = 4};
+    const float positions[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const uint32_t indices[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    mesh.positions = malloc(sizeof positions);
+    mesh.normals = malloc(sizeof positions);
+    mesh.uvs = malloc(8 * sizeof(float));
+    mesh.indices = malloc(sizeof indices);
+    memcpy(mesh.positions, positions, sizeof positions);
+    memcpy(mesh.indices, indices, sizeof indices);
+    for (int v = 0; v < 4; v++) {
+        float n[3] = {positions[3 * v] - 0.25f, positions[3 * v + 1] - 0.25f, positions[3 * v + 2] - 0.25f};
+        float length = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int c = 0; c < 3; c++)
+            mesh.normals[3 * v + c] = n[c] / length;
+        mesh.uvs[2 * v] = 0.1f * v, mesh.uvs[2 * v + 1] = 0.2f * v;
+    }
+    int mesh_index = scene_add_mesh(&s, &mesh);
+    scene_object object = {.mesh = mesh_index};
+    assert_true(scene_add_object(&s, &object) >= 0);
+    scene_instance here = {.object = 0, .material = 0};
+    scene_identity_transform(here.object_to_world);
+    scene_instance there = {.object = 0, .material = 0,
+                            .object_to_world = {{2, 0, 0, 5}, {0, 2, 0, 0}, {0, 0, 2, 0}}};
+    assert_true(scene_add_instance(&s, &here) >= 0 && scene_add_instance(&s, &there) >= 0);
+    packed_scene packed;
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_int_equal(packed.instance_count, 1);
+    assert_int_equal(packed.triangle_count, 8);
+    assert_int_equal(packed.vertex_count, 4);   /* once, for both placements */
+    int triangles = 0;
+    for (uint32_t slot = 0; slot < packed.primitive_count; slot++) {
+        packed_primitive primitive = packed_primitive_at(&packed, slot);
+        if (primitive.type != PRIMITIVE_TRIANGLE)
+            continue;
+        triangles++;
+        assert_true(primitive.has_uvs);
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = primitive.vertices[k];
+            assert_true(v < packed.vertex_count);
+            /* Find the mesh vertex at that position: its normal and uv must match. */
+            float position[3], normal[3];
+            packed_vertex_position(&packed, v, position);
+            assert_true(packed_vertex_normal(&packed, v, normal));
+            int match = -1;
+            for (int m = 0; m < 4; m++)
+                if (memcmp(position, positions + 3 * m, sizeof position) == 0)
+                    match = m;
+            assert_true(match >= 0);
+            for (int c = 0; c < 3; c++)
+                assert_float_equal(normal[c], mesh.normals[3 * match + c], 1e-4);
+            uint32_t uv_texel = packed.uv_offset + v / 2;
+            assert_true(packed_float(&packed, uv_texel, (int)(2 * (v % 2))) == mesh.uvs[2 * match]);
+            assert_true(packed_float(&packed, uv_texel, (int)(2 * (v % 2) + 1)) == mesh.uvs[2 * match + 1]);
+        }
+    }
+    assert_int_equal(triangles, 8);
+    packed_scene_free(&packed);
+    scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -646,6 +767,8 @@ int main(void)
         cmocka_unit_test(singular_instance_is_an_error),
         cmocka_unit_test(emissive_spheres_become_lights),
         cmocka_unit_test(placed_emitters_become_lights),
+        cmocka_unit_test(normals_survive_the_encoding),
+        cmocka_unit_test(mesh_vertices_are_stored_once),
     };
     return cmocka_run_group_tests_name("pack", tests, NULL, NULL);
 }
