@@ -941,11 +941,14 @@ static int render_frame(gpu_context *context, const render_request *request, int
                 fprintf(stderr,
                         "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights; BVH depth %d, "
                         "built in %.3f s; packed %llu bytes (%.1f per triangle without images)%s; first pass "
-                        "done %.3f s after start (context, parse, BVH, upload, compile)\n",
+                        "done %.3f s after start (context, parse, BVH, upload, compile); after it %.3f s for "
+                        "%llu samples (%.3g us/sample)\n",
                         result.primitive_count, result.triangle_count, result.instance_count, result.light_count,
                         result.bvh_depth, result.bvh_build_seconds, (unsigned long long)result.packed_bytes,
                         result.triangle_count ? (double)geometry_bytes / result.triangle_count : 0.0,
-                        result.reused_scene ? ", already on the device" : "", progress.first_pass);
+                        result.reused_scene ? ", already on the device" : "", progress.first_pass,
+                        result.steady_seconds, (unsigned long long)result.steady_samples,
+                        result.steady_samples ? result.steady_seconds / (double)result.steady_samples * 1e6 : 0.0);
             }
             if (!request->quiet)
                 fprintf(stderr,

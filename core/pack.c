@@ -604,6 +604,9 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
         if (o >= 0 && !p.object_needed[o])
             continue;
         if (o >= 0) {
+            /* Every BVH's root at an even node, so that sibling pairs (at odd nodes) start
+             * on a 64-byte boundary (see node_offset). */
+            node_count += node_count % 2;
             built->node_base = (uint32_t)node_count;
             built->primitive_base = (uint32_t)primitive_count;
             node_count += built->tree.node_count;
@@ -656,7 +659,12 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     uint64_t shape_offset = info_offset + (primitive_count + 3) / 4;
     uint64_t vertex_offset = shape_offset + shape_texels;
     uint64_t uv_offset = vertex_offset + vertex_count;
+    /* A node is 32 bytes and an interior node reads its two children, first and first + 1,
+     * which are contiguous: with node_offset 2 mod 4 texels and every pair at an odd node,
+     * each pair is one 64-byte cache line instead of straddling two (the buffer itself
+     * is 64-byte aligned). */
     uint64_t node_offset = uv_offset + (vertex_count + 1) / 2;
+    node_offset += (6 - node_offset % 4) % 4;
     uint64_t instance_offset = node_offset + node_count * PACKED_NODE_STRIDE;
     uint64_t texture_offset = instance_offset + (uint64_t)p.packed_instances * PACKED_INSTANCE_STRIDE;
     uint64_t image_offset = texture_offset + (uint64_t)s->texture_count * PACKED_TEXTURE_STRIDE;

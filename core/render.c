@@ -319,6 +319,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         .samples_done = samples_resumed,
     };
     double last_checkpoint = seconds_now();
+    double first_pass_end = 0;
     bool interrupted = false;
     bool adaptive = options->pass_work_budget == 0;
     double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
@@ -348,8 +349,13 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         progress.passes++;
         progress.samples_done += report.samples_finished;
         progress.elapsed_seconds = seconds_now() - start;
-        if (progress.passes == 1)
+        if (progress.passes == 1) {
             result->first_pass_seconds = progress.elapsed_seconds;
+            first_pass_end = seconds_now();
+        } else {
+            result->steady_samples += report.samples_finished;
+            result->steady_seconds = seconds_now() - first_pass_end;
+        }
         if (options->progress != NULL)
             options->progress(options->progress_context, &progress);
         if (report.unfinished_pixels == 0)

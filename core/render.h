@@ -89,6 +89,9 @@ typedef struct render_result {
     uint64_t samples;            /* samples finished over all pixels */
     double seconds;              /* whole render, including set-up */
     double first_pass_seconds;   /* from the start until the first pass finished */
+    double steady_seconds;       /* the passes after the first (set-up and compile done) */
+    uint64_t steady_samples;     /* samples those passes finished: their ratio is the
+                                  * cost of a sample, whatever the set-up cost */
     double path_segments;        /* rays traced, counted by the shader */
     int passes;
     int bvh_depth;

@@ -29,9 +29,11 @@
 # below the core count when other work took CPU), render s (rtspheres' own time:
 # from the BVH build to the last pass, so BVH build, upload and shader compile are in it;
 # the reference: its render loop), samples/s, path segments/s (counted by the shader
-# and by the reference, one per ray from the camera or a bounce), us/sample (render s
-# less the BVH build, per sample: the build is a one-off cost, in its own column, whose
-# share would otherwise depend on the spp), BVH s, B/tri (packed bytes per triangle), first pass s (process start to the
+# and by the reference, one per ray from the camera or a bounce), us/sample (the passes
+# after the first, over the samples they finished, as rtspheres --verbose reports it: the
+# cost of a sample once set-up is done; BVH build, packing, upload and compile are
+# one-off costs with columns of their own, whose share would otherwise depend on the
+# spp), BVH s, B/tri (packed bytes per triangle), first pass s (process start to the
 # first finished pass), RSS MiB (peak resident set, the process with all its threads).
 #
 # Outputs:
@@ -151,11 +153,14 @@ bench() {
     cpu=$(field "$measured" 's/.*, \([0-9.]*\) s CPU.*/\1/p')
     rss=$(field "$measured" 's/^peak_rss: \([0-9]*\) KiB.*/\1/p')
     rss=$(awk -v k="$rss" 'BEGIN { if (k == "-") print "-"; else printf "%.0f", k / 1024 }')
-    # Time per sample from the render time less the BVH build and the sample count (not
-    # from the rounded rate).
-    per_sample=$(awk -v s="$render_seconds" -v b="$build" -v size="$size" -v spp="$spp" 'BEGIN {
-        split(size, wh, "x"); if (b == "-") b = 0
-        if (s == "-") print "-"; else printf "%.4g", (s - b) / (wh[1] * wh[2] * spp) }')
+    # Time per sample: the passes after the first over the samples they finished
+    # (rtspheres --verbose); without it, the render time less the BVH build over all
+    # samples (not from the rounded rate).
+    steady=$(field "$details" 's/.*after it \([0-9.]*\) s for \([0-9]*\) samples.*/\1 \2/p')
+    per_sample=$(awk -v s="$render_seconds" -v b="$build" -v size="$size" -v spp="$spp" -v steady="$steady" 'BEGIN {
+        split(size, wh, "x"); if (b == "-") b = 0; split(steady, st, " ")
+        if (steady != "-" && st[2] > 0) printf "%.4g", st[1] / st[2]
+        else if (s == "-") print "-"; else printf "%.4g", (s - b) / (wh[1] * wh[2] * spp) }')
     record "$name" "$size" "$spp" 1 "$triangles" "$wall" "$render_seconds" "$samples" "$segments" "$per_sample" \
         "$build" "$per_triangle" "$first" "$rss" - "$cpu" "$note"
 }
@@ -312,7 +317,7 @@ targets=$work/targets.tsv
     printf 'weekend_segments_ratio\t%s\t>=\t3\tx\tweekend path segments/s / reference path segments/s\n' \
         "$(awk -v a="$(value weekend 9)" -v b="$(value reference-weekend 9)" 'BEGIN {
             if (a == "-" || b == "-" || b <= 0) print "-"; else printf "%.3g", a / b }')"
-    printf 'mesh_time_per_sample_growth\t%s\t<=\t2.5\tx\ttime per sample mesh-%s / mesh-%s (BVH build apart)\n' \
+    printf 'mesh_time_per_sample_growth\t%s\t<=\t2.5\tx\ttime per sample mesh-%s / mesh-%s (set-up apart)\n' \
         "$(awk -v a="$(value "mesh-$last_level" 10)" -v b="$(value "mesh-$first_level" 10)" 'BEGIN {
             if (a == "-" || b == "-" || b <= 0) print "-"; else printf "%.3g", a / b }')" "$last_level" "$first_level"
     printf 'cold_start_first_pass\t%s\t<\t0.5\ts\tcold start to first pass (start-up probe, no shader cache)\n' \
@@ -326,8 +331,8 @@ targets=$work/targets.tsv
 echo
 echo "targets (ratios measured in this run):"
 awk -F '\t' '{ printf "  %-74s %7s %-2s %-3s %-2s %s\n", $6, $2, $3, $4, $5, $7 }' "$targets"
-# Counting the BVH build in (the one-off cost the growth target leaves to its own column):
-echo "  (time per sample with the BVH build in it: mesh-$last_level / mesh-$first_level = $(awk -F '\t' \
+# Counting the set-up in (the one-off costs the growth target leaves to their own columns):
+echo "  (time per sample with BVH build, packing, upload and compile in it: mesh-$last_level / mesh-$first_level = $(awk -F '\t' \
     -v a="mesh-$last_level" -v b="mesh-$first_level" '$1 == a || $1 == b {
         split($2, wh, "x"); t[$1] = $7 == "-" ? -1 : $7 / (wh[1] * wh[2] * $3) }
     END { if (t[a] > 0 && t[b] > 0) printf "%.3g", t[a] / t[b]; else print "unknown" }' "$rows"))"
