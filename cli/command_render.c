@@ -79,7 +79,7 @@ static void print_help(FILE *stream)
             "                         reach (lights, volumes, textures); the image is the same,\n"
             "                         only slower: for checking exactly that\n"
             "      --pass-budget N    fixed work units per pixel per GPU pass (default: adapted\n"
-            "                         so a pass takes about 0.25 s; the image is the same)\n"
+            "                         so a pass takes about 0.25 s, 1 s on llvmpipe; the image is the same)\n"
             "      --device N         use EGL device N (see `rtspheres info`)\n"
             "  -q, --quiet            no progress bar and no summary line\n"
             "  -v, --verbose          OpenGL debug messages and set-up details on stderr\n"

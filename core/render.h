@@ -15,7 +15,8 @@
  *     pass takes about target_pass_seconds, between 16 and 16384 units (the shader's
  *     hard cap per traversal is 60,000, under llvmpipe's 65,535). A non-zero value is
  *     used for every pass. The image does not depend on it, only the time per pass.
- *   target_pass_seconds 0.25 (short passes keep progress, Ctrl-C and GPU watchdogs happy),
+ *   target_pass_seconds 0.25 on a GPU (short passes keep progress, Ctrl-C and watchdogs
+ *     happy), 1 on a CPU rasteriser (where each pass costs a share of its time),
  *   light sampling on (next-event estimation with MIS; the image's expectation is the
  *     same without it, only the noise differs),
  *   russian_roulette_depth 4 (paths may end at random from the 5th segment on),
