@@ -213,7 +213,7 @@ std::vector<std::string> draw_chart(OIIO::ImageBuf &image, const std::vector<poi
               algo::TextAlignY::Top);
     text.draw((x0 + x1) / 2, HEIGHT - 10, "triangles (icosphere meshes, log scale)", 16, algo::TextAlignX::Center,
               algo::TextAlignY::Bottom);
-    text.draw(14, TOP - 12, "time per sample, BVH build apart (microseconds)", 16, algo::TextAlignX::Left,
+    text.draw(14, TOP - 12, "time per sample once set up: the passes after the first (microseconds)", 16, algo::TextAlignX::Left,
               algo::TextAlignY::Bottom);
     return text.fonts_work ? std::vector<std::string>{} : text.labels;
 }
