@@ -14,6 +14,9 @@ scratch=$2
 
 # Every render is tiny, so that a case that wrongly succeeds still ends at once.
 small="--size 8x8 --spp 1 --quiet"
+# Each case gets this long before it counts as a hang (generous: the sanitizer build is
+# several times slower).
+case_seconds=120
 cases="$scratch/cases"
 mkdir -p "$cases"
 
@@ -25,10 +28,12 @@ expect_bad() {
     output="$work/out.png"
     rm -f "$output"
     # shellcheck disable=SC2086 # $small is a list of options
-    "$program" render "$scene" -o "$output" $small "$@" >"$work/stdout" 2>"$work/stderr"
+    timeout -k 5 "$case_seconds" "$program" render "$scene" -o "$output" $small "$@" >"$work/stdout" 2>"$work/stderr"
     got=$?
     message=$(head -c 300 "$work/stderr" | tr '\n' ' ')
-    if [ "$got" -ge 128 ]; then
+    if [ "$got" = 124 ]; then
+        fail "$name" "hung: killed after $case_seconds s"
+    elif [ "$got" -ge 128 ]; then
         fail "$name" "crashed (exit $got): $message"
     elif [ "$got" != 2 ]; then
         fail "$name" "exit $got, expected 2: $message"
@@ -46,10 +51,12 @@ expect_bad() {
 expect_usage() {
     name=$1 pattern=$2
     shift 2
-    "$program" "$@" >"$work/stdout" 2>"$work/stderr"
+    timeout -k 5 "$case_seconds" "$program" "$@" >"$work/stdout" 2>"$work/stderr"
     got=$?
     message=$(head -c 300 "$work/stderr" | tr '\n' ' ')
-    if [ "$got" -ge 128 ]; then
+    if [ "$got" = 124 ]; then
+        fail "$name" "hung: killed after $case_seconds s"
+    elif [ "$got" -ge 128 ]; then
         fail "$name" "crashed (exit $got): $message"
     elif [ "$got" != 2 ]; then
         fail "$name" "exit $got, expected 2: $message"

@@ -54,6 +54,12 @@ range=$(channel_range "$partial" samples)
 if awk -v r="$range" 'BEGIN { split(r, v, " "); exit !(v[1] >= 0 && v[2] <= 2048 && v[1] < 2048) }'; then
     pass "partial records real per-pixel sample counts ($range)"
 else fail "partial sample counts" "samples channel range '$range'"; fi
+# Its metadata agree with the channel: samples_finished is the channel's sum.
+finished=$(metadata "$partial" samples_finished)
+channel_sum=$(awk -v m="$(channel_mean "$partial" samples)" 'BEGIN { printf "%.0f", m * 48 * 27 }')
+if [ -n "$finished" ] && [ "$finished" = "$channel_sum" ] && [ "$finished" -lt $((48 * 27 * 2048)) ]; then
+    pass "the partial's samples_finished ($finished) is the sum of its samples channel"
+else fail "the partial's samples_finished" "metadata '$finished', channel sum '$channel_sum'"; fi
 
 # SIGTERM behaves the same.
 code=$(interrupt_running TERM "$scratch/term.exr")
