@@ -153,4 +153,39 @@ moving_sphere -1 0 -5  1 0 -5  0.5 black" 7,7,9,9)
 if awk -v r="$blurred" 'BEGIN { split(r, c, " "); exit !(c[2] > 0.2 && c[2] < 0.9) }'; then
     pass "motion blur: the sweep's middle is partly covered ($blurred)"
 else fail "motion blur" "centre $blurred, expected between 0.2 and 0.9"; fi
+# Normal maps: a tangent-space map that is (0.5, 0.5, 1) everywhere, (0, 0, 1) once
+# decoded, leaves the shading normal as it is, on a sphere and on a quad, so the image
+# equals the one without a map (but for float rounding in the bilinear weights); a
+# tilted map, (0.7, 0.5, 0.714) = a normal leaning 23 degrees along the tangent, changes
+# it. The maps are EXRs rendered by rtspheres itself from a constant sky: exact floats.
+printf 'camera from 0 0 1 at 0 0 0 up 0 1 0 fov 40\nsky constant 0.5 0.5 1\n' >"$scratch/flat-map.txt"
+printf 'camera from 0 0 1 at 0 0 0 up 0 1 0 fov 40\nsky constant 0.7 0.5 0.714\n' >"$scratch/tilt-map.txt"
+if "$program" render "$scratch/flat-map.txt" -o "$scratch/flat.exr" --size 8x8 --spp 1 --quiet &&
+   "$program" render "$scratch/tilt-map.txt" -o "$scratch/tilt.exr" --size 8x8 --spp 1 --quiet; then
+    for map in none flat tilt; do
+        clause=""
+        [ $map = none ] || clause="normal_map \"$map.exr\""
+        printf 'render size 48 27 spp 16 depth 4 seed 2\ncamera from 0 1 4 at 0 0.6 0 up 0 1 0 fov 40\n%s\n%s\n%s\n%s\n%s\n%s\n%s\n' \
+            "sky gradient 1 1 1  0.3 0.5 1" "light sun -0.4 -1 -0.3 color 1 1 1 intensity 2" \
+            "material m lambertian 0.8 0.8 0.8 $clause" "material floor lambertian 0.5 0.5 0.5" \
+            "sphere 0 0.6 0 0.6 m" "quad -2 0 -1  1.6 0 0  0 1.2 0 m" "sphere 0 -100 0 100 floor" \
+            >"$scratch/normal-$map.txt"
+        "$program" render "$scratch/normal-$map.txt" -o "$scratch/normal-$map.exr" --quiet ||
+            fail "normal map render ($map)" "render failed"
+    done
+    if "$program" diff "$scratch/normal-flat.exr" "$scratch/normal-none.exr" --fail 1e-5 --failpercent 0 \
+            >"$scratch/normal.diff" 2>&1; then
+        pass "a flat normal map changes nothing ($(grep '^max error' "$scratch/normal.diff"))"
+    else
+        fail "a flat normal map changes nothing" "$(tr '\n' ' ' <"$scratch/normal.diff")"
+    fi
+    if "$program" diff "$scratch/normal-tilt.exr" "$scratch/normal-none.exr" --failpercent 5 >/dev/null 2>&1; then
+        fail "a tilted normal map changes the shading" "under 5% of pixels changed"
+    else
+        pass "a tilted normal map changes the shading"
+    fi
+else
+    fail "normal maps" "could not render the map images"
+fi
+
 finish
