@@ -1,5 +1,6 @@
 #!/bin/sh
-# Runs every test of rtspheres and ends with one line "Total: N passed, N failed".
+# Runs every test of rtspheres and ends with one line "Total: N passed, N failed, N
+# skipped" (skips: checks this machine cannot run, listed with their reasons above it).
 #   usage: tests/run.sh BUILD_DIR PROGRAM
 # Unit tests: each build/tests/test_* binary (cmocka; its own summary lines are kept).
 # Render tests: every tests/render/test-*.sh, each given PROGRAM and a scratch directory;
@@ -38,6 +39,7 @@ for script in tests/render/test-*.sh; do
     start=$(date +%s)
     if sh "$script" "$program" "$scratch/$name" >"$out" 2>&1; then status=0; else status=$?; fi
     cat "$out"
+    grep '^SKIP ' "$out" | sed "s/^SKIP /  $name: /" >>"$scratch/skipped"
     n_pass=$(grep -c '^PASS ' "$out")
     n_fail=$(grep -c '^FAIL ' "$out")
     passed=$((passed + n_pass))
@@ -67,5 +69,12 @@ if [ "$passed" = 0 ] && [ "$failed" = 0 ]; then
     exit 1
 fi
 [ -z "$failures" ] || echo "Failed:$failures"
-echo "Total: $passed passed, $failed failed"
+# Skips are checks this machine cannot run (no pseudo-terminals, no cgroups, ...): listed
+# with their reasons, never counted as passed.
+if [ -s "$scratch/skipped" ]; then
+    echo "Skipped (the environment cannot run them):"
+    cat "$scratch/skipped"
+fi
+touch "$scratch/skipped"
+echo "Total: $passed passed, $failed failed, $(wc -l <"$scratch/skipped" | tr -d ' ') skipped"
 [ "$failed" = 0 ]
