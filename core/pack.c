@@ -66,20 +66,30 @@ typedef struct vertex_list {
     uint32_t count, capacity;
 } vertex_list;
 
+/* Returns items (count used of *capacity, size bytes each) with room for one more,
+ * doubled and moved when full (*capacity updated), or NULL when memory runs out or 32-bit
+ * indices would not reach; items stays the caller's to free either way. */
+static void *grow_for_one(void *items, uint32_t count, uint32_t *capacity, size_t size)
+{
+    if (count < *capacity)
+        return items;
+    if (*capacity >= UINT32_MAX / 4)
+        return NULL;
+    uint32_t grown_capacity = *capacity ? *capacity * 2 : 64;
+    void *grown = realloc(items, (size_t)grown_capacity * size);
+    if (grown != NULL)
+        *capacity = grown_capacity;
+    return grown;
+}
+
 /* Appends a zeroed vertex; returns its index, or UINT32_MAX when memory runs out or the
  * list would pass 32-bit indices. */
 static uint32_t vertex_push(vertex_list *list)
 {
-    if (list->count == list->capacity) {
-        if (list->capacity >= UINT32_MAX / 4)
-            return UINT32_MAX;
-        uint32_t capacity = list->capacity ? list->capacity * 2 : 256;
-        pending_vertex *grown = realloc(list->items, (size_t)capacity * sizeof *grown);
-        if (grown == NULL)
-            return UINT32_MAX;
-        list->items = grown;
-        list->capacity = capacity;
-    }
+    pending_vertex *items = grow_for_one(list->items, list->count, &list->capacity, sizeof *items);
+    if (items == NULL)
+        return UINT32_MAX;
+    list->items = items;
     memset(&list->items[list->count], 0, sizeof list->items[0]);
     return list->count++;
 }
@@ -87,14 +97,10 @@ static uint32_t vertex_push(vertex_list *list)
 /* Appends an item; returns a pointer to it, or NULL when memory runs out. */
 static pending_primitive *list_push(primitive_list *list)
 {
-    if (list->count == list->capacity) {
-        uint32_t capacity = list->capacity ? list->capacity * 2 : 64;
-        pending_primitive *grown = realloc(list->items, (size_t)capacity * sizeof *grown);
-        if (grown == NULL)
-            return NULL;
-        list->items = grown;
-        list->capacity = capacity;
-    }
+    pending_primitive *items = grow_for_one(list->items, list->count, &list->capacity, sizeof *items);
+    if (items == NULL)
+        return NULL;
+    list->items = items;
     pending_primitive *item = &list->items[list->count++];
     memset(item, 0, sizeof *item);
     item->material = PACKED_NONE;
@@ -183,19 +189,37 @@ static void pending_from_shape(pending_primitive *item, const scene_shape *shape
     box_pad(&item->box);
 }
 
-/* Moves a shape by the affine m (rows x, y, z): points by m, a quad's edges by its linear
- * part, a sphere's radius by scale (the caller bakes spheres only under a uniform scale). */
-static void transform_shape(scene_shape *shape, const float m[3][4], float scale)
+/* Writes m p to out for the affine m (rows x, y, z); with translate false, only m's
+ * linear part (for an edge or other direction). */
+static void move_point(const float m[3][4], const float p[3], bool translate, float out[3])
+{
+    float q[3];
+    for (int r = 0; r < 3; r++)
+        q[r] = m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + (translate ? m[r][3] : 0.0f);
+    memcpy(out, q, sizeof q);
+}
+
+/* Writes to out the normal n moved by the transpose of inverse (the inverse of a
+ * placement), as the shader moves an instance's normals; not renormalised, so that moved
+ * normals interpolate to the moved interpolation. */
+static void move_normal(const float inverse[3][4], const float n[3], float out[3])
+{
+    float q[3];
+    for (int c = 0; c < 3; c++)
+        q[c] = inverse[0][c] * n[0] + inverse[1][c] * n[1] + inverse[2][c] * n[2];
+    memcpy(out, q, sizeof q);
+}
+
+/* Moves a shape by the affine m (rows x, y, z) whose inverse is inverse: points by m, a
+ * quad's edges by its linear part, corner normals by the inverse transpose, a sphere's
+ * radius by scale (the caller bakes spheres only under a uniform scale). */
+static void transform_shape(scene_shape *shape, const float m[3][4], const float inverse[3][4], float scale)
 {
     int points = shape->type == SHAPE_MOVING_SPHERE ? 2 : shape->type == SHAPE_SPHERE ? 1 : 3;
-    for (int k = 0; k < points; k++) {
-        bool edge = shape->type == SHAPE_QUAD && k > 0;
-        float q[3];
-        for (int r = 0; r < 3; r++)
-            q[r] = m[r][0] * shape->points[k][0] + m[r][1] * shape->points[k][1] + m[r][2] * shape->points[k][2]
-                   + (edge ? 0.0f : m[r][3]);
-        memcpy(shape->points[k], q, sizeof q);
-    }
+    for (int k = 0; k < points; k++)
+        move_point(m, shape->points[k], !(shape->type == SHAPE_QUAD && k > 0), shape->points[k]);
+    for (int corner = 0; corner < 3 && shape->has_normals; corner++)
+        move_normal(inverse, shape->normals[corner], shape->normals[corner]);
     shape->radius *= scale;
 }
 
@@ -255,8 +279,7 @@ static bvh_box transform_box(const bvh_box *box, const float m[3][4])
         float p[3] = {(corner & 1) ? box->max[0] : box->min[0], (corner & 2) ? box->max[1] : box->min[1],
                       (corner & 4) ? box->max[2] : box->min[2]};
         float q[3];
-        for (int r = 0; r < 3; r++)
-            q[r] = m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3];
+        move_point(m, p, true, q);
         box_add_point(&world, q);
     }
     box_pad(&world);
@@ -314,32 +337,24 @@ typedef struct packer {
 } packer;
 
 /* Appends the vertices of a mesh to the packer's list, moved by transform when it is not
- * NULL (normals by the inverse transpose, so that they interpolate to the normal the
- * shader would compute for the placed mesh). Returns the index of the first one in
- * *first, or an error. */
-static rt_status add_mesh_vertices(packer *p, const scene_mesh *mesh, const float (*transform)[4], uint32_t *first,
-                                   rt_error *error)
+ * NULL (normals by the inverse transpose, inverse being transform's inverse). Returns the
+ * index of the first one in *first, or an error. */
+static rt_status add_mesh_vertices(packer *p, const scene_mesh *mesh, const float (*transform)[4],
+                                   const float (*inverse)[4], uint32_t *first, rt_error *error)
 {
-    float inverse[3][4];
-    if (transform != NULL && !invert_affine(transform, inverse))
-        return rt_error_set(error, RT_ERROR_INPUT, "PACK: a placement of mesh '%s' cannot be inverted", mesh->path);
     *first = p->vertices.count;
     for (int v = 0; v < mesh->vertex_count; v++) {
         uint32_t index = vertex_push(&p->vertices);
         if (index == UINT32_MAX)
             return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory for the vertices of '%s'", mesh->path);
         pending_vertex *vertex = &p->vertices.items[index];
-        const float *position = mesh->positions + 3 * (size_t)v;
-        for (int r = 0; r < 3; r++)
-            vertex->position[r] = transform == NULL ? position[r]
-                                                    : transform[r][0] * position[0] + transform[r][1] * position[1]
-                                                          + transform[r][2] * position[2] + transform[r][3];
+        memcpy(vertex->position, mesh->positions + 3 * (size_t)v, sizeof vertex->position);
+        if (transform != NULL)
+            move_point(transform, vertex->position, true, vertex->position);
         if (mesh->normals != NULL) {
-            const float *normal = mesh->normals + 3 * (size_t)v;
-            for (int c = 0; c < 3; c++)
-                vertex->normal[c] = transform == NULL ? normal[c]
-                                                      : inverse[0][c] * normal[0] + inverse[1][c] * normal[1]
-                                                            + inverse[2][c] * normal[2];
+            memcpy(vertex->normal, mesh->normals + 3 * (size_t)v, sizeof vertex->normal);
+            if (transform != NULL)
+                move_normal(inverse, vertex->normal, vertex->normal);
             vertex->has_normal = dot3(vertex->normal, vertex->normal) > 0;
         }
         if (mesh->uvs != NULL)
@@ -410,6 +425,10 @@ static rt_status add_object_primitives(packer *p, int index, int override, primi
     const scene_object *object = &s->objects[index];
     const float (*transform)[4] = baked_instance >= 0 ? s->instances[baked_instance].object_to_world : NULL;
     float scale = transform != NULL ? uniform_scale(transform) : 1.0f;
+    float inverse[3][4];
+    if (transform != NULL && !invert_affine(transform, inverse))
+        return rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d has a transform that cannot be inverted",
+                            baked_instance);
     if (object->mesh >= 0) {
         const scene_mesh *mesh = &s->meshes[object->mesh];
         if (mesh->positions == NULL && mesh->triangle_count > 0)
@@ -420,7 +439,7 @@ static rt_status add_object_primitives(packer *p, int index, int override, primi
         if (transform == NULL && p->mesh_first_vertex[object->mesh] != UINT32_MAX) {
             first = p->mesh_first_vertex[object->mesh];
         } else {
-            rt_status status = add_mesh_vertices(p, mesh, transform, &first, error);
+            rt_status status = add_mesh_vertices(p, mesh, transform, (const float (*)[4])inverse, &first, error);
             if (status != RT_OK)
                 return status;
             if (transform == NULL)
@@ -436,23 +455,10 @@ static rt_status add_object_primitives(packer *p, int index, int override, primi
         }
         return RT_OK;
     }
-    float inverse[3][4];
-    if (transform != NULL && !invert_affine(transform, inverse))
-        return rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d has a transform that cannot be inverted",
-                            baked_instance);
     for (int k = 0; k < object->shape_count; k++) {
         scene_shape shape = s->shapes[object->first_shape + k];
-        if (transform != NULL) {
-            transform_shape(&shape, transform, scale);
-            /* Corner normals move by the inverse transpose, as a mesh's do. */
-            for (int corner = 0; corner < 3 && shape.has_normals; corner++) {
-                float moved[3];
-                for (int c = 0; c < 3; c++)
-                    moved[c] = inverse[0][c] * shape.normals[corner][0] + inverse[1][c] * shape.normals[corner][1]
-                               + inverse[2][c] * shape.normals[corner][2];
-                memcpy(shape.normals[corner], moved, sizeof moved);
-            }
-        }
+        if (transform != NULL)
+            transform_shape(&shape, transform, (const float (*)[4])inverse, scale);
         pending_primitive *item = list_push(list);
         if (item == NULL)
             return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");

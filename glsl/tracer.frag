@@ -843,8 +843,6 @@ uint choose_light(float u)
     return low;
 }
 
-// Solid-angle density, seen from p, of the direction light sampling would pick towards
-// point x on the light (normal n there). Spheres are sampled by their visible cone.
 // The light record head of an area light and its primitive's geometry (sphere: centre
 // and radius in a; quad and triangle: corner in a, edges in b and c).
 void area_light_geometry(uint light, out uvec4 head, out vec4 a, out vec4 b, out vec4 c)
@@ -873,11 +871,11 @@ uint area_light_of(uint slot)
                                                                                                            : NONE;
 }
 
-float light_direction_pdf(uint light, vec3 p, vec3 x, vec3 n)
+// Solid-angle density, seen from p, of the direction light sampling would pick towards
+// point x on area light (normal n there), given its record head and geometry. Spheres
+// are sampled by their visible cone.
+float area_light_pdf(uvec4 head, vec4 a, vec4 edge1, vec4 edge2, vec3 p, vec3 x, vec3 n)
 {
-    uvec4 head;
-    vec4 a, edge1, edge2;
-    area_light_geometry(light, head, a, edge1, edge2);
     if (head.x == uint(LIGHT_SPHERE)) {
         float distance_squared = dot(a.xyz - p, a.xyz - p);
         if (distance_squared <= a.w * a.w)
@@ -890,6 +888,15 @@ float light_direction_pdf(uint light, vec3 p, vec3 x, vec3 n)
     float distance_squared = dot(to_light, to_light);
     float cosine = abs(dot(n, to_light)) * inversesqrt(distance_squared);
     return cosine > 1e-8 ? distance_squared / (cosine * area) : 0.0;
+}
+
+// The same by light index.
+float light_direction_pdf(uint light, vec3 p, vec3 x, vec3 n)
+{
+    uvec4 head;
+    vec4 a, edge1, edge2;
+    area_light_geometry(light, head, a, edge1, edge2);
+    return area_light_pdf(head, a, edge1, edge2, p, x, n);
 }
 
 // A direction from p towards a point on light (u uniform): the direction, the distance to
@@ -939,7 +946,7 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
         if (distance < 1e-12)
             return false;
         direction = to_light / distance;
-        pdf = light_direction_pdf(light, p, x, n);
+        pdf = area_light_pdf(head, a, edge1, edge2, p, x, n);   // the geometry is at hand
         if (pdf == 0.0)
             return false;
     }

@@ -36,3 +36,11 @@ metadata() {
 within() {
     awk -v v="$1" -v e="$2" -v r="$3" 'BEGIN { d = v - e; if (d < 0) d = -d; a = e < 0 ? -e : e; exit !(v != "" && d <= r * a) }'
 }
+
+# files_are NAME DIR EXPECTED: passes when the names in DIR, sorted and space-separated,
+# are EXPECTED (no other file, no temporary left behind).
+files_are() {
+    got=$(ls -A "$2" | sort | tr '\n' ' ' | sed 's/ $//')
+    if [ "$got" = "$3" ]; then pass "$1"
+    else fail "$1" "files '$got', expected '$3'"; fi
+}

@@ -21,14 +21,6 @@ same() {
     fi
 }
 
-# files_are NAME DIR EXPECTED: the names in DIR, sorted and space-separated, are EXPECTED
-# (no other file, no temporary left behind).
-files_are() {
-    got=$(ls -A "$2" | sort | tr '\n' ' ' | sed 's/ $//')
-    if [ "$got" = "$3" ]; then pass "$1"
-    else fail "$1" "files '$got', expected '$3'"; fi
-}
-
 # usage_error NAME PATTERN ARGS...: `render ARGS` exits 2, says PATTERN (grep -E) on stderr
 # and writes nothing into $scratch/refused.
 usage_error() {

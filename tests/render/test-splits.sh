@@ -39,13 +39,6 @@ merged_equals() {
     fi
 }
 
-# files_are NAME DIR EXPECTED: the sorted names in DIR are exactly EXPECTED.
-files_are() {
-    got=$(ls -A "$2" | sort | tr '\n' ' ' | sed 's/ $//')
-    if [ "$got" = "$3" ]; then pass "$1"
-    else fail "$1" "files '$got', expected '$3'"; fi
-}
-
 # usage_error NAME PATTERN ARGS...: `render ARGS` (the test scene, size and spp, output
 # $scratch/refused/out.exr or a pattern there) exits 2, says PATTERN (grep -E) on stderr
 # and writes nothing.
