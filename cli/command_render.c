@@ -12,10 +12,10 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "batch.h"
+#include "clock.h"
 #include "commands.h"
 #include "gpu.h"
 #include "image_io.h"
@@ -151,20 +151,13 @@ typedef struct progress_state {
     double first_pass;           /* seconds from the command's start to the first pass's end */
 } progress_state;
 
-static double monotonic_seconds(void)
-{
-    struct timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    return now.tv_sec + now.tv_nsec * 1e-9;
-}
-
 static double command_start_seconds;
 
 static void draw_progress(void *context, const render_progress *progress)
 {
     progress_state *state = context;
     if (progress->passes == 1)
-        state->first_pass = monotonic_seconds() - state->command_start;
+        state->first_pass = clock_seconds() - state->command_start;
     if (!state->tty || progress->samples_total == 0)
         return;
     double fraction = (double)progress->samples_done / (double)progress->samples_total;
@@ -967,7 +960,7 @@ static int render_frame(gpu_context *context, const render_request *request, int
 
 int command_render(int argc, char **argv)
 {
-    command_start_seconds = monotonic_seconds();
+    command_start_seconds = clock_seconds();
     render_request request = {.seed = -1, .device = -1};
     bool help_shown = false;
     int exit_code = parse_arguments(argc, argv, &request, &help_shown);
@@ -1008,8 +1001,7 @@ int command_render(int argc, char **argv)
     if (request.frames.count == 0) {
         exit_code = render_frame(context, &request, -1, request.output);
     } else {
-        struct timespec start, end;
-        clock_gettime(CLOCK_MONOTONIC, &start);
+        double start = clock_seconds();
         int rendered = 0;
         for (int i = 0; i < request.frames.count && exit_code == EXIT_OK && !stop_requested; i++) {
             if (request.shard_count && strcmp(request.shard_by, "frames") == 0 && i % request.shard_count != request.shard_index)
@@ -1031,8 +1023,7 @@ int command_render(int argc, char **argv)
             exit_code = render_frame(context, &request, request.frames.frames[i], name);
             rendered++;
         }
-        clock_gettime(CLOCK_MONOTONIC, &end);
-        double seconds = (double)(end.tv_sec - start.tv_sec) + (end.tv_nsec - start.tv_nsec) * 1e-9;
+        double seconds = clock_seconds() - start;
         if (stop_requested && exit_code == EXIT_OK)
             exit_code = EXIT_RUNTIME;
         if (!request.quiet && rendered > 0)

@@ -1,6 +1,7 @@
 /* batch.c: see batch.h. */
 #include "batch.h"
 
+#include "array.h"
 #include "expression.h"
 
 #include <ctype.h>
@@ -30,7 +31,7 @@ static int read_number(const char **cursor, long *value)
 }
 
 /* Appends frame to the list, refusing duplicates and overlong lists. */
-static rt_status append_frame(frame_list *list, int *capacity, long frame, const char *item, int item_length,
+static rt_status append_frame(frame_list *list, size_t *capacity, long frame, const char *item, int item_length,
                               rt_error *error)
 {
     for (int i = 0; i < list->count; i++)
@@ -39,14 +40,8 @@ static rt_status append_frame(frame_list *list, int *capacity, long frame, const
                                 item_length, item);
     if (list->count == BATCH_MAX_FRAMES)
         return rt_error_set(error, RT_ERROR_INPUT, "frames: more than %d frames", BATCH_MAX_FRAMES);
-    if (list->count == *capacity) {
-        int grown_capacity = *capacity ? *capacity * 2 : 64;
-        int *grown = realloc(list->frames, (size_t)grown_capacity * sizeof *grown);
-        if (grown == NULL)
-            return rt_error_set(error, RT_ERROR_RUNTIME, "frames: out of memory");
-        list->frames = grown;
-        *capacity = grown_capacity;
-    }
+    if (!array_reserve((void **)&list->frames, capacity, (size_t)list->count + 1, sizeof *list->frames))
+        return rt_error_set(error, RT_ERROR_RUNTIME, "frames: out of memory");
     list->frames[list->count++] = (int)frame;
     return RT_OK;
 }
@@ -55,7 +50,7 @@ rt_status frame_list_parse(const char *text, frame_list *out, rt_error *error)
 {
     out->frames = NULL;
     out->count = 0;
-    int capacity = 0;
+    size_t capacity = 0;
     const char *p = text;
     if (*p == '\0')
         return rt_error_set(error, RT_ERROR_INPUT, "frames: the list is empty (e.g. 1-60 or 1-10,15,20-30:2)");

@@ -84,28 +84,6 @@ typedef struct split_plane {
     double cost;                   /* not divided by the node's metric (see choose_split()) */
 } split_plane;
 
-/* Returns the box that contains nothing: min +inf, max -inf, so that growing it by any box
- * gives that box. */
-static bvh_box empty_box(void)
-{
-    bvh_box box;
-    for (int axis = 0; axis < 3; axis++) {
-        box.min[axis] = INFINITY;
-        box.max[axis] = -INFINITY;
-    }
-    return box;
-}
-
-/* Grows *box to also contain *other. Plain comparisons rather than fminf()/fmaxf(): the
- * boxes hold no NaN (checked on input), and those are library calls unless inlined. */
-static void grow_box(bvh_box *box, const bvh_box *other)
-{
-    for (int axis = 0; axis < 3; axis++) {
-        box->min[axis] = other->min[axis] < box->min[axis] ? other->min[axis] : box->min[axis];
-        box->max[axis] = other->max[axis] > box->max[axis] ? other->max[axis] : box->max[axis];
-    }
-}
-
 /* Returns how expensive it is to have a ray enter *box, measured as its surface area, or as
  * the sum of its edge lengths when by_edge_length is set (for nodes of zero area, where a
  * line of boxes would make every area zero and the SAH blind). Computed in double because
@@ -196,10 +174,10 @@ static rt_status check_boxes(const bvh_box *boxes, uint32_t count, rt_error *err
 static void bound_items(const build_item *items, uint32_t begin, uint32_t end,
                         bvh_box *box, bvh_box *centroid_box)
 {
-    *box = empty_box();
-    *centroid_box = empty_box();
+    *box = bvh_box_empty();
+    *centroid_box = bvh_box_empty();
     for (uint32_t i = begin; i < end; i++) {
-        grow_box(box, &items[i].box);
+        bvh_box_grow(box, &items[i].box);
         for (int axis = 0; axis < 3; axis++) {
             float centroid = items[i].centroid[axis];
             centroid_box->min[axis] = centroid < centroid_box->min[axis] ? centroid : centroid_box->min[axis];
@@ -230,24 +208,24 @@ static bool choose_split(const build_item *items, uint32_t begin, uint32_t end,
         double scale = bin_count / extent;
 
         for (int bin = 0; bin < bin_count; bin++) {
-            scratch->bins[bin].box = empty_box();
+            scratch->bins[bin].box = bvh_box_empty();
             scratch->bins[bin].count = 0;
         }
         for (uint32_t i = begin; i < end; i++) {
             sah_bin *bin = &scratch->bins[bin_of(items[i].centroid[axis], origin, scale, bin_count)];
-            grow_box(&bin->box, &items[i].box);
+            bvh_box_grow(&bin->box, &items[i].box);
             bin->count++;
         }
 
         /* Right to left: what the right side costs for each plane, before bin i. An empty
          * bin changes nothing, so it reuses the value of the bin after it (this matters
          * for small nodes with many bins, most of them empty). */
-        bvh_box right_box = empty_box();
+        bvh_box right_box = bvh_box_empty();
         uint32_t right_count = 0;
         double right_weighted_area = 0;
         for (int bin = bin_count - 1; bin > 0; bin--) {
             if (scratch->bins[bin].count > 0) {
-                grow_box(&right_box, &scratch->bins[bin].box);
+                bvh_box_grow(&right_box, &scratch->bins[bin].box);
                 right_count += scratch->bins[bin].count;
                 right_weighted_area = box_metric(&right_box, by_edge_length) * right_count;
             }
@@ -257,12 +235,12 @@ static bool choose_split(const build_item *items, uint32_t begin, uint32_t end,
 
         /* Left to right: add the left side and keep the cheapest plane with both sides full.
          * The plane after an empty bin splits like the plane before it, so it is skipped. */
-        bvh_box left_box = empty_box();
+        bvh_box left_box = bvh_box_empty();
         uint32_t left_count = 0;
         for (int bin = 0; bin < bin_count - 1; bin++) {
             if (scratch->bins[bin].count == 0)
                 continue;
-            grow_box(&left_box, &scratch->bins[bin].box);
+            bvh_box_grow(&left_box, &scratch->bins[bin].box);
             left_count += scratch->bins[bin].count;
             if (scratch->right_count[bin + 1] == 0)
                 break;
@@ -316,7 +294,7 @@ static rt_status build_empty(bvh *out, rt_error *error)
     out->nodes = malloc(sizeof *out->nodes);
     if (out->nodes == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "BVH: out of memory for the empty tree");
-    out->nodes[0] = (bvh_node){.box = empty_box(), .first = 0, .count = 0};
+    out->nodes[0] = (bvh_node){.box = bvh_box_empty(), .first = 0, .count = 0};
     out->node_count = 1;
     return RT_OK;
 }

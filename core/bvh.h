@@ -18,6 +18,7 @@
 #ifndef RT_BVH_H
 #define RT_BVH_H
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -27,6 +28,34 @@ typedef struct bvh_box {
     float min[3];
     float max[3];
 } bvh_box;
+
+/* The box API (the one box type of the code base; the packer uses it too). */
+
+/* Returns the box that contains nothing: min +inf, max -inf, so that growing it by any box
+ * or point gives that box or point. */
+static inline bvh_box bvh_box_empty(void)
+{
+    return (bvh_box){{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+}
+
+/* Grows *box to also contain *other. Plain comparisons rather than fminf()/fmaxf(): boxes
+ * hold no NaN (checked on input), and those are library calls unless inlined. */
+static inline void bvh_box_grow(bvh_box *box, const bvh_box *other)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        box->min[axis] = other->min[axis] < box->min[axis] ? other->min[axis] : box->min[axis];
+        box->max[axis] = other->max[axis] > box->max[axis] ? other->max[axis] : box->max[axis];
+    }
+}
+
+/* Grows *box to also contain point p. */
+static inline void bvh_box_add_point(bvh_box *box, const float p[3])
+{
+    for (int axis = 0; axis < 3; axis++) {
+        box->min[axis] = p[axis] < box->min[axis] ? p[axis] : box->min[axis];
+        box->max[axis] = p[axis] > box->max[axis] ? p[axis] : box->max[axis];
+    }
+}
 
 typedef struct bvh_build_config {
     int max_leaf_size;

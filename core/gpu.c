@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hash.h"
 #include "scene.h"
 #include "shader_sources.h"
 
@@ -552,18 +553,6 @@ static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *
     return RT_OK;
 }
 
-/* FNV-1a over the packed texels: tells an unchanged scene between frames. */
-static uint64_t hash_texels(const uint32_t *texels, uint32_t texel_count)
-{
-    uint64_t hash = 0xcbf29ce484222325ull;
-    const uint32_t *end = texels + (size_t)texel_count * 4;
-    for (const uint32_t *p = texels; p < end; p++) {
-        hash ^= *p;
-        hash *= 0x100000001b3ull;
-    }
-    return hash;
-}
-
 /* Uploads the packed scene into a buffer object read through an RGBA32UI buffer texture
  * (usamplerBuffer), checked against GL_MAX_TEXTURE_BUFFER_SIZE. A buffer texture rather
  * than a 2D one because a fetch from it is a bounds check and a load: on llvmpipe a 2D
@@ -734,7 +723,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->width = parameters->width;
     tracer->height = parameters->height;
     rt_status status = build_program(tracer, parameters, error);
-    uint64_t hash = hash_texels(packed_texels, texel_count);
+    uint64_t hash = hash_bytes(HASH_START, packed_texels, (size_t)texel_count * 16u);
     if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == hash
         && context->packed_texel_count == texel_count) {
         tracer->packed_texture = context->packed_texture;

@@ -1,6 +1,8 @@
 /* merge.c: see merge.h. */
 #include "merge.h"
 
+#include "array.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -24,9 +26,11 @@ typedef struct region {
 
 struct merger {
     part_record *parts;
-    int part_count, part_capacity;
+    int part_count;
+    size_t part_capacity;
     region *regions;
-    int region_count, region_capacity;
+    int region_count;
+    size_t region_capacity;
     int full_width, full_height;
     /* Per pixel of the full image: R*n, G*n, B*n, n, summed over the parts in double. */
     double *sums;
@@ -165,23 +169,6 @@ static rt_status place_part(const merger *m, const char *name, const rt_image *i
     return RT_OK;
 }
 
-/* Grows *array (of element_size bytes each) so it holds at least needed elements.
- * Returns false when memory runs out; the array is then unchanged. */
-static bool reserve(void **array, int *capacity, int needed, size_t element_size)
-{
-    if (needed <= *capacity)
-        return true;
-    int grown = *capacity ? *capacity * 2 : 16;
-    if (grown < needed)
-        grown = needed;
-    void *bigger = realloc(*array, (size_t)grown * element_size);
-    if (bigger == NULL)
-        return false;
-    *array = bigger;
-    *capacity = grown;
-    return true;
-}
-
 rt_status merger_add(merger *m, const char *name, const rt_image *image, const merge_metadata *metadata,
                      rt_error *error)
 {
@@ -231,8 +218,10 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
 
     /* Everything that can fail for lack of memory happens before the merger changes. */
     char *name_copy = strdup(name);
-    if (name_copy == NULL || !reserve((void **)&m->parts, &m->part_capacity, m->part_count + 1, sizeof *m->parts)
-        || !reserve((void **)&m->regions, &m->region_capacity, m->region_count + 1, sizeof *m->regions)) {
+    if (name_copy == NULL
+        || !array_reserve((void **)&m->parts, &m->part_capacity, (size_t)m->part_count + 1, sizeof *m->parts)
+        || !array_reserve((void **)&m->regions, &m->region_capacity, (size_t)m->region_count + 1,
+                          sizeof *m->regions)) {
         free(name_copy);
         return rt_error_set(error, RT_ERROR_RUNTIME, "MERGE: out of memory");
     }

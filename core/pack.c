@@ -4,7 +4,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+
+#include "array.h"
+#include "clock.h"
 
 pack_options pack_options_defaults(void)
 {
@@ -28,13 +30,6 @@ static float bits_float(uint32_t bits)
 static float dot3(const float a[3], const float b[3]);
 static void cross3(const float a[3], const float b[3], float out[3]);
 
-static double seconds_now(void)
-{
-    struct timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    return now.tv_sec + now.tv_nsec * 1e-9;
-}
-
 /* ---- primitives before packing ------------------------------------------------------- */
 
 /* One primitive on its way into a BVH: what to write and its bounding box. */
@@ -50,7 +45,8 @@ typedef struct pending_primitive {
 
 typedef struct primitive_list {
     pending_primitive *items;
-    uint32_t count, capacity;
+    uint32_t count;
+    size_t capacity;
 } primitive_list;
 
 /* A triangle vertex on its way into the vertex section. */
@@ -63,33 +59,20 @@ typedef struct pending_vertex {
 
 typedef struct vertex_list {
     pending_vertex *items;
-    uint32_t count, capacity;
+    uint32_t count;
+    size_t capacity;
 } vertex_list;
 
-/* Returns items (count used of *capacity, size bytes each) with room for one more,
- * doubled and moved when full (*capacity updated), or NULL when memory runs out or 32-bit
- * indices would not reach; items stays the caller's to free either way. */
-static void *grow_for_one(void *items, uint32_t count, uint32_t *capacity, size_t size)
-{
-    if (count < *capacity)
-        return items;
-    if (*capacity >= UINT32_MAX / 4)
-        return NULL;
-    uint32_t grown_capacity = *capacity ? *capacity * 2 : 64;
-    void *grown = realloc(items, (size_t)grown_capacity * size);
-    if (grown != NULL)
-        *capacity = grown_capacity;
-    return grown;
-}
+/* Lists stop well short of 32-bit indices, which the packed records use. */
+#define PACK_LIST_LIMIT (UINT32_MAX / 4)
 
 /* Appends a zeroed vertex; returns its index, or UINT32_MAX when memory runs out or the
  * list would pass 32-bit indices. */
 static uint32_t vertex_push(vertex_list *list)
 {
-    pending_vertex *items = grow_for_one(list->items, list->count, &list->capacity, sizeof *items);
-    if (items == NULL)
+    if (list->count >= PACK_LIST_LIMIT
+        || !array_reserve((void **)&list->items, &list->capacity, (size_t)list->count + 1, sizeof *list->items))
         return UINT32_MAX;
-    list->items = items;
     memset(&list->items[list->count], 0, sizeof list->items[0]);
     return list->count++;
 }
@@ -97,31 +80,14 @@ static uint32_t vertex_push(vertex_list *list)
 /* Appends an item; returns a pointer to it, or NULL when memory runs out. */
 static pending_primitive *list_push(primitive_list *list)
 {
-    pending_primitive *items = grow_for_one(list->items, list->count, &list->capacity, sizeof *items);
-    if (items == NULL)
+    if (list->count >= PACK_LIST_LIMIT
+        || !array_reserve((void **)&list->items, &list->capacity, (size_t)list->count + 1, sizeof *list->items))
         return NULL;
-    list->items = items;
     pending_primitive *item = &list->items[list->count++];
     memset(item, 0, sizeof *item);
     item->material = PACKED_NONE;
     item->instance = PACKED_NONE;
     return item;
-}
-
-static void box_empty(bvh_box *box)
-{
-    for (int axis = 0; axis < 3; axis++) {
-        box->min[axis] = INFINITY;
-        box->max[axis] = -INFINITY;
-    }
-}
-
-static void box_add_point(bvh_box *box, const float p[3])
-{
-    for (int axis = 0; axis < 3; axis++) {
-        box->min[axis] = fminf(box->min[axis], p[axis]);
-        box->max[axis] = fmaxf(box->max[axis], p[axis]);
-    }
 }
 
 /* Pads a box by a few float steps: corners computed in float round, and a box that cuts
@@ -147,7 +113,7 @@ static void sphere_box(bvh_box *box, const float center[3], float radius)
 static void pending_from_shape(pending_primitive *item, const scene_shape *shape, uint32_t material)
 {
     item->material = material;
-    box_empty(&item->box);
+    item->box = bvh_box_empty();
     const float (*p)[3] = shape->points;
     switch (shape->type) {
     case SHAPE_SPHERE:
@@ -172,7 +138,7 @@ static void pending_from_shape(pending_primitive *item, const scene_shape *shape
             item->data[2][axis] = p[2][axis] - p[0][axis];
         }
         for (int k = 0; k < 3; k++)
-            box_add_point(&item->box, p[k]);
+            bvh_box_add_point(&item->box, p[k]);
         break;
     case SHAPE_QUAD:
         item->type = PRIMITIVE_QUAD;
@@ -182,7 +148,7 @@ static void pending_from_shape(pending_primitive *item, const scene_shape *shape
             float q[3];
             for (int axis = 0; axis < 3; axis++)
                 q[axis] = p[0][axis] + ((corner & 1) ? p[1][axis] : 0) + ((corner & 2) ? p[2][axis] : 0);
-            box_add_point(&item->box, q);
+            bvh_box_add_point(&item->box, q);
         }
         break;
     }
@@ -273,14 +239,13 @@ static float uniform_scale(const float m[3][4])
 /* The world box of an object box under object_to_world (its 8 corners transformed). */
 static bvh_box transform_box(const bvh_box *box, const float m[3][4])
 {
-    bvh_box world;
-    box_empty(&world);
+    bvh_box world = bvh_box_empty();
     for (int corner = 0; corner < 8; corner++) {
         float p[3] = {(corner & 1) ? box->max[0] : box->min[0], (corner & 2) ? box->max[1] : box->min[1],
                       (corner & 4) ? box->max[2] : box->min[2]};
         float q[3];
         move_point(m, p, true, q);
-        box_add_point(&world, q);
+        bvh_box_add_point(&world, q);
     }
     box_pad(&world);
     return world;
@@ -304,9 +269,9 @@ static rt_status build_tree(built_tree *built, const pack_options *options, doub
         return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
     for (uint32_t i = 0; i < count; i++)
         boxes[i] = built->primitives.items[i].box;
-    double start = seconds_now();
+    double start = clock_seconds();
     rt_status status = bvh_build(boxes, count, options->bvh_config, &built->tree, error);
-    *seconds += seconds_now() - start;
+    *seconds += clock_seconds() - start;
     free(boxes);
     return status;
 }

@@ -5,9 +5,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "camera.h"
+#include "clock.h"
+#include "hash.h"
 #include "pack.h"
 
 #define INITIAL_ADAPTIVE_BUDGET 64
@@ -24,24 +25,6 @@
 render_options render_options_defaults(void)
 {
     return (render_options){0};
-}
-
-/* FNV-1a, 64-bit, continued from hash over size bytes. */
-static uint64_t hash_bytes(uint64_t hash, const void *data, size_t size)
-{
-    const unsigned char *bytes = data;
-    for (size_t i = 0; i < size; i++) {
-        hash ^= bytes[i];
-        hash *= 0x100000001b3ull;
-    }
-    return hash;
-}
-
-static double seconds_now(void)
-{
-    struct timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    return now.tv_sec + now.tv_nsec * 1e-9;
 }
 
 /* Fills the tracer's parameters from the scene, its camera frame and the options. */
@@ -238,7 +221,7 @@ static float *resume_sums(const rt_image *partial, int width, int height, uint32
 rt_status render_scene(gpu_context *context, const scene *s, const render_options *options,
                        render_result *result, rt_error *error)
 {
-    double start = seconds_now();
+    double start = clock_seconds();
     memset(result, 0, sizeof *result);
     render_options defaults = render_options_defaults();
     if (options == NULL)
@@ -273,7 +256,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     result->primitive_count = packed.primitive_count;
     result->instance_count = packed.instance_count;
     result->light_count = packed.light_count;
-    uint64_t hash = 0xcbf29ce484222325ull;
+    uint64_t hash = HASH_START;
     hash = hash_bytes(hash, packed.texels, (size_t)packed.texel_count * 16u);
     hash = hash_bytes(hash, &frame, sizeof frame);
     hash = hash_bytes(hash, &s->sky.type, sizeof s->sky.type);
@@ -323,7 +306,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         .samples_total = (uint64_t)width * height * s->render.samples_per_pixel,
         .samples_done = samples_resumed,
     };
-    double last_checkpoint = seconds_now();
+    double last_checkpoint = clock_seconds();
     double first_pass_end = 0;
     bool interrupted = false;
     bool adaptive = options->pass_work_budget == 0;
@@ -337,14 +320,14 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
                                                                                : MAXIMUM_ADAPTIVE_BUDGET;
     for (;;) {
         gpu_pass_report report;
-        double pass_start = seconds_now();
+        double pass_start = clock_seconds();
         status = gpu_tracer_run_pass(tracer, &report, error);
         if (status != RT_OK)
             break;
         if (adaptive) {
             /* Pass time grows roughly linearly with the budget; move towards the target
              * by at most a factor of 4 per pass so one odd pass cannot swing it far. */
-            double pass_seconds = seconds_now() - pass_start;
+            double pass_seconds = clock_seconds() - pass_start;
             double scale = pass_seconds > 0 ? target_seconds / pass_seconds : 4.0;
             scale = scale < 0.5 ? 0.5 : scale > 4.0 ? 4.0 : scale;
             budget *= scale;
@@ -354,13 +337,13 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         }
         progress.passes++;
         progress.samples_done += report.samples_finished;
-        progress.elapsed_seconds = seconds_now() - start;
+        progress.elapsed_seconds = clock_seconds() - start;
         if (progress.passes == 1) {
             result->first_pass_seconds = progress.elapsed_seconds;
-            first_pass_end = seconds_now();
+            first_pass_end = clock_seconds();
         } else {
             result->steady_samples += report.samples_finished;
-            result->steady_seconds = seconds_now() - first_pass_end;
+            result->steady_seconds = clock_seconds() - first_pass_end;
         }
         if (options->progress != NULL)
             options->progress(options->progress_context, &progress);
@@ -371,7 +354,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
             break;
         }
         if (options->checkpoint != NULL && options->checkpoint_seconds > 0
-            && seconds_now() - last_checkpoint >= options->checkpoint_seconds) {
+            && clock_seconds() - last_checkpoint >= options->checkpoint_seconds) {
             rt_image partial;
             uint64_t partial_samples;
             status = read_image(tracer, width, height, &partial, NULL, NULL, &partial_samples, error);
@@ -382,7 +365,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
             image_free(&partial);
             if (status != RT_OK)
                 break;
-            last_checkpoint = seconds_now();
+            last_checkpoint = clock_seconds();
         }
     }
 
@@ -416,7 +399,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
 
     result->passes = progress.passes;
     result->path_segments = totals.path_segments;
-    result->seconds = seconds_now() - start;
+    result->seconds = clock_seconds() - start;
     if (interrupted)
         return rt_error_set(error, RT_ERROR_INTERRUPTED, "RENDER: interrupted after %llu of %llu samples",
                             (unsigned long long)result->samples, (unsigned long long)progress.samples_total);

@@ -1,6 +1,8 @@
 /* scene.c: see scene.h. */
 #include "scene.h"
 
+#include "array.h"
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -48,24 +50,10 @@ void scene_free(scene *s)
     scene_defaults(s);
 }
 
-/* Grows *array (of element_size bytes each) so that one more element fits.
- * Returns 0 on success, -1 when memory runs out (the array is then unchanged). */
-static int grow(void **array, int count, int *capacity, size_t element_size)
-{
-    if (count < *capacity)
-        return 0;
-    int new_capacity = *capacity ? *capacity * 2 : 16;
-    void *grown = realloc(*array, (size_t)new_capacity * element_size);
-    if (grown == NULL)
-        return -1;
-    *array = grown;
-    *capacity = new_capacity;
-    return 0;
-}
 
 int scene_add_material(scene *s, const scene_material *material)
 {
-    if (grow((void **)&s->materials, s->material_count, &s->material_capacity, sizeof *material))
+    if (!array_reserve((void **)&s->materials, &s->material_capacity, (size_t)s->material_count + 1, sizeof *material))
         return -1;
     s->materials[s->material_count] = *material;
     return s->material_count++;
@@ -73,7 +61,7 @@ int scene_add_material(scene *s, const scene_material *material)
 
 int scene_add_sphere(scene *s, const scene_sphere *sphere)
 {
-    if (grow((void **)&s->spheres, s->sphere_count, &s->sphere_capacity, sizeof *sphere))
+    if (!array_reserve((void **)&s->spheres, &s->sphere_capacity, (size_t)s->sphere_count + 1, sizeof *sphere))
         return -1;
     s->spheres[s->sphere_count] = *sphere;
     return s->sphere_count++;
@@ -81,7 +69,7 @@ int scene_add_sphere(scene *s, const scene_sphere *sphere)
 
 int scene_add_shape(scene *s, const scene_shape *shape)
 {
-    if (grow((void **)&s->shapes, s->shape_count, &s->shape_capacity, sizeof *shape))
+    if (!array_reserve((void **)&s->shapes, &s->shape_capacity, (size_t)s->shape_count + 1, sizeof *shape))
         return -1;
     s->shapes[s->shape_count] = *shape;
     return s->shape_count++;
@@ -89,7 +77,7 @@ int scene_add_shape(scene *s, const scene_shape *shape)
 
 int scene_add_object(scene *s, const scene_object *object)
 {
-    if (grow((void **)&s->objects, s->object_count, &s->object_capacity, sizeof *object))
+    if (!array_reserve((void **)&s->objects, &s->object_capacity, (size_t)s->object_count + 1, sizeof *object))
         return -1;
     s->objects[s->object_count] = *object;
     return s->object_count++;
@@ -97,7 +85,7 @@ int scene_add_object(scene *s, const scene_object *object)
 
 int scene_add_instance(scene *s, const scene_instance *instance)
 {
-    if (grow((void **)&s->instances, s->instance_count, &s->instance_capacity, sizeof *instance))
+    if (!array_reserve((void **)&s->instances, &s->instance_capacity, (size_t)s->instance_count + 1, sizeof *instance))
         return -1;
     s->instances[s->instance_count] = *instance;
     return s->instance_count++;
@@ -105,7 +93,7 @@ int scene_add_instance(scene *s, const scene_instance *instance)
 
 int scene_add_mesh(scene *s, const scene_mesh *mesh)
 {
-    if (grow((void **)&s->meshes, s->mesh_count, &s->mesh_capacity, sizeof *mesh))
+    if (!array_reserve((void **)&s->meshes, &s->mesh_capacity, (size_t)s->mesh_count + 1, sizeof *mesh))
         return -1;
     s->meshes[s->mesh_count] = *mesh;
     return s->mesh_count++;
@@ -113,7 +101,7 @@ int scene_add_mesh(scene *s, const scene_mesh *mesh)
 
 int scene_add_texture(scene *s, const scene_texture *texture)
 {
-    if (grow((void **)&s->textures, s->texture_count, &s->texture_capacity, sizeof *texture))
+    if (!array_reserve((void **)&s->textures, &s->texture_capacity, (size_t)s->texture_count + 1, sizeof *texture))
         return -1;
     s->textures[s->texture_count] = *texture;
     return s->texture_count++;
@@ -121,7 +109,7 @@ int scene_add_texture(scene *s, const scene_texture *texture)
 
 int scene_add_image(scene *s, const scene_image *image)
 {
-    if (grow((void **)&s->images, s->image_count, &s->image_capacity, sizeof *image))
+    if (!array_reserve((void **)&s->images, &s->image_capacity, (size_t)s->image_count + 1, sizeof *image))
         return -1;
     s->images[s->image_count] = *image;
     return s->image_count++;
@@ -129,7 +117,7 @@ int scene_add_image(scene *s, const scene_image *image)
 
 int scene_add_light(scene *s, const scene_light *light)
 {
-    if (grow((void **)&s->lights, s->light_count, &s->light_capacity, sizeof *light))
+    if (!array_reserve((void **)&s->lights, &s->light_capacity, (size_t)s->light_count + 1, sizeof *light))
         return -1;
     s->lights[s->light_count] = *light;
     return s->light_count++;
@@ -137,7 +125,7 @@ int scene_add_light(scene *s, const scene_light *light)
 
 int scene_add_warning(scene *s, const char *format, ...)
 {
-    if (grow((void **)&s->warnings, s->warning_count, &s->warning_capacity, sizeof *s->warnings))
+    if (!array_reserve((void **)&s->warnings, &s->warning_capacity, (size_t)s->warning_count + 1, sizeof *s->warnings))
         return -1;
     va_list arguments;
     va_start(arguments, format);

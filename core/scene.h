@@ -18,6 +18,7 @@
 #define RT_SCENE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "packed_layout.h"
@@ -216,26 +217,36 @@ typedef struct scene {
     scene_render_settings render;
     scene_sky sky;
     scene_material *materials;
-    int material_count, material_capacity;
+    int material_count;
+    size_t material_capacity;
     scene_sphere *spheres;
-    int sphere_count, sphere_capacity;
+    int sphere_count;
+    size_t sphere_capacity;
     scene_shape *shapes;
-    int shape_count, shape_capacity;
+    int shape_count;
+    size_t shape_capacity;
     scene_object *objects;
-    int object_count, object_capacity;
+    int object_count;
+    size_t object_capacity;
     scene_instance *instances;
-    int instance_count, instance_capacity;
+    int instance_count;
+    size_t instance_capacity;
     scene_mesh *meshes;
-    int mesh_count, mesh_capacity;
+    int mesh_count;
+    size_t mesh_capacity;
     scene_texture *textures;
-    int texture_count, texture_capacity;
+    int texture_count;
+    size_t texture_capacity;
     scene_image *images;
-    int image_count, image_capacity;
+    int image_count;
+    size_t image_capacity;
     scene_light *lights;
-    int light_count, light_capacity;
+    int light_count;
+    size_t light_capacity;
     float ambient[3];            /* Whitted integrator's ambient term; default 0.03 0.03 0.03 */
     scene_warning *warnings;     /* things worth telling the user that do not stop the render */
-    int warning_count, warning_capacity;   /* (e.g. a mesh's missing MTL file), in the order found */
+    int warning_count;
+    size_t warning_capacity;     /* (e.g. a mesh's missing MTL file), in the order found */
 } scene;
 
 /* Fills *s with the defaults above and empty arrays. Never fails; frees nothing. */
