@@ -179,14 +179,16 @@ FUZZ_CC ?= clang
 FUZZ_DIR := build-fuzz
 FUZZ_FLAGS := -std=c11 -D_GNU_SOURCE -g -O1 -fno-omit-frame-pointer -Icore -Iglsl \
 	-fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+# The packer and the CPU traversal of what it packs.
+FUZZ_PACK_SOURCES := core/pack.c core/packed_traverse.c
 FUZZ_SCENE_SOURCES := tests/fuzz/fuzz_scene_parse.c core/scene_parse.c core/expression.c core/scene.c \
-	core/status.c core/bvh.c core/pack.c core/camera.c
+	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c
 FUZZ_EXPRESSION_SOURCES := tests/fuzz/fuzz_expression.c core/expression.c core/status.c
 # The OBJ harness runs scene_load_assets(), which links the C++ shims (tinyobjloader and,
 # for images, OpenImageIO); the libraries themselves are not instrumented.
 FUZZ_CXX ?= clang++
 FUZZ_OBJ_C_SOURCES := tests/fuzz/fuzz_obj_load.c core/scene_parse.c core/expression.c core/scene.c \
-	core/status.c core/bvh.c core/pack.c core/camera.c core/scene_assets.c
+	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c core/scene_assets.c
 FUZZ_OBJ_CXX_SOURCES := core/obj_load.cpp core/image_io.cpp
 FUZZ_HARNESSES := $(FUZZ_DIR)/fuzz_scene_parse $(FUZZ_DIR)/fuzz_expression $(FUZZ_DIR)/fuzz_obj_load
 

@@ -130,7 +130,7 @@ typedef struct gpu_tracer_parameters {
     float camera_u[3], camera_v[3];       /* lens axes (right, up), unit length */
     float lens_radius;
     float shutter_open, shutter_close;    /* ray times are uniform in [open, close] */
-    uint32_t camera_media;                /* volumes the camera is in (pack.h: packed_media_at) */
+    uint32_t camera_media;                /* volumes the camera is in (packed_traverse.h) */
     int sky_type;                         /* SKY_* of scene.h */
     float sky_bottom[3], sky_top[3];
     float sky_intensity;

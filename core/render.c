@@ -10,6 +10,7 @@
 #include "clock.h"
 #include "hash.h"
 #include "pack.h"
+#include "packed_traverse.h"
 
 #define INITIAL_ADAPTIVE_BUDGET 64
 #define MINIMUM_ADAPTIVE_BUDGET 16

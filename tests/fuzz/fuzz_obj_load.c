@@ -31,6 +31,7 @@
 #include "camera.h"
 #include "obj_load.h"
 #include "pack.h"
+#include "packed_traverse.h"
 #include "scene_assets.h"
 #include "scene_parse.h"
 

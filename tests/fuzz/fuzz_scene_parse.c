@@ -33,6 +33,7 @@
 
 #include "camera.h"
 #include "pack.h"
+#include "packed_traverse.h"
 #include "scene_parse.h"
 
 #define MAX_DEFINES 8

@@ -1,5 +1,6 @@
 /* test_pack.c: the packed scene (pack.h): header and record layout round trip, BVH leaf
- * order, and the packed traversal (the shader's algorithm, in C) against brute force. */
+ * order, and the packed traversal (packed_traverse.h: the shader's algorithm, in C)
+ * against brute force. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -12,6 +13,7 @@
 #include <string.h>
 
 #include "pack.h"
+#include "packed_traverse.h"
 
 /* splitmix64: a small deterministic generator for test data. */
 static uint64_t random_state;
