@@ -179,8 +179,9 @@ FUZZ_CC ?= clang
 FUZZ_DIR := build-fuzz
 FUZZ_FLAGS := -std=c11 -D_GNU_SOURCE -g -O1 -fno-omit-frame-pointer -Icore -Iglsl \
 	-fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
-# The packer and the CPU traversal of what it packs.
-FUZZ_PACK_SOURCES := core/pack.c core/packed_traverse.c
+# The packer and the CPU traversal of what it packs (core/pack_internal.h lists its files).
+FUZZ_PACK_SOURCES := core/pack.c core/pack_collect.c core/pack_geometry.c core/pack_lights.c \
+	core/pack_materials.c core/packed_traverse.c
 FUZZ_SCENE_SOURCES := tests/fuzz/fuzz_scene_parse.c core/scene_parse.c core/expression.c core/scene.c \
 	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c
 FUZZ_EXPRESSION_SOURCES := tests/fuzz/fuzz_expression.c core/expression.c core/status.c

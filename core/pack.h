@@ -12,7 +12,8 @@
  *
  * Output: texel_count texels of four uint32 each (texels[4*i .. 4*i+3] is texel i);
  * floats are stored as their bit patterns. Reading them back on the CPU (records, the
- * shader's traversal) is packed_traverse.h's.
+ * shader's traversal) is packed_traverse.h's. The packer's steps and files:
+ * pack_internal.h.
  *
  * Defaults of pack_options (all zero): BVHs built with bvh_build_config defaults.
  */

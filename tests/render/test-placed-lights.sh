@@ -1,9 +1,9 @@
 #!/bin/sh
 # test-placed-lights.sh: emitters of placed objects (shapes in a group with a transform,
 # meshes placed by groups and instances) are lights like world ones: the packer bakes
-# such a placement into the world (pack.c, instance_bakes), so light sampling and the
-# Whitted integrator see them. Spheres under a rotation or a non-uniform scale stay
-# instanced (found by BSDF sampling only): checked too.
+# such a placement into the world (core/pack_collect.c, instance_bakes), so light
+# sampling and the Whitted integrator see them. Spheres under a rotation or a non-uniform
+# scale stay instanced (found by BSDF sampling only): checked too.
 #   usage: sh tests/render/test-placed-lights.sh PROGRAM SCRATCH_DIR
 set -u
 program=$1

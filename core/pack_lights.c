@@ -1,0 +1,198 @@
+/* pack_lights.c: the packer's light section (pack_internal.h): the emissive world
+ * primitives (area lights), the scene's point, spot and sun lights and the environment
+ * map, each with its power, which the cdf of choosing a light follows; and the
+ * environment's sampling distribution. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cglm/cglm.h>
+
+#include "pack_internal.h"
+
+/* Whether a world primitive is an area light: a sphere, quad or triangle whose material
+ * (concrete at the top level) emits. Moving spheres are left to BSDF sampling. */
+static bool is_area_light(const scene *s, const pending_primitive *item)
+{
+    if (item->type != PRIMITIVE_SPHERE && item->type != PRIMITIVE_QUAD && item->type != PRIMITIVE_TRIANGLE)
+        return false;
+    return pack_is_emissive(s, item->material);
+}
+
+uint32_t pack_count_area_lights(const packer *p)
+{
+    uint32_t count = 0;
+    for (uint32_t k = 0; k < p->top.primitives.count; k++)
+        count += is_area_light(p->scene, &p->top.primitives.items[k]);
+    return count;
+}
+
+/* Writes the area lights, in primitive slot order, from light 0 on; their powers go to
+ * power[]: emission luminance x area (x pi for the cosine lobe). */
+static void write_area_lights(packer *p, double *power)
+{
+    const scene *s = p->scene;
+    uint32_t light = 0;
+    for (uint32_t slot = 0; slot < p->top.primitives.count; slot++) {
+        const pending_primitive *item = &p->top.primitives.items[p->top.tree.primitive_indices[slot]];
+        if (!is_area_light(s, item))
+            continue;
+        const float *e = s->materials[item->material].emission;
+        double luminance = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
+        double area;
+        uint32_t type;
+        if (item->type == PRIMITIVE_SPHERE) {
+            area = 4 * M_PI * item->data[0][3] * item->data[0][3];
+            type = LIGHT_SPHERE;
+        } else {
+            vec3 normal;
+            glm_vec3_cross((float *)item->data[1], (float *)item->data[2], normal);
+            area = sqrt((double)glm_vec3_norm2(normal)) * (item->type == PRIMITIVE_QUAD ? 1.0 : 0.5);
+            type = item->type == PRIMITIVE_QUAD ? LIGHT_QUAD : LIGHT_TRIANGLE;
+        }
+        /* A light of no power is still listed (for MIS weights) but never chosen. */
+        power[light] = luminance * area * M_PI;
+        /* Slots ascend with light: the shader finds a primitive's light by a binary
+         * search of the first area_light_count lights. */
+        put_texel(p->texels, p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE, type, slot, 0, 0);
+        light++;
+    }
+}
+
+/* Half the diagonal of the top-level box (1 when there is none): what a sun or the
+ * environment lights is taken to be this large. */
+static double scene_radius(const packer *p)
+{
+    double radius = 1;
+    if (p->top.primitives.count > 0) {
+        const bvh_box *box = &p->top.tree.nodes[0].box;
+        double extent[3] = {box->max[0] - box->min[0], box->max[1] - box->min[1], box->max[2] - box->min[2]};
+        radius = 0.5 * sqrt(extent[0] * extent[0] + extent[1] * extent[1] + extent[2] * extent[2]);
+        if (!(radius > 0) || !isfinite(radius))
+            radius = 1;
+    }
+    return radius;
+}
+
+/* Writes the scene's point, spot and sun lights from light first on, with their powers.
+ * A sun's power is its irradiance over the scene's cross-section. */
+static void write_scene_lights(packer *p, uint32_t first, double radius, double *power)
+{
+    const scene *s = p->scene;
+    uint32_t light = first;
+    for (int k = 0; k < s->light_count; k++, light++) {
+        const scene_light *source = &s->lights[k];
+        const float *c = source->color;
+        double luminance = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+        uint32_t type = source->type == SCENE_LIGHT_POINT ? LIGHT_POINT
+                        : source->type == SCENE_LIGHT_SPOT ? LIGHT_SPOT : LIGHT_SUN;
+        double cos_outer = cos(source->spot_outer_degrees * M_PI / 180);
+        double cos_inner = cos(source->spot_inner_degrees * M_PI / 180);
+        double cos_sun = cos(0.5 * source->sun_angle_degrees * M_PI / 180);
+        if (type == LIGHT_POINT)
+            power[light] = 4 * M_PI * luminance;
+        else if (type == LIGHT_SPOT)
+            power[light] = 2 * M_PI * (1 - 0.5 * (cos_outer + cos_inner)) * luminance;
+        else
+            power[light] = M_PI * radius * radius * luminance;
+        bool polynomial = source->falloff == FALLOFF_POLYNOMIAL;
+        uint64_t base = p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
+        put_texel(p->texels, base, type, polynomial ? float_bits(source->attenuation[0]) : 0,
+                  polynomial ? float_bits(source->attenuation[1]) : 0,
+                  polynomial ? float_bits(source->attenuation[2]) : 0);
+        /* The sun is stored as the direction towards it. */
+        vec3 where;
+        if (type == LIGHT_SUN)
+            glm_vec3_negate_to((float *)source->direction, where);
+        else
+            glm_vec3_copy((float *)source->position, where);
+        put_texel(p->texels, base + 1, float_bits(where[0]), float_bits(where[1]), float_bits(where[2]), 0);
+        put_texel(p->texels, base + 2, float_bits(c[0]), float_bits(c[1]), float_bits(c[2]),
+                  float_bits((float)(type == LIGHT_SUN ? cos_sun : cos_outer)));
+        put_texel(p->texels, base + 3, float_bits(source->direction[0]), float_bits(source->direction[1]),
+                  float_bits(source->direction[2]), float_bits((float)cos_inner));
+    }
+}
+
+/* Writes the environment's sampling distribution (packed_layout.h, lights) and its light
+ * record as light number light; returns its power: the mean radiance on the scene's
+ * cross-section from all around. Rows, then pixels in each row, are weighted by
+ * luminance x sin(latitude) (the solid angle a pixel covers); a small floor keeps every
+ * pixel reachable. */
+static rt_status write_environment(packer *p, uint32_t light, double radius, double *power, rt_error *error)
+{
+    const scene_image *environment = p->environment;
+    uint32_t *texels = p->texels;
+    uint64_t offset = p->layout.environment_offset;
+    int width = environment->width, height = environment->height;
+    double *row_sums = calloc((size_t)height, sizeof *row_sums);
+    if (row_sums == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+    double mean = 0;
+    for (size_t i = 0; i < (size_t)width * height; i++) {
+        const float *c = environment->pixels + 4 * i;
+        mean += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    }
+    mean /= (double)width * height;
+    double floor_weight = 1e-3 * mean + 1e-12, total_weight = 0;
+    for (int y = 0; y < height; y++) {
+        double sine = sin(M_PI * (y + 0.5) / height), row = 0;
+        uint64_t row_base = offset + height + (uint64_t)y * width;
+        for (int x = 0; x < width; x++) {
+            const float *c = environment->pixels + 4 * ((size_t)y * width + x);
+            row += (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2] + floor_weight) * sine;
+            put_texel(texels, row_base + x, float_bits((float)row), 0, 0, 0);
+        }
+        for (int x = 0; x < width; x++) {
+            uint64_t at = row_base + x;
+            float value = x + 1 == width ? 1.0f : bits_float(texels[4 * at]) / (float)row;
+            texels[4 * at] = float_bits(value);
+        }
+        row_sums[y] = row;
+        total_weight += row;
+    }
+    double cumulative_rows = 0;
+    for (int y = 0; y < height; y++) {
+        cumulative_rows += row_sums[y];
+        put_texel(texels, offset + y, float_bits(y + 1 == height ? 1.0f : (float)(cumulative_rows / total_weight)), 0,
+                  0, 0);
+    }
+    free(row_sums);
+    power[light] = 4 * M_PI * radius * radius * mean * p->scene->sky.intensity;
+    put_texel(texels, p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE, LIGHT_ENVIRONMENT,
+              (uint32_t)width, (uint32_t)height, 0);
+    return RT_OK;
+}
+
+rt_status pack_write_lights(packer *p, rt_error *error)
+{
+    uint32_t light_count = (uint32_t)p->layout.light_count;
+    if (light_count == 0)
+        return RT_OK;
+    double *power = malloc(light_count * sizeof *power);
+    if (power == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+    uint32_t area_lights = (uint32_t)p->layout.area_light_count;
+    double radius = scene_radius(p);
+    write_area_lights(p, power);
+    write_scene_lights(p, area_lights, radius, power);
+    if (p->environment != NULL) {
+        rt_status status = write_environment(p, area_lights + (uint32_t)p->scene->light_count, radius, power, error);
+        if (status != RT_OK) {
+            free(power);
+            return status;
+        }
+    }
+    /* The cdf of choosing each light, by power (all alike when none has any). */
+    double total = 0;
+    for (uint32_t l = 0; l < light_count; l++)
+        total += power[l];
+    double cumulative = 0;
+    for (uint32_t l = 0; l < light_count; l++) {
+        cumulative += total > 0 ? power[l] / total : 1.0 / light_count;
+        uint64_t base = p->layout.light_offset + (uint64_t)l * PACKED_LIGHT_STRIDE;
+        p->texels[4 * (base + 1) + 3] = float_bits(l + 1 == light_count ? 1.0f : (float)cumulative);
+    }
+    free(power);
+    return RT_OK;
+}

@@ -1,0 +1,60 @@
+/* pack_materials.c: the packer's appearance sections (pack_internal.h): materials (and
+ * the default grey one after the scene's), textures, image records and pixels. */
+#include <string.h>
+
+#include "pack_internal.h"
+
+void pack_write_materials(packer *p)
+{
+    const scene *s = p->scene;
+    for (uint64_t i = 0; i < p->layout.material_count; i++) {
+        scene_material m = scene_material_defaults();
+        if (i < (uint64_t)s->material_count)
+            m = s->materials[i];
+        else {
+            m.type = MATERIAL_LAMBERTIAN;
+            m.albedo[0] = m.albedo[1] = m.albedo[2] = 0.5f;
+        }
+        uint64_t base = p->layout.material_offset + i * PACKED_MATERIAL_STRIDE;
+        put_texel(p->texels, base + 0, (uint32_t)m.type, float_bits(m.albedo[0]), float_bits(m.albedo[1]),
+                  float_bits(m.albedo[2]));
+        put_texel(p->texels, base + 1, float_bits(m.emission[0]), float_bits(m.emission[1]),
+                  float_bits(m.emission[2]), float_bits(m.fuzz));
+        put_texel(p->texels, base + 2, float_bits(m.index_of_refraction),
+                  m.albedo_texture >= 0 ? (uint32_t)m.albedo_texture : PACKED_NONE,
+                  m.emission_texture >= 0 ? (uint32_t)m.emission_texture : PACKED_NONE,
+                  m.normal_map >= 0 ? (uint32_t)m.normal_map : PACKED_NONE);
+        /* Phong terms of the Whitted integrator: a dim white highlight on diffuse
+         * surfaces and the metal's own colour on metals, unless the scene says. */
+        float specular[3] = {0.04f, 0.04f, 0.04f};
+        if (m.specular_set)
+            memcpy(specular, m.specular, sizeof specular);
+        else if (m.type == MATERIAL_METAL)
+            memcpy(specular, m.albedo, sizeof specular);
+        put_texel(p->texels, base + 3, float_bits(m.phong_exponent > 0 ? m.phong_exponent : 32.0f),
+                  float_bits(specular[0]), float_bits(specular[1]), float_bits(specular[2]));
+    }
+}
+
+void pack_write_textures(packer *p)
+{
+    const scene *s = p->scene;
+    for (int i = 0; i < s->texture_count; i++) {
+        const scene_texture *t = &s->textures[i];
+        uint64_t base = p->layout.texture_offset + (uint64_t)i * PACKED_TEXTURE_STRIDE;
+        put_texel(p->texels, base, (uint32_t)t->type, (uint32_t)t->even, (uint32_t)t->odd, (uint32_t)t->image);
+        put_texel(p->texels, base + 1, float_bits(t->color[0]), float_bits(t->color[1]), float_bits(t->color[2]),
+                  float_bits(t->scale));
+    }
+    uint64_t next_pixel = p->layout.pixel_offset;
+    for (int i = 0; i < s->image_count; i++) {
+        const scene_image *image = &s->images[i];
+        put_texel(p->texels, p->layout.image_offset + (uint64_t)i * PACKED_IMAGE_STRIDE, (uint32_t)next_pixel,
+                  (uint32_t)image->width, (uint32_t)image->height, 0);
+        uint64_t pixels = (uint64_t)image->width * image->height;
+        if (image->pixels != NULL)
+            for (uint64_t k = 0; k < 4 * pixels; k++)
+                p->texels[4 * next_pixel + k] = float_bits(image->pixels[k]);
+        next_pixel += pixels;
+    }
+}
