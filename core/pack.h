@@ -31,6 +31,21 @@ typedef struct pack_options {
     const bvh_build_config *bvh_config;  /* NULL: defaults */
 } pack_options;
 
+/* What a packed scene holds, noted by each section's writer as it writes: render.c
+ * chooses the tracer variant from it (gpu.h, GPU_OMIT_*) without reading texels again.
+ * The type sets have bit 1 << tag set for each tag of packed_layout.h present. */
+typedef struct pack_summary {
+    uint32_t primitive_types;    /* PRIMITIVE_* records in any BVH level; PRIMITIVE_INSTANCE:
+                                  * a second level */
+    uint32_t light_types;        /* LIGHT_* records in the light section (LIGHT_SPHERE,
+                                  * _QUAD, _TRIANGLE: emissive world primitives;
+                                  * LIGHT_ENVIRONMENT: the sky's environment map) */
+    bool volumes;                /* an instance is a volume (INSTANCE_VOLUME) */
+    bool emitters;               /* an emissive material, whether a primitive uses it or not */
+    bool textures;               /* a texture record, or a material naming a texture */
+    bool normal_maps;            /* a material with a normal map */
+} pack_summary;
+
 typedef struct packed_scene {
     uint32_t *texels;
     uint32_t texel_count;
@@ -50,6 +65,7 @@ typedef struct packed_scene {
     uint32_t triangle_count;     /* triangles stored (mesh triangles once per object) */
     int bvh_depth;               /* deepest level of any BVH */
     double bvh_build_seconds;    /* all BVH builds together */
+    pack_summary summary;        /* what the sections hold */
 } packed_scene;
 
 /* Returns options with every field at its default (all zero). */

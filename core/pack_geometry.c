@@ -66,6 +66,7 @@ static void write_primitive(packer *p, const pending_primitive *item, uint64_t g
     texels[4 * (p->layout.info_offset + global_slot / 4) + global_slot % 4] =
         item->type << PRIMITIVE_INFO_TYPE_SHIFT | (item->has_uvs ? PRIMITIVE_INFO_HAS_UVS : 0) | material;
     p->out->triangle_count += item->type == PRIMITIVE_TRIANGLE;
+    p->out->summary.primitive_types |= 1u << item->type;
 }
 
 /* Writes the nodes of one BVH, its child and leaf indices moved to where it landed. */
@@ -149,6 +150,7 @@ rt_status pack_write_instances(packer *p, rt_error *error)
                       float_bits(world_to_object[r][2]), float_bits(world_to_object[r][3]));
         put_texel(p->texels, base + 4, float_bits(instance->density), float_bits(instance->volume_albedo[0]),
                   float_bits(instance->volume_albedo[1]), float_bits(instance->volume_albedo[2]));
+        p->out->summary.volumes |= instance->volume;
     }
     return RT_OK;
 }

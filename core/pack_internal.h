@@ -9,7 +9,8 @@
  *             core/pack_lights.c     lights and their powers, the environment's CDF
  *             core/pack_materials.c  materials, textures, images
  *
- * Each writer fills its section of p->texels at the offsets of p->layout.
+ * Each writer fills its section of p->texels at the offsets of p->layout, and notes in
+ * p->out->summary what its section holds (pack.h, pack_summary).
  */
 #ifndef RT_PACK_INTERNAL_H
 #define RT_PACK_INTERNAL_H

@@ -55,6 +55,7 @@ static void write_area_lights(packer *p, double *power)
         /* Slots ascend with light: the shader finds a primitive's light by a binary
          * search of the first area_light_count lights. */
         put_texel(p->texels, p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE, type, slot, 0, 0);
+        p->out->summary.light_types |= 1u << type;
         light++;
     }
 }
@@ -111,6 +112,7 @@ static void write_scene_lights(packer *p, uint32_t first, double radius, double 
                   float_bits((float)(type == LIGHT_SUN ? cos_sun : cos_outer)));
         put_texel(p->texels, base + 3, float_bits(source->direction[0]), float_bits(source->direction[1]),
                   float_bits(source->direction[2]), float_bits((float)cos_inner));
+        p->out->summary.light_types |= 1u << type;
     }
 }
 
@@ -161,6 +163,7 @@ static rt_status write_environment(packer *p, uint32_t light, double radius, dou
     power[light] = 4 * M_PI * radius * radius * mean * p->scene->sky.intensity;
     put_texel(texels, p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE, LIGHT_ENVIRONMENT,
               (uint32_t)width, (uint32_t)height, 0);
+    p->out->summary.light_types |= 1u << LIGHT_ENVIRONMENT;
     return RT_OK;
 }
 

@@ -7,6 +7,7 @@
 void pack_write_materials(packer *p)
 {
     const scene *s = p->scene;
+    pack_summary *summary = &p->out->summary;
     for (uint64_t i = 0; i < p->layout.material_count; i++) {
         scene_material m = scene_material_defaults();
         if (i < (uint64_t)s->material_count)
@@ -33,6 +34,9 @@ void pack_write_materials(packer *p)
             memcpy(specular, m.albedo, sizeof specular);
         put_texel(p->texels, base + 3, float_bits(m.phong_exponent > 0 ? m.phong_exponent : 32.0f),
                   float_bits(specular[0]), float_bits(specular[1]), float_bits(specular[2]));
+        summary->emitters |= m.type == MATERIAL_EMISSIVE;
+        summary->textures |= m.albedo_texture >= 0 || m.emission_texture >= 0;
+        summary->normal_maps |= m.normal_map >= 0;
     }
 }
 
@@ -45,6 +49,7 @@ void pack_write_textures(packer *p)
         put_texel(p->texels, base, (uint32_t)t->type, (uint32_t)t->even, (uint32_t)t->odd, (uint32_t)t->image);
         put_texel(p->texels, base + 1, float_bits(t->color[0]), float_bits(t->color[1]), float_bits(t->color[2]),
                   float_bits(t->scale));
+        p->out->summary.textures = true;
     }
     uint64_t next_pixel = p->layout.pixel_offset;
     for (int i = 0; i < s->image_count; i++) {

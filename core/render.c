@@ -69,49 +69,35 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
 }
 
 /* Returns the GPU_OMIT_* bits of the tracer code this render cannot reach (gpu.h), and
- * GPU_FIX_UNIFORMS: no light sampling in path tracing without lights (or with it switched
- * off), no volumes when there is none and the camera is in none, no textures when no
- * material has one; primitive types and emitters as the packed records (every BVH level)
- * hold them. The --full-tracer option asks for 0: everything, read from uniforms. */
-static uint32_t omitted_features(const scene *s, const packed_scene *packed, const render_options *options,
-                                 uint32_t camera_media)
+ * GPU_FIX_UNIFORMS, from what the packed scene holds (pack.h, pack_summary): no light
+ * sampling in path tracing without lights (or with it switched off), no volumes when there
+ * is none and the camera is in none, no textures when there is none and no material has a
+ * normal map; primitive types and emitters as the packed records (every BVH level) hold
+ * them. The --full-tracer option asks for 0: everything, read from uniforms. */
+static uint32_t omitted_features(const packed_scene *packed, const render_options *options, uint32_t camera_media)
 {
     if (options->full_tracer)
         return 0;
+    const pack_summary *contents = &packed->summary;
     uint32_t omitted = GPU_FIX_UNIFORMS;
     if (options->integrator == 0 && (packed->light_count == 0 || options->no_light_sampling))
         omitted |= GPU_OMIT_DIRECT_LIGHT;
-    bool volumes = camera_media != 0;
-    for (int i = 0; i < s->instance_count && !volumes; i++)
-        volumes = s->instances[i].volume;
-    if (!volumes)
+    if (!contents->volumes && camera_media == 0)
         omitted |= GPU_OMIT_VOLUMES;
-    bool textures = s->texture_count > 0;
-    for (int i = 0; i < s->material_count && !textures; i++)
-        textures = s->materials[i].normal_map >= 0 || s->materials[i].albedo_texture >= 0
-                   || s->materials[i].emission_texture >= 0;
-    if (!textures)
+    if (!contents->textures && !contents->normal_maps)
         omitted |= GPU_OMIT_TEXTURES;
-    bool present[PRIMITIVE_TYPE_COUNT] = {false};
-    for (uint32_t slot = 0; slot < packed->primitive_count; slot++) {
-        uint32_t type = packed_primitive_type(packed, slot);
-        if (type < PRIMITIVE_TYPE_COUNT)
-            present[type] = true;
-    }
-    if (!present[PRIMITIVE_SPHERE] && !present[PRIMITIVE_MOVING_SPHERE])
+    uint32_t types = contents->primitive_types;
+    if (!(types & (1u << PRIMITIVE_SPHERE | 1u << PRIMITIVE_MOVING_SPHERE)))
         omitted |= GPU_OMIT_SPHERES;
-    if (!present[PRIMITIVE_MOVING_SPHERE])
+    if (!(types & 1u << PRIMITIVE_MOVING_SPHERE))
         omitted |= GPU_OMIT_MOVING_SPHERES;
-    if (!present[PRIMITIVE_TRIANGLE])
+    if (!(types & 1u << PRIMITIVE_TRIANGLE))
         omitted |= GPU_OMIT_TRIANGLES;
-    if (!present[PRIMITIVE_QUAD])
+    if (!(types & 1u << PRIMITIVE_QUAD))
         omitted |= GPU_OMIT_QUADS;
-    if (!present[PRIMITIVE_INSTANCE])
+    if (!(types & 1u << PRIMITIVE_INSTANCE))
         omitted |= GPU_OMIT_INSTANCES;
-    bool emitters = false;
-    for (uint32_t m = 0; m < packed->material_count && !emitters; m++)
-        emitters = packed_uint(packed, packed->material_offset + m * PACKED_MATERIAL_STRIDE, 0) == MATERIAL_EMISSIVE;
-    if (!emitters)
+    if (!contents->emitters)
         omitted |= GPU_OMIT_EMITTERS;
     return omitted;
 }
@@ -283,7 +269,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     gpu_tracer_parameters parameters;
     tracer_parameters(s, &frame, options, region, &parameters);
     parameters.camera_media = packed_media_at(&packed, s->camera.look_from);
-    parameters.omitted_features = omitted_features(s, &packed, options, parameters.camera_media);
+    parameters.omitted_features = omitted_features(&packed, options, parameters.camera_media);
     uint64_t samples_resumed = 0;
     float *sums = NULL;
     if (options->resume != NULL) {
