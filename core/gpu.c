@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "hash.h"
 #include "scene.h"
 #include "shader_sources.h"
 
@@ -713,7 +712,8 @@ static void set_parameters(const gpu_info *info, GLuint program, const gpu_trace
 }
 
 rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
-                            const gpu_tracer_parameters *parameters, gpu_tracer **out, rt_error *error)
+                            uint64_t texel_hash, const gpu_tracer_parameters *parameters, gpu_tracer **out,
+                            rt_error *error)
 {
     *out = NULL;
     gpu_tracer *tracer = calloc(1, sizeof *tracer);
@@ -723,8 +723,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->width = parameters->width;
     tracer->height = parameters->height;
     rt_status status = build_program(tracer, parameters, error);
-    uint64_t hash = hash_bytes(HASH_START, packed_texels, (size_t)texel_count * 16u);
-    if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == hash
+    if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == texel_hash
         && context->packed_texel_count == texel_count) {
         tracer->packed_texture = context->packed_texture;
         tracer->packed_buffer = context->packed_buffer;
@@ -740,7 +739,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
         if (status == RT_OK) {
             context->packed_texture = tracer->packed_texture;
             context->packed_buffer = tracer->packed_buffer;
-            context->packed_hash = hash;
+            context->packed_hash = texel_hash;
             context->packed_texel_count = texel_count;
         }
     }

@@ -171,11 +171,13 @@ typedef struct gpu_tracer gpu_tracer;
 
 /* Compiles the tracer (once per context), uploads the packed scene (unless the context
  * already holds exactly these texels) (texel_count texels of 4 uint32 each,
- * see packed_layout.h) and creates the state textures for parameters->width x height.
- * Too large for the device (texture size, memory) is RT_ERROR_INPUT saying which limit.
- * Free with gpu_tracer_destroy(). */
+ * see packed_layout.h; texel_hash: their hash, pack.h's packed_scene.texel_hash, which
+ * tells whether the context holds them) and creates the state textures for
+ * parameters->width x height. Too large for the device (texture size, memory) is
+ * RT_ERROR_INPUT saying which limit. Free with gpu_tracer_destroy(). */
 rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
-                            const gpu_tracer_parameters *parameters, gpu_tracer **out, rt_error *error);
+                            uint64_t texel_hash, const gpu_tracer_parameters *parameters, gpu_tracer **out,
+                            rt_error *error);
 
 /* Runs one pass: every unfinished pixel does at most pass_work_budget units of work,
  * keeps its unfinished path in the state textures, and starts new samples while it has

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hash.h"
 #include "pack_internal.h"
 
 pack_options pack_options_defaults(void)
@@ -203,6 +204,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
     if (status == RT_OK) {
         pack_write_textures(&p);
         out->texels = p.texels;
+        out->texel_hash = hash_bytes(HASH_START, p.texels, (size_t)out->texel_count * 16u);
         p.texels = NULL;
     }
     finish_packer(&p);

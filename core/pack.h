@@ -66,6 +66,9 @@ typedef struct packed_scene {
     int bvh_depth;               /* deepest level of any BVH */
     double bvh_build_seconds;    /* all BVH builds together */
     pack_summary summary;        /* what the sections hold */
+    uint64_t texel_hash;         /* hash_bytes (hash.h) of the texels from HASH_START: the
+                                  * one hash of the packed scene (the device's copy, the
+                                  * scene hash of render.h) */
 } packed_scene;
 
 /* Returns options with every field at its default (all zero). */

@@ -102,6 +102,28 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
     return omitted;
 }
 
+/* Returns the scene hash (render.h, render_result): the packed scene's texel hash carried
+ * on (FNV-1a runs on from any state, so this is the hash of the texels followed by the
+ * rest) over the camera frame, the sky, the shutter, the ambient light, the full size, the
+ * depth and the options that change the image. */
+static uint64_t scene_hash(const scene *s, const packed_scene *packed, const camera_frame *frame,
+                           const render_options *options)
+{
+    uint64_t hash = packed->texel_hash;
+    hash = hash_bytes(hash, frame, sizeof *frame);
+    hash = hash_bytes(hash, &s->sky.type, sizeof s->sky.type);
+    hash = hash_bytes(hash, s->sky.bottom, sizeof s->sky.bottom);
+    hash = hash_bytes(hash, s->sky.top, sizeof s->sky.top);
+    hash = hash_bytes(hash, &s->sky.intensity, sizeof s->sky.intensity);
+    hash = hash_bytes(hash, &s->sky.rotation_degrees, sizeof s->sky.rotation_degrees);
+    hash = hash_bytes(hash, &s->camera.shutter_open, sizeof s->camera.shutter_open);
+    hash = hash_bytes(hash, &s->camera.shutter_close, sizeof s->camera.shutter_close);
+    hash = hash_bytes(hash, s->ambient, sizeof s->ambient);
+    int shape[5] = {s->render.width, s->render.height, s->render.max_depth, options->no_light_sampling,
+                    (int)options->integrator};
+    return hash_bytes(hash, shape, sizeof shape);
+}
+
 /* Reads the tracer's accumulation into a new width x height image of means (R, G, B) and
  * per-pixel finished samples; *samples receives their total. The caller frees image. */
 static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, float *luminance_squares,
@@ -243,20 +265,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     result->primitive_count = packed.primitive_count;
     result->instance_count = packed.instance_count;
     result->light_count = packed.light_count;
-    uint64_t hash = HASH_START;
-    hash = hash_bytes(hash, packed.texels, (size_t)packed.texel_count * 16u);
-    hash = hash_bytes(hash, &frame, sizeof frame);
-    hash = hash_bytes(hash, &s->sky.type, sizeof s->sky.type);
-    hash = hash_bytes(hash, s->sky.bottom, sizeof s->sky.bottom);
-    hash = hash_bytes(hash, s->sky.top, sizeof s->sky.top);
-    hash = hash_bytes(hash, &s->sky.intensity, sizeof s->sky.intensity);
-    hash = hash_bytes(hash, &s->sky.rotation_degrees, sizeof s->sky.rotation_degrees);
-    hash = hash_bytes(hash, &s->camera.shutter_open, sizeof s->camera.shutter_open);
-    hash = hash_bytes(hash, &s->camera.shutter_close, sizeof s->camera.shutter_close);
-    hash = hash_bytes(hash, s->ambient, sizeof s->ambient);
-    int shape[5] = {s->render.width, s->render.height, s->render.max_depth, options->no_light_sampling,
-                    (int)options->integrator};
-    hash = hash_bytes(hash, shape, sizeof shape);
+    uint64_t hash = scene_hash(s, &packed, &frame, options);
     result->scene_hash = hash;
     if (options->resume != NULL && options->resume_scene_hash != 0 && options->resume_scene_hash != hash) {
         packed_scene_free(&packed);
@@ -282,7 +291,8 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         parameters.resume = sums;
     }
     gpu_tracer *tracer = NULL;
-    status = gpu_tracer_create(context, packed.texels, packed.texel_count, &parameters, &tracer, error);
+    status = gpu_tracer_create(context, packed.texels, packed.texel_count, packed.texel_hash, &parameters, &tracer,
+                               error);
     packed_scene_free(&packed);
     free(sums);
     if (status != RT_OK)

@@ -1,7 +1,7 @@
 /* test_pack_summary.c: what pack_scene() says a scene holds (pack.h, pack_summary), which
  * chooses the tracer variant: primitive kinds in either BVH level, instances, volumes,
- * emitters, textures and normal maps, lights by kind, the environment. Small scenes from
- * text, their images given stand-in pixels. */
+ * emitters, textures and normal maps, lights by kind, the environment; and the texel hash
+ * it hands on (hash.h). Small scenes from text, their images given stand-in pixels. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hash.h"
 #include "pack.h"
 #include "packed_traverse.h"
 #include "scene_parse.h"
@@ -173,10 +174,29 @@ static void each_scene_is_summarised(void **state)
     }
 }
 
+static void texel_hash_is_the_hash_of_the_texels(void **state)
+{
+    (void)state;
+    packed_scene packed;
+    pack_text("material grey lambertian 0.5 0.5 0.5\n"
+              "sphere 0 0 0 1 grey\n",
+              &packed);
+    assert_true(packed.texel_hash == hash_bytes(HASH_START, packed.texels, (size_t)packed.texel_count * 16u));
+    uint64_t first = packed.texel_hash;
+    packed_scene_free(&packed);
+    /* Another radius: other texels, another hash. */
+    pack_text("material grey lambertian 0.5 0.5 0.5\n"
+              "sphere 0 0 0 2 grey\n",
+              &packed);
+    assert_true(packed.texel_hash != first);
+    packed_scene_free(&packed);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(each_scene_is_summarised),
+        cmocka_unit_test(texel_hash_is_the_hash_of_the_texels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
