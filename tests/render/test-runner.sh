@@ -3,7 +3,8 @@
 # directory (so the real run never finds them, and the copy of run.sh there runs only
 # them): the counts of the Total line, one line for a passing test and the whole output
 # of a failing one, V=1, the SKIP list, running tests by name, an unknown name, a crashed
-# unit binary, and the time-out, which must leave no process of the test behind.
+# unit binary, a bad RTSPHERES_TEST_TIMEOUT, and the time-out and a stopped run, which
+# must leave no process of the test behind.
 #   usage: sh tests/render/test-runner.sh PROGRAM SCRATCH_DIR
 # PROGRAM is not used: the fake tests render nothing.
 . "$(dirname "$0")/lib.sh"
