@@ -3,7 +3,8 @@
 # Targets
 #   all      (default) build ./rtspheres
 #   demo     install missing packages, build, render scenes/three-balls.txt to demo.png
-#   test     install missing packages, build, run every test (unit, render, analytic)
+#   test     install missing packages, build, run every test (unit, render, analytic),
+#            or just the tests TESTS names (make test TESTS="test-frames test_pack")
 #   bench    build with release flags and time the benchmark scenes against a plain C
 #            reference built in the same run (not a test): a table with the targets as
 #            ratios, build/bench.csv (appended), build/bench.json, build/bench-plot.png
@@ -16,7 +17,10 @@
 #   clean    remove build products
 #
 # Knobs
-#   V=1        show the commands
+#   V=1        show the commands (and with `test`, every check a passing test makes)
+#   TESTS      with `test`: the names of the tests to run (default: all of them)
+#   RTSPHERES_TEST_TIMEOUT  with `test`: seconds each test may take (environment;
+#              default 120 s a unit binary, 600 s a render script; tests/run.sh)
 #   SAN=1      build with AddressSanitizer + UndefinedBehaviorSanitizer (into build-san/)
 #   CFLAGS, CXXFLAGS, LDFLAGS   yours: appended after ours, never replacing them
 #   CC, CXX    compilers (default cc, c++)
@@ -155,8 +159,8 @@ $(BUILD)/keep-libraries-loaded.so: tests/sanitizers/keep_libraries_loaded.c
 
 test: deps
 	$(Q)$(MAKE) --no-print-directory $(PROGRAM) unit-tests $(SAN_TEST_SHIM)
-	$(Q)$(if $(SAN_TEST_ENV),rm -rf $(SAN_REPORTS) && mkdir -p $(SAN_REPORTS) && )$(SAN_TEST_ENV) sh tests/run.sh \
-		$(BUILD) ./$(PROGRAM)
+	$(Q)$(if $(SAN_TEST_ENV),rm -rf $(SAN_REPORTS) && mkdir -p $(SAN_REPORTS) && )$(SAN_TEST_ENV) V=$(V) sh tests/run.sh \
+		$(BUILD) ./$(PROGRAM) $(TESTS)
 
 # The bench compiles its own tools (the reference with -O3 -march=native -fopenmp and none
 # of your CFLAGS, since it is the yardstick; the peak-RSS wrapper; the chart) into

@@ -2,9 +2,6 @@
 # test-analytic.sh: scenes whose correct image is known in closed form, so they check
 # correctness itself (golden images only catch change).
 #   usage: sh tests/render/test-analytic.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 # White furnace: a convex diffuse sphere of albedo a in a uniform white sky. A camera ray

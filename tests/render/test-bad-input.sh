@@ -7,9 +7,6 @@
 #   usage: sh tests/render/test-bad-input.sh PROGRAM SCRATCH_DIR
 # Starting the program costs about 0.3 s (its image libraries), so the cases run in two
 # halves at once, each in its own directory; their lines are printed in order at the end.
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 # Every render is tiny, so that a case that wrongly succeeds still ends at once.
@@ -20,6 +17,27 @@ case_seconds=120
 cases="$scratch/cases"
 mkdir -p "$cases"
 
+# refusal_problem PATTERN COMMAND...: runs COMMAND (killed after $case_seconds) with its
+# stdout and stderr in $work; prints nothing when it exits 2 with stderr matching PATTERN
+# (grep -E), else what went wrong: a hang, a crash (exit >= 128), another exit code or
+# another message.
+refusal_problem() {
+    refusal_pattern=$1
+    shift
+    timeout -k 5 "$case_seconds" "$@" >"$work/stdout" 2>"$work/stderr"
+    got=$?
+    message=$(head -c 300 "$work/stderr" | tr '\n' ' ')
+    if [ "$got" = 124 ]; then
+        echo "hung: killed after $case_seconds s"
+    elif [ "$got" -ge 128 ]; then
+        echo "crashed (exit $got): $message"
+    elif [ "$got" != 2 ]; then
+        echo "exit $got, expected 2: $message"
+    elif ! grep -qE -e "$refusal_pattern" "$work/stderr"; then
+        echo "stderr lacks /$refusal_pattern/: $message"
+    fi
+}
+
 # expect_bad NAME PATTERN SCENE [OPTIONS...]: renders SCENE to a fresh output and checks
 # exit 2, stderr matching PATTERN (grep -E), and that no output file appeared.
 expect_bad() {
@@ -28,17 +46,9 @@ expect_bad() {
     output="$work/out.png"
     rm -f "$output"
     # shellcheck disable=SC2086 # $small is a list of options
-    timeout -k 5 "$case_seconds" "$program" render "$scene" -o "$output" $small "$@" >"$work/stdout" 2>"$work/stderr"
-    got=$?
-    message=$(head -c 300 "$work/stderr" | tr '\n' ' ')
-    if [ "$got" = 124 ]; then
-        fail "$name" "hung: killed after $case_seconds s"
-    elif [ "$got" -ge 128 ]; then
-        fail "$name" "crashed (exit $got): $message"
-    elif [ "$got" != 2 ]; then
-        fail "$name" "exit $got, expected 2: $message"
-    elif ! grep -qE -e "$pattern" "$work/stderr"; then
-        fail "$name" "stderr lacks /$pattern/: $message"
+    problem=$(refusal_problem "$pattern" "$program" render "$scene" -o "$output" $small "$@")
+    if [ -n "$problem" ]; then
+        fail "$name" "$problem"
     elif [ -e "$output" ]; then
         fail "$name" "an output file was written"
     else
@@ -51,20 +61,8 @@ expect_bad() {
 expect_usage() {
     name=$1 pattern=$2
     shift 2
-    timeout -k 5 "$case_seconds" "$program" "$@" >"$work/stdout" 2>"$work/stderr"
-    got=$?
-    message=$(head -c 300 "$work/stderr" | tr '\n' ' ')
-    if [ "$got" = 124 ]; then
-        fail "$name" "hung: killed after $case_seconds s"
-    elif [ "$got" -ge 128 ]; then
-        fail "$name" "crashed (exit $got): $message"
-    elif [ "$got" != 2 ]; then
-        fail "$name" "exit $got, expected 2: $message"
-    elif ! grep -qE -e "$pattern" "$work/stderr"; then
-        fail "$name" "stderr lacks /$pattern/: $message"
-    else
-        pass "$name"
-    fi
+    problem=$(refusal_problem "$pattern" "$program" "$@")
+    if [ -n "$problem" ]; then fail "$name" "$problem"; else pass "$name"; fi
 }
 
 # write_case NAME TEXT: writes TEXT (printf format: \NNN octal escapes work) to

@@ -4,14 +4,7 @@
 # The test images are tiny binary PPMs (P6) written with printf, so that nothing beyond
 # a POSIX shell is needed. Prints "PASS name" or "FAIL name: detail" per check; exits 1
 # when any check failed.
-set -u
-program=$1
-scratch=$2
-mkdir -p "$scratch" || exit 1
-failures=0
-
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1: $2"; failures=$((failures + 1)); }
+. "$(dirname "$0")/lib.sh"
 
 # Writes a WIDTH x HEIGHT P6 image filled with R G B (0-255), except that the pixel at
 # (X, Y), when given, is R2 G2 B2.
@@ -169,4 +162,4 @@ name=help
 run_diff --help
 check_exit "$name" 0 && { has out "usage: rtspheres diff" && pass "$name" || fail "$name" "no usage line"; }
 
-[ "$failures" = 0 ]
+finish

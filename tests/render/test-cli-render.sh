@@ -2,26 +2,7 @@
 # test-cli-render.sh: the render command from a user's side: options, -D, determinism,
 # and failures that must give a clear message and exit code while losing nothing.
 #   usage: sh tests/render/test-cli-render.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
-
-# expect_exit NAME CODE PATTERN COMMAND...: runs COMMAND, checks its exit code and that
-# stderr contains PATTERN (a grep -E expression).
-expect_exit() {
-    name=$1 code=$2 pattern=$3
-    shift 3
-    "$@" >"$scratch/stdout" 2>"$scratch/stderr"
-    got=$?
-    if [ "$got" != "$code" ]; then
-        fail "$name" "exit $got, expected $code; stderr: $(head -c 300 "$scratch/stderr")"
-    elif [ -n "$pattern" ] && ! grep -qE -e "$pattern" "$scratch/stderr"; then
-        fail "$name" "stderr lacks /$pattern/: $(head -c 300 "$scratch/stderr")"
-    else
-        pass "$name"
-    fi
-}
 
 small="--size 16x12 --spp 2 --quiet"
 scene=scenes/materials/lambertian.txt

@@ -4,41 +4,17 @@
 # report, reuse of an unchanged scene on the device, bad lists, and output name patterns
 # without --frames (formatted with -D frame=N, else 0).
 #   usage: sh tests/render/test-frames.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 scene=scenes/three-balls.txt
 tiny="--size 16x9 --spp 2 --max-depth 4"
 
-# same NAME A B: A and B have exactly the same pixels (diff --fail 0 --failpercent 0).
-same() {
-    if "$program" diff "$2" "$3" --fail 0 --failpercent 0 >"$scratch/diff" 2>&1; then
-        pass "$1"
-    else
-        fail "$1" "$2 and $3 differ: $(tr '\n' ' ' <"$scratch/diff" | head -c 300)"
-    fi
-}
-
 # usage_error NAME PATTERN ARGS...: `render ARGS` exits 2, says PATTERN (grep -E) on stderr
 # and writes nothing into $scratch/refused.
 usage_error() {
-    name=$1 pattern=$2
+    usage_name=$1 usage_pattern=$2
     shift 2
-    rm -rf "$scratch/refused"
-    mkdir -p "$scratch/refused"
-    "$program" render "$@" >/dev/null 2>"$scratch/stderr"
-    got=$?
-    if [ "$got" != 2 ]; then
-        fail "$name" "exit $got, expected 2; stderr: $(head -c 300 "$scratch/stderr")"
-    elif ! grep -qE -e "$pattern" "$scratch/stderr"; then
-        fail "$name" "stderr lacks /$pattern/: $(head -c 300 "$scratch/stderr")"
-    elif [ -n "$(ls -A "$scratch/refused")" ]; then
-        fail "$name" "files were written: $(ls -A "$scratch/refused" | tr '\n' ' ')"
-    else
-        pass "$name"
-    fi
+    expect_refusal "$usage_name" "$usage_pattern" "$scratch/refused" "$program" render "$@"
 }
 
 # A scene that uses $frame (not $time): the sphere moves with it.

@@ -6,8 +6,6 @@
 # broken contract fails. `make fuzz` is the long run (FUZZ_SECONDS per harness).
 #   usage: sh tests/render/test-fuzz-smoke.sh PROGRAM SCRATCH_DIR
 # PROGRAM is unused: the harnesses call the core library directly.
-set -u
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 fuzz_cc=${FUZZ_CC:-clang}

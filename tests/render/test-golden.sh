@@ -6,9 +6,6 @@
 # kept as golden-diff-NAME.png in the directory given by RTSPHERES_DIFF_DIR (default: the
 # scratch directory, which is removed; set it to keep the images).
 #   usage: sh tests/render/test-golden.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 here=$(dirname "$0")
 . "$here/lib.sh"
 . "$here/golden-options.sh"

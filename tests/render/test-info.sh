@@ -4,9 +4,6 @@
 # the list is refused (exit 2) by info and render alike, naming the number asked for and
 # how many devices there are.
 #   usage: sh tests/render/test-info.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 # field NAME: the value of the "NAME: value" line of the last info output.

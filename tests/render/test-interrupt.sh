@@ -4,9 +4,6 @@
 # the output), --checkpoint writes that file periodically, and --resume continues it to
 # the same image as an uninterrupted render.
 #   usage: sh tests/render/test-interrupt.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 scene=scenes/materials/lambertian.txt
 # About 2.7 million samples: seconds on llvmpipe; the tests wait for the first checkpoint

@@ -3,78 +3,40 @@
 # merge back into the single-machine render, and mismatched, overlapping or missing parts
 # are refused with exit 2 and a message.
 #   usage: sh tests/render/test-merge.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 scene=scenes/materials/metal.txt
 size="--size 48x27"
+# What every render of the test scene gets (render in lib.sh): the test size, 16 spp.
+render_options="$size --spp 16"
 full=$scratch/full.exr
-
-# render OUTPUT [OPTIONS...]: renders the test scene at the test size, 16 spp, quietly.
-render() {
-    out=$1
-    shift
-    "$program" render "$scene" -o "$out" $size --spp 16 --quiet "$@"
-}
-
-# stats_of FILE [--crop C]: runs `stats` once and keeps its output in $scratch/stats, which
-# stat_range and stat_metadata read (each `stats` run costs an OpenImageIO start-up).
-stats_of() {
-    "$program" stats "$@" >"$scratch/stats" 2>&1
-}
-
-# stat_range CHANNEL: "min max" of a channel in the last stats_of output.
-stat_range() {
-    sed -n "s/^channel $1: mean [^ ]* min \([^ ]*\) max \([^ ]*\)/\1 \2/p" "$scratch/stats"
-}
-
-# stat_metadata NAME: an rtspheres:NAME value in the last stats_of output.
-stat_metadata() {
-    sed -n "s/^metadata rtspheres:$1: //p" "$scratch/stats"
-}
 
 # merge_ok NAME EXPECTED TOLERANCE PARTS...: merges PARTS into $scratch/NAME.exr and
 # compares the result with EXPECTED by `diff --fail TOLERANCE --failpercent 0`; also
 # checks that every pixel has 16 samples and the merged image says it is complete.
 merge_ok() {
-    name=$1 expected=$2 tolerance=$3
+    merge_name=$1 merge_expected=$2 merge_tolerance=$3
     shift 3
-    merged=$scratch/$name.exr
-    if ! "$program" merge "$@" -o "$merged" --quiet 2>"$scratch/stderr"; then
-        fail "$name" "merge failed: $(head -c 300 "$scratch/stderr")"
-    elif ! "$program" diff "$merged" "$expected" --fail "$tolerance" --failpercent 0 >"$scratch/diff" 2>&1; then
-        fail "$name" "merged image differs from the full render: $(tr '\n' ' ' <"$scratch/diff")"
-    elif ! stats_of "$merged" || [ "$(stat_range samples)" != "16 16" ]; then
-        fail "$name" "samples channel min/max is '$(stat_range samples)', expected '16 16'"
+    problem=$(merge_problem "$merge_expected" "$merge_tolerance" 16 "$scratch/$merge_name.exr" "$@")
+    if [ -n "$problem" ]; then
+        fail "$merge_name" "$problem"
     elif [ "$(stat_metadata spp)" != 16 ] || [ "$(stat_metadata complete)" != 1 ]; then
-        fail "$name" "metadata spp '$(stat_metadata spp)', complete '$(stat_metadata complete)'"
+        fail "$merge_name" "metadata spp '$(stat_metadata spp)', complete '$(stat_metadata complete)'"
     elif grep -q merged_parts "$scratch/stats" && [ "$(stat_metadata merged_parts)" != $# ]; then
         # (checked where `stats` prints rtspheres:merged_parts)
-        fail "$name" "metadata merged_parts '$(stat_metadata merged_parts)', expected $#"
+        fail "$merge_name" "metadata merged_parts '$(stat_metadata merged_parts)', expected $#"
     else
-        pass "$name"
+        pass "$merge_name"
     fi
 }
 
 # refuse NAME PATTERN PARTS...: merging PARTS exits 2, says PATTERN (grep -E) on stderr and
 # writes no output.
 refuse() {
-    name=$1 pattern=$2
+    refuse_name=$1 refuse_pattern=$2
     shift 2
-    rm -f "$scratch/refused.exr"
-    "$program" merge "$@" -o "$scratch/refused.exr" >/dev/null 2>"$scratch/stderr"
-    got=$?
-    if [ "$got" != 2 ]; then
-        fail "$name" "exit $got, expected 2; stderr: $(head -c 300 "$scratch/stderr")"
-    elif ! grep -qE -e "$pattern" "$scratch/stderr"; then
-        fail "$name" "stderr lacks /$pattern/: $(head -c 300 "$scratch/stderr")"
-    elif [ -e "$scratch/refused.exr" ]; then
-        fail "$name" "an output was written although the merge was refused"
-    else
-        pass "$name"
-    fi
+    expect_refusal "$refuse_name" "$refuse_pattern" "$scratch/refused" \
+        "$program" merge "$@" -o "$scratch/refused/out.exr"
 }
 
 if ! render "$full"; then

@@ -4,33 +4,13 @@
 # exactly, the contact sheet holds the frames as they are, and bad montages exit 2
 # without touching their inputs.
 #   usage: sh tests/render/test-montage-sweep.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
-
-# expect_exit NAME CODE PATTERN COMMAND...: runs COMMAND, checks its exit code and that
-# stderr contains PATTERN (a grep -E expression).
-expect_exit() {
-    name=$1 code=$2 pattern=$3
-    shift 3
-    "$@" >"$scratch/stdout" 2>"$scratch/stderr"
-    got=$?
-    if [ "$got" != "$code" ]; then
-        fail "$name" "exit $got, expected $code; stderr: $(head -c 300 "$scratch/stderr")"
-    elif [ -n "$pattern" ] && ! grep -qE -e "$pattern" "$scratch/stderr"; then
-        fail "$name" "stderr lacks /$pattern/: $(head -c 300 "$scratch/stderr")"
-    else
-        pass "$name"
-    fi
-}
 
 image_size() { "$program" stats "$1" | sed -n 's/^size: //p'; }
 
 # colour_means FILE [CROP]: "R G B", the colour channels' means, from one `stats` run.
 colour_means() {
-    if [ -n "${2:-}" ]; then "$program" stats "$1" --crop "$2"; else "$program" stats "$1"; fi |
-        sed -n 's/^channel [RGB]: mean \([^ ]*\) .*/\1/p' | tr '\n' ' '
+    "$program" stats "$1" ${2:+--crop "$2"} | sed -n 's/^channel [RGB]: mean \([^ ]*\) .*/\1/p' | tr '\n' ' '
 }
 
 # same_means A CROP_A B CROP_B: true when every colour channel's mean agrees to 8-bit

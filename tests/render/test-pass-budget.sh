@@ -5,9 +5,6 @@
 # that per sample; the shader counts the segments it traced, and the image must not
 # depend on how the work is split into passes.
 #   usage: sh tests/render/test-pass-budget.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 # Every sample in the mirror cell runs exactly depth = 20000 segments (see the scene).

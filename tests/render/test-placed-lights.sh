@@ -5,9 +5,6 @@
 # sampling and the Whitted integrator see them. Spheres under a rotation or a non-uniform
 # scale stay instanced (found by BSDF sampling only): checked too.
 #   usage: sh tests/render/test-placed-lights.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 # lights_and_instances SCENE [OPTIONS]: "N instances, M lights" from --verbose.

@@ -2,9 +2,6 @@
 # test-postprocess.sh: AOVs (their layers and their values on scenes where they are known),
 # the denoiser, blur, exposure and tone mapping from the command line.
 #   usage: sh tests/render/test-postprocess.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 scene=scenes/three-balls.txt
 small="--size 96x54 --seed 3 --quiet"
@@ -14,16 +11,16 @@ rms() { "$program" diff "$1" "$2" --fail 1 --failpercent 100 | sed -n 's/^rms er
 
 # stats_lines FILE [CROP]: the "channel NAME: mean M min A max B" lines of `stats`.
 stats_lines() {
-    if [ -n "${2:-}" ]; then "$program" stats "$1" --crop "$2"; else "$program" stats "$1"; fi | grep '^channel '
+    "$program" stats "$1" ${2:+--crop "$2"} | grep '^channel '
 }
 
 # pixel FILE X Y: `stats` of the one pixel (X, Y) (row 0 at the top) into $scratch/pixel;
 # value CHANNEL then reads that pixel's value of a channel.
 pixel() { "$program" stats "$1" --crop "$2,$3,$(($2 + 1)),$(($3 + 1))" >"$scratch/pixel"; }
-value() { sed -n "s/^channel $1: mean \([^ ]*\) .*/\1/p" "$scratch/pixel"; }
+value() { stat_mean "$1" "$scratch/pixel"; }
 
 # range_of CHANNEL: "min max" of a channel in the stats lines kept in $scratch/inside.
-range_of() { sed -n "s/^channel $1: mean [^ ]* min \([^ ]*\) max \([^ ]*\)/\1 \2/p" "$scratch/inside"; }
+range_of() { stat_range "$1" "$scratch/inside"; }
 
 # near A B TOLERANCE: true when |A - B| <= TOLERANCE (absolute) and A is a number.
 near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a != "" && d <= t) }'; }

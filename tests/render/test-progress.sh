@@ -3,9 +3,6 @@
 # script(1), which gives the command a pseudo-terminal), never when stderr is a file or
 # with --quiet; the one-line summary comes at the end unless --quiet.
 #   usage: sh tests/render/test-progress.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 render="$program render scenes/three-balls.txt --size 64x36 --spp 128"

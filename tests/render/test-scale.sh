@@ -3,9 +3,6 @@
 # here) loads, builds its BVH and renders, and its image is the sphere it approximates:
 # a diffuse furnace, exactly the albedo where the camera sees the mesh.
 #   usage: sh tests/render/test-scale.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 if ! cc -std=c11 -O2 scenes/generators/assets.c -lm -o "$scratch/assets" 2>"$scratch/cc.err"; then

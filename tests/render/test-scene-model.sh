@@ -2,9 +2,6 @@
 # test-scene-model.sh: the scene model end to end (groups, transforms, instances, meshes,
 # volumes, textures) checked against what must be true whatever the noise.
 #   usage: sh tests/render/test-scene-model.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 here=$(cd "$(dirname "$0")" && pwd)
 

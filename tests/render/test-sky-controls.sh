@@ -5,9 +5,6 @@
 # (right-handed about +Y: what was at +X comes to -Z, in front of the camera), so a
 # camera turned to look at +X in the unturned sky sees the same picture.
 #   usage: sh tests/render/test-sky-controls.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 assets="$(pwd)/scenes/assets"

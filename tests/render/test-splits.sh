@@ -5,59 +5,32 @@
 # position in the list is I mod N, and options that contradict each other are usage
 # errors (exit 2, a message, nothing written).
 #   usage: sh tests/render/test-splits.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 scene=scenes/materials/metal.txt
 size="--size 48x27"
+# What every render of the test scene gets (render in lib.sh): the test size, 16 spp.
+render_options="$size --spp 16"
 full=$scratch/full.exr
-
-# render OUTPUT [OPTIONS...]: the test scene at the test size, 16 spp, quietly.
-render() {
-    out=$1
-    shift
-    "$program" render "$scene" -o "$out" $size --spp 16 --quiet "$@"
-}
 
 # merged_equals NAME TOLERANCE PARTS...: merges PARTS (into $scratch/merged.exr) and compares the result with the
 # full render by `diff --fail TOLERANCE --failpercent 0`; every pixel must have 16 samples.
 merged_equals() {
-    name=$1 tolerance=$2
+    merged_name=$1 merged_tolerance=$2
     shift 2
-    merged=$scratch/merged.exr
-    rm -f "$merged"
-    if ! "$program" merge "$@" -o "$merged" --quiet 2>"$scratch/stderr"; then
-        fail "$name" "merge failed: $(head -c 300 "$scratch/stderr")"
-    elif ! "$program" diff "$merged" "$full" --fail "$tolerance" --failpercent 0 >"$scratch/diff" 2>&1; then
-        fail "$name" "merged parts differ from the full render: $(tr '\n' ' ' <"$scratch/diff" | head -c 300)"
-    elif [ "$(channel_range "$merged" samples)" != "16 16" ]; then
-        fail "$name" "samples min/max '$(channel_range "$merged" samples)', expected '16 16'"
-    else
-        pass "$name"
-    fi
+    problem=$(merge_problem "$full" "$merged_tolerance" 16 "$scratch/merged.exr" "$@")
+    if [ -n "$problem" ]; then fail "$merged_name" "$problem"; else pass "$merged_name"; fi
 }
 
 # usage_error NAME PATTERN ARGS...: `render ARGS` (the test scene, size and spp, output
 # $scratch/refused/out.exr or a pattern there) exits 2, says PATTERN (grep -E) on stderr
 # and writes nothing.
 usage_error() {
-    name=$1 pattern=$2
+    usage_name=$1 usage_pattern=$2
     shift 2
-    rm -rf "$scratch/refused"
-    mkdir -p "$scratch/refused"
-    "$program" render "$scene" $size --spp 16 --quiet "$@" >/dev/null 2>"$scratch/stderr"
-    got=$?
-    if [ "$got" != 2 ]; then
-        fail "$name" "exit $got, expected 2; stderr: $(head -c 300 "$scratch/stderr")"
-    elif ! grep -qE -e "$pattern" "$scratch/stderr"; then
-        fail "$name" "stderr lacks /$pattern/: $(head -c 300 "$scratch/stderr")"
-    elif [ -n "$(ls -A "$scratch/refused")" ]; then
-        fail "$name" "files were written: $(ls -A "$scratch/refused" | tr '\n' ' ')"
-    else
-        pass "$name"
-    fi
+    # shellcheck disable=SC2086 # $render_options is a list of options
+    expect_refusal "$usage_name" "$usage_pattern" "$scratch/refused" \
+        "$program" render "$scene" $render_options --quiet "$@"
 }
 
 if ! render "$full"; then

@@ -2,9 +2,6 @@
 # test-textures-sky.sh: textures, image textures, the sky box and the environment map,
 # and motion blur, checked by what must hold exactly (not against goldens).
 #   usage: sh tests/render/test-textures-sky.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 # ppm FILE TOP BOTTOM: an 8x8 binary PPM whose top four rows are colour TOP and bottom

@@ -13,9 +13,6 @@
 # spheres left out of next-week.txt). Between them the scenes below leave out and keep
 # each feature.
 #   usage: sh tests/render/test-tracer-variants.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 # check NAME SCENE [OPTIONS...]: renders SCENE both ways and compares.

@@ -5,9 +5,6 @@
 # which must show: the smooth, textured quad below differs from the flat one. Also in a
 # placed group, the corner normals move with the triangle.
 #   usage: sh tests/render/test-triangle-attributes.sh PROGRAM SCRATCH_DIR
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 earth="$(pwd)/scenes/assets/earth.ppm"

@@ -7,9 +7,6 @@
 # The render under valgrind takes most of the time (llvmpipe compiling the tracer shader,
 # slowed down some 50 times), so it runs in the background while the other commands run
 # one after the other on the second core.
-set -u
-program=$1
-scratch=$2
 . "$(dirname "$0")/lib.sh"
 
 if ! command -v valgrind >/dev/null 2>&1; then

@@ -19,6 +19,7 @@
 
 #include "bvh.h"
 #include "packed_layout.h"
+#include "support.h"
 
 /* ---- deterministic random numbers (splitmix64) ---- */
 
@@ -26,18 +27,10 @@ typedef struct random_source {
     uint64_t state;
 } random_source;
 
-static uint64_t random_next(random_source *source)
-{
-    uint64_t z = (source->state += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
 /* Returns a float in [low, high). */
 static float random_float(random_source *source, float low, float high)
 {
-    float unit = (float)(random_next(source) >> 40) * 0x1.0p-24f;
+    float unit = (float)(splitmix64_next(&source->state) >> 40) * 0x1.0p-24f;
     /* Not low + (high - low) * unit: high - low overflows for ranges near FLT_MAX. */
     return low * (1 - unit) + high * unit;
 }
@@ -45,7 +38,7 @@ static float random_float(random_source *source, float low, float high)
 /* Returns an integer in [0, bound). */
 static uint32_t random_below(random_source *source, uint32_t bound)
 {
-    return (uint32_t)(random_next(source) % bound);
+    return (uint32_t)(splitmix64_next(&source->state) % bound);
 }
 
 /* ---- boxes ---- */

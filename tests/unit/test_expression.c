@@ -11,23 +11,11 @@
 #include <string.h>
 
 #include "expression.h"
+#include "support.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-/* cmocka 1.1 compares floats only in single precision: this checks doubles. */
-#define assert_double_equal(actual, expected, tolerance) \
-    check_double_equal((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
-
-static void check_double_equal(double actual, double expected, double tolerance, const char *text,
-                               const char *file, int line)
-{
-    if (!(fabs(actual - expected) <= tolerance)) {
-        print_error("%s is %.17g, expected %.17g (tolerance %g)\n", text, actual, expected, tolerance);
-        _fail(file, line);
-    }
-}
 
 /* Variables the tests can use: $a = 2, $b = 3, $abc = 10, $huge = 1e308. */
 static bool test_lookup(void *context, const char *name, size_t length, double *value)

@@ -11,32 +11,9 @@
 #include <string.h>
 
 #include "image_diff.h"
+#include "support.h"
 
 #define CLOSE 1e-12
-
-/* cmocka's assert_float_equal works in float; these metrics are doubles. */
-#define assert_close(actual, expected, tolerance) \
-    assert_close_at((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
-
-static void assert_close_at(double actual, double expected, double tolerance, const char *what,
-                            const char *file, int line)
-{
-    if (actual == expected || fabs(actual - expected) <= tolerance)
-        return;
-    print_error("%s is %.17g, expected %.17g (within %g)\n", what, actual, expected, tolerance);
-    _fail(file, line);
-}
-
-/* Makes a width x height image with every sample set to value. */
-static rt_image make_image(int width, int height, int channels, float value)
-{
-    rt_image image;
-    rt_error error;
-    assert_int_equal(image_create(&image, width, height, channels, &error), RT_OK);
-    for (int i = 0; i < width * height * channels; i++)
-        image.pixels[i] = value;
-    return image;
-}
 
 static float *sample(rt_image *image, int x, int y, int c)
 {

@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "image_io.h"
+#include "support.h"
 
 /* Under SAN=1: OpenImageIO 2.4 leaks one error string when libpng gives up on a truncated
  * PNG (it longjmps past the string's destructor). These hooks, read by the sanitizer
@@ -34,63 +35,6 @@ const char *__asan_default_options(void);
 const char *__lsan_default_suppressions(void);
 const char *__asan_default_options(void) { return "fast_unwind_on_malloc=0"; }
 const char *__lsan_default_suppressions(void) { return "leak:PNGInput::PngReadCallback\n"; }
-
-#define assert_contains(haystack, needle) \
-    assert_contains_at((haystack), (needle), __FILE__, __LINE__)
-
-static void assert_contains_at(const char *haystack, const char *needle, const char *file, int line)
-{
-    if (strstr(haystack, needle) != NULL)
-        return;
-    print_error("'%s' does not contain '%s'\n", haystack, needle);
-    _fail(file, line);
-}
-
-typedef struct scratch {
-    char directory[256];
-    char path[512];  /* the last path made by in_scratch() */
-} scratch;
-
-/* Returns directory/name in the scratch's path buffer (overwritten by the next call). */
-static const char *in_scratch(scratch *s, const char *name)
-{
-    snprintf(s->path, sizeof s->path, "%s/%s", s->directory, name);
-    return s->path;
-}
-
-static int make_scratch(void **state)
-{
-    scratch *s = calloc(1, sizeof *s);
-    if (s == NULL)
-        return -1;
-    const char *tmp = getenv("TMPDIR");
-    snprintf(s->directory, sizeof s->directory, "%s/test_image_io.XXXXXX",
-             tmp && *tmp ? tmp : "/tmp");
-    if (mkdtemp(s->directory) == NULL) {
-        free(s);
-        return -1;
-    }
-    *state = s;
-    return 0;
-}
-
-/* Removes the scratch directory and what the test left in it (regular files only). */
-static int remove_scratch(void **state)
-{
-    scratch *s = *state;
-    DIR *dir = opendir(s->directory);
-    if (dir != NULL) {
-        struct dirent *entry;
-        while ((entry = readdir(dir)) != NULL) {
-            if (strcmp(entry->d_name, ".") != 0 && strcmp(entry->d_name, "..") != 0)
-                unlink(in_scratch(s, entry->d_name));
-        }
-        closedir(dir);
-    }
-    rmdir(s->directory);
-    free(s);
-    return 0;
-}
 
 /* Asserts the scratch directory holds exactly the names given (NULL-terminated list), so
  * that no temporary file was left behind. */

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "merge.h"
+#include "support.h"
 
 /* Makes a part: a width x height region at (x, y) of a full_width x full_height image,
  * channels R, G, B, samples, every pixel colour (r, g, b) with n samples. full_width 0
@@ -73,18 +74,15 @@ static rt_status add(merger *m, const char *name, rt_image part, merge_metadata 
 }
 
 /* Asserts that text contains every one of the NULL-terminated fragments. */
-static void assert_mentions(const char *text, ...)
+#define assert_mentions(text, ...) check_mentions((text), __FILE__, __LINE__, __VA_ARGS__)
+
+static void check_mentions(const char *text, const char *file, int line, ...)
 {
     va_list fragments;
-    va_start(fragments, text);
+    va_start(fragments, line);
     const char *fragment;
-    while ((fragment = va_arg(fragments, const char *)) != NULL) {
-        if (strstr(text, fragment) == NULL) {
-            print_error("'%s' does not mention '%s'\n", text, fragment);
-            va_end(fragments);
-            fail();
-        }
-    }
+    while ((fragment = va_arg(fragments, const char *)) != NULL)
+        support_check_contains(text, fragment, file, line);
     va_end(fragments);
 }
 
@@ -416,43 +414,6 @@ static void test_malformed_parts(void **state)
     assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_ERROR_INPUT);
     assert_mentions(error.message, "no parts", NULL);
     merger_free(m);
-}
-
-typedef struct scratch {
-    char directory[256];
-    char path[512];
-} scratch;
-
-static int make_scratch(void **state)
-{
-    scratch *s = calloc(1, sizeof *s);
-    const char *tmp = getenv("TMPDIR");
-    snprintf(s->directory, sizeof s->directory, "%s/test_merge.XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (mkdtemp(s->directory) == NULL) {
-        free(s);
-        return -1;
-    }
-    *state = s;
-    return 0;
-}
-
-static int remove_scratch(void **state)
-{
-    scratch *s = *state;
-    static const char *const names[] = {"part.exr", "bare.exr", "rgb.exr"};
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
-        snprintf(s->path, sizeof s->path, "%s/%s", s->directory, names[i]);
-        unlink(s->path);
-    }
-    rmdir(s->directory);
-    free(s);
-    return 0;
-}
-
-static const char *in_scratch(scratch *s, const char *name)
-{
-    snprintf(s->path, sizeof s->path, "%s/%s", s->directory, name);
-    return s->path;
 }
 
 /* merge_read_part reads what render writes: the data window and the metadata. */

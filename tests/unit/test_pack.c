@@ -14,16 +14,13 @@
 
 #include "pack.h"
 #include "packed_traverse.h"
+#include "support.h"
 
-/* splitmix64: a small deterministic generator for test data. */
+/* A number in [0, 1) from the splitmix64 sequence of support.h (the test data). */
 static uint64_t random_state;
 static double random_unit(void)
 {
-    uint64_t z = (random_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return (double)(z >> 11) / 9007199254740992.0;
+    return (double)(splitmix64_next(&random_state) >> 11) / 9007199254740992.0;
 }
 
 static void add_material(scene *s, const char *name, int type, float r, float g, float b)

@@ -14,35 +14,10 @@
 #include <string.h>
 
 #include "postprocess.h"
-
-#define assert_close(actual, expected, tolerance) \
-    assert_close_at((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
-
-static void assert_close_at(double actual, double expected, double tolerance, const char *what, const char *file,
-                            int line)
-{
-    if (actual == expected || fabs(actual - expected) <= tolerance)
-        return;
-    print_error("%s is %.9g, expected %.9g (within %g)\n", what, actual, expected, tolerance);
-    _fail(file, line);
-}
-
-/* Fails unless actual is within relative (a fraction) of expected. */
-#define assert_relative(actual, expected, relative) \
-    assert_close_at((actual), (expected), (relative) * fabs((double)(expected)), #actual, __FILE__, __LINE__)
+#include "support.h"
 
 /* ---------------------------------------------------------------------------------- */
 /* Helpers                                                                              */
-
-static rt_image make_image(int width, int height, int channels, float value)
-{
-    rt_image image;
-    rt_error error;
-    assert_int_equal(image_create(&image, width, height, channels, &error), RT_OK);
-    for (size_t i = 0; i < (size_t)width * height * channels; i++)
-        image.pixels[i] = value;
-    return image;
-}
 
 static float *at(const rt_image *image, int x, int y, int c)
 {

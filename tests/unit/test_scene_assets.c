@@ -10,7 +10,6 @@
 
 #include <cmocka.h>
 
-#include <ftw.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -23,85 +22,13 @@
 #include "obj_load.h"
 #include "scene.h"
 #include "scene_assets.h"
+#include "support.h"
 
 /* Under SAN=1 OpenImageIO needs the slow unwinder for its stacks (as in test_image_io). */
 const char *__asan_default_options(void);
 const char *__asan_default_options(void) { return "fast_unwind_on_malloc=0"; }
 
 #define POSITION "scenes/x.txt:12:6"
-
-#define assert_contains(haystack, needle) assert_contains_at((haystack), (needle), __FILE__, __LINE__)
-
-static void assert_contains_at(const char *haystack, const char *needle, const char *file, int line)
-{
-    if (strstr(haystack, needle) != NULL)
-        return;
-    print_error("'%s' does not contain '%s'\n", haystack, needle);
-    _fail(file, line);
-}
-
-#define assert_close(a, b, tolerance) assert_close_at((a), (b), (tolerance), __FILE__, __LINE__)
-
-static void assert_close_at(double a, double b, double tolerance, const char *file, int line)
-{
-    if (fabs(a - b) <= tolerance)
-        return;
-    print_error("%.9g is not within %g of %.9g\n", a, tolerance, b);
-    _fail(file, line);
-}
-
-/* ---- scratch directory ------------------------------------------------------------------ */
-
-typedef struct scratch {
-    char directory[256];
-    char path[512];  /* the last path made by in_scratch() */
-} scratch;
-
-static const char *in_scratch(scratch *s, const char *name)
-{
-    snprintf(s->path, sizeof s->path, "%s/%s", s->directory, name);
-    return s->path;
-}
-
-static int make_scratch(void **state)
-{
-    scratch *s = calloc(1, sizeof *s);
-    if (s == NULL)
-        return -1;
-    const char *tmp = getenv("TMPDIR");
-    snprintf(s->directory, sizeof s->directory, "%s/test_scene_assets.XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (mkdtemp(s->directory) == NULL) {
-        free(s);
-        return -1;
-    }
-    *state = s;
-    return 0;
-}
-
-static int remove_entry(const char *path, const struct stat *info, int flag, struct FTW *ftw)
-{
-    (void)info, (void)flag, (void)ftw;
-    return remove(path);
-}
-
-static int remove_scratch(void **state)
-{
-    scratch *s = *state;
-    nftw(s->directory, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
-    free(s);
-    return 0;
-}
-
-/* Writes text to directory/name and returns the path (in the scratch's buffer). */
-static const char *write_file(scratch *s, const char *name, const char *text)
-{
-    const char *path = in_scratch(s, name);
-    FILE *file = fopen(path, "wb");
-    assert_non_null(file);
-    assert_int_equal(fwrite(text, 1, strlen(text), file), strlen(text));
-    assert_int_equal(fclose(file), 0);
-    return path;
-}
 
 /* Writes a width x height image of channels channels, every pixel = value (per channel). */
 static void write_image(const char *path, int width, int height, int channels, const float *value)

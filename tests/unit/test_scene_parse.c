@@ -5,7 +5,6 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#include <ftw.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -15,21 +14,9 @@
 #include <unistd.h>
 
 #include "scene_parse.h"
+#include "support.h"
 
 /* ------------------------------------------------------------------ helpers */
-
-/* cmocka 1.1 compares floats only in single precision: this checks doubles. */
-#define assert_double_equal(actual, expected, tolerance) \
-    check_double_equal((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
-
-static void check_double_equal(double actual, double expected, double tolerance, const char *text,
-                               const char *file, int line)
-{
-    if (!(fabs(actual - expected) <= tolerance)) {
-        print_error("%s is %.17g, expected %.17g (tolerance %g)\n", text, actual, expected, tolerance);
-        _fail(file, line);
-    }
-}
 
 #define assert_vector_equal(vector, x, y, z)            \
     do {                                                \
@@ -114,75 +101,26 @@ static scene_parse_options options_with_defines(const scene_define *defines, int
     return options;
 }
 
-/* ---- temporary directory for file tests (one per test, removed afterwards) */
-
-typedef struct temporary_directory {
-    char path[64];
-} temporary_directory;
-
-/* Setup: makes a fresh directory under /tmp and stores it in *state. */
-static int create_directory(void **state)
-{
-    temporary_directory *directory = malloc(sizeof *directory);
-    if (directory == NULL)
-        return -1;
-    strcpy(directory->path, "/tmp/rtspheres-scene-test.XXXXXX");
-    if (mkdtemp(directory->path) == NULL) {
-        free(directory);
-        return -1;
-    }
-    *state = directory;
-    return 0;
-}
-
-/* nftw callback: removes one file or (emptied) directory. */
-static int remove_entry(const char *path, const struct stat *info, int type, struct FTW *walk)
-{
-    (void)info;
-    (void)type;
-    (void)walk;
-    return remove(path);
-}
-
-/* Teardown: removes the test's directory and everything in it. */
-static int remove_directory(void **state)
-{
-    temporary_directory *directory = *state;
-    int result = nftw(directory->path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
-    free(directory);
-    return result;
-}
+/* ---- file tests: each gets a scratch directory (support.h) as its state */
 
 /* Returns "DIRECTORY/name" in buffer. */
 static const char *path_in(void **state, const char *name, char *buffer, size_t size)
 {
-    const temporary_directory *directory = *state;
-    snprintf(buffer, size, "%s/%s", directory->path, name);
+    if (snprintf(buffer, size, "%s", in_scratch(*state, name)) >= (int)size)
+        fail_msg("the path of %s is too long", name);
     return buffer;
 }
 
-/* Writes length bytes of content to DIRECTORY/name, creating one level of subdirectory. */
+/* Writes length bytes of content to DIRECTORY/name, making its subdirectories. */
 static void write_bytes(void **state, const char *name, const char *content, size_t length)
 {
-    char path[256];
-    path_in(state, name, path, sizeof path);
-    const char *slash = strchr(name, '/');
-    if (slash != NULL) {
-        char directory[256];
-        snprintf(directory, sizeof directory, "%s/%.*s", ((temporary_directory *)*state)->path,
-                 (int)(slash - name), name);
-        mkdir(directory, 0700);
-    }
-    FILE *file = fopen(path, "wb");
-    assert_non_null(file);
-    assert_int_equal(fwrite(content, 1, length, file), length);
-    assert_int_equal(fclose(file), 0);
+    scratch_write(*state, name, content, length);
 }
 
 /* Writes the string content to DIRECTORY/name. */
 static void write_text(void **state, const char *name, const char *content)
 {
-    write_bytes(state, name, content, strlen(content));
+    write_file(*state, name, content);
 }
 
 /* Loads DIRECTORY/name and checks the error as check_parse_error does; prefix and
@@ -194,7 +132,7 @@ static void write_text(void **state, const char *name, const char *content)
 static void check_file_error(void **state, const char *name, const scene_parse_options *options,
                              const char *prefix_format, const char *phrase_format, const char *file, int line)
 {
-    const char *directory = ((temporary_directory *)*state)->path;
+    const char *directory = ((scratch *)*state)->directory;
     char path[256], prefix[512], phrase[1024];
     path_in(state, name, path, sizeof path);
     snprintf(prefix, sizeof prefix, prefix_format, directory);
@@ -915,7 +853,7 @@ static void test_load_file(void **state)
 
 static void test_unreadable_top_file(void **state)
 {
-    const char *directory = ((temporary_directory *)*state)->path;
+    const char *directory = ((scratch *)*state)->directory;
     char path[256], expected[512];
     scene s;
     rt_error error = {{0}};
@@ -969,7 +907,7 @@ static void test_include_relative_to_including_file(void **state)
 
 static void test_include_from_string_and_absolute_path(void **state)
 {
-    const char *directory = ((temporary_directory *)*state)->path;
+    const char *directory = ((scratch *)*state)->directory;
     write_text(state, "m.txt", "material m lambertian 1 1 1\n");
     char source_name[256], text[512];
     snprintf(source_name, sizeof source_name, "%s/virtual.txt", directory);
@@ -1018,7 +956,7 @@ static void test_oversized_files(void **state)
     assert_file_error(state, "zero.txt", NULL, "%s/zero.txt:1:1: ",
                       "cannot read included file '/dev/zero': File too large");
 
-    const char *directory = ((temporary_directory *)*state)->path;
+    const char *directory = ((scratch *)*state)->directory;
     char path[256], expected[512];
     write_text(state, "huge.txt", "");
     assert_int_equal(truncate(path_in(state, "huge.txt", path, sizeof path), (off_t)300 << 20), 0);
@@ -1942,7 +1880,7 @@ static void test_meshes(void **state)
 {
     write_text(state, "models/a.obj", "# not read by the parser\n");
     write_text(state, "models/part.txt", "mesh \"a.obj\"            # next to part.txt\nmesh \"../models/a.obj\"\n");
-    const char *directory = ((temporary_directory *)*state)->path;
+    const char *directory = ((scratch *)*state)->directory;
     write_text(state, "top.txt",
                "material m lambertian 1 1 1\n"
                "material n metal 1 1 1\n"
@@ -2777,17 +2715,17 @@ int main(void)
         cmocka_unit_test(test_define_used_without_set),
         cmocka_unit_test(test_define_unused_is_an_error),
         cmocka_unit_test(test_define_bad_value),
-        cmocka_unit_test_setup_teardown(test_load_file, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_unreadable_top_file, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_binary_file, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_include_relative_to_including_file, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_include_from_string_and_absolute_path, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_include_camera_position, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_missing_include, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_oversized_files, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_include_cycles, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_include_depth_limit, create_directory, remove_directory),
-        cmocka_unit_test_setup_teardown(test_define_applies_across_includes, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_load_file, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_unreadable_top_file, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_binary_file, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_include_relative_to_including_file, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_include_from_string_and_absolute_path, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_include_camera_position, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_missing_include, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_oversized_files, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_include_cycles, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_include_depth_limit, make_scratch, remove_scratch),
+        cmocka_unit_test_setup_teardown(test_define_applies_across_includes, make_scratch, remove_scratch),
         cmocka_unit_test(test_documented_example),
         cmocka_unit_test(test_textures),
         cmocka_unit_test(test_texture_errors),
@@ -2806,20 +2744,20 @@ int main(void)
         cmocka_unit_test(test_named_group_placed_again_shares_objects),
         cmocka_unit_test(test_material_inheritance),
         cmocka_unit_test(test_shapes_without_any_material),
-        cmocka_unit_test_setup_teardown(test_meshes, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_meshes, make_scratch, remove_scratch),
         cmocka_unit_test(test_volumes),
         cmocka_unit_test(test_volume_boundary_must_be_closed),
         cmocka_unit_test(test_instance_forms_and_errors),
         cmocka_unit_test(test_braces),
         cmocka_unit_test(test_nesting_limit),
-        cmocka_unit_test_setup_teardown(test_include_inside_a_block, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_include_inside_a_block, make_scratch, remove_scratch),
         cmocka_unit_test(test_documented_scene_model_example),
         cmocka_unit_test(test_lights_defaults),
         cmocka_unit_test(test_light_clauses),
         cmocka_unit_test(test_light_expressions_and_sweep),
         cmocka_unit_test(test_light_errors),
         cmocka_unit_test(test_lights_only_at_the_top_level),
-        cmocka_unit_test_setup_teardown(test_light_in_an_included_file, create_directory, remove_directory),
+        cmocka_unit_test_setup_teardown(test_light_in_an_included_file, make_scratch, remove_scratch),
         cmocka_unit_test(test_ambient),
         cmocka_unit_test(test_material_phong_and_specular),
         cmocka_unit_test(test_documented_light_example),

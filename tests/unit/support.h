@@ -1,0 +1,176 @@
+/* support.h: the helpers the cmocka unit tests share (header only: each test includes it
+ * after its own headers; every helper is static inline, so a test pays only for what it
+ * calls).
+ *
+ *   assert_close(actual, expected, tolerance)      doubles within an absolute tolerance
+ *   assert_double_equal(actual, expected, tolerance)  the same check, cmocka's naming
+ *   assert_relative(actual, expected, relative)    doubles within a fraction of expected
+ *   assert_contains(haystack, needle)              a string holds a fixed substring
+ *   make_image(width, height, channels, value)     an image with every sample = value
+ *   splitmix64_next(&state)                        reproducible 64-bit test data
+ *   scratch: make_scratch / remove_scratch (a cmocka setup/teardown pair), in_scratch,
+ *            write_file, scratch_write             a fresh directory per test
+ *
+ * The assertions fail the running test at the caller's file and line, as cmocka's own
+ * assert_* do; the value printed is the expression as written in the test. */
+#ifndef RT_TEST_SUPPORT_H
+#define RT_TEST_SUPPORT_H
+
+/* cmocka.h needs these four before it. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <errno.h>
+#include <ftw.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "image_io.h"
+
+/* ---- float assertions -------------------------------------------------------------------- */
+
+/* Fails the test at file:line unless actual equals expected or lies within tolerance of it
+ * (equality first, so that two equal infinities pass); what names the expression. cmocka
+ * 1.1's assert_float_equal compares in single precision, which these tests cannot use. */
+static inline void support_check_close(double actual, double expected, double tolerance, const char *what,
+                                       const char *file, int line)
+{
+    if (actual == expected || fabs(actual - expected) <= tolerance)
+        return;
+    print_error("%s is %.17g, expected %.17g (within %g)\n", what, actual, expected, tolerance);
+    _fail(file, line);
+}
+
+#define assert_close(actual, expected, tolerance) \
+    support_check_close((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
+
+/* The same check as assert_close, under the name cmocka's assert_float_equal suggests. */
+#define assert_double_equal(actual, expected, tolerance) assert_close(actual, expected, tolerance)
+
+/* Fails unless actual is within relative (a fraction, 0.01 = 1%) of expected. */
+#define assert_relative(actual, expected, relative)                                                   \
+    support_check_close((actual), (expected), (relative) * fabs((double)(expected)), #actual, __FILE__, \
+                        __LINE__)
+
+/* ---- string assertions ------------------------------------------------------------------- */
+
+/* Fails the test at file:line unless haystack contains needle (a fixed string). */
+static inline void support_check_contains(const char *haystack, const char *needle, const char *file, int line)
+{
+    if (strstr(haystack, needle) != NULL)
+        return;
+    print_error("'%s' does not contain '%s'\n", haystack, needle);
+    _fail(file, line);
+}
+
+#define assert_contains(haystack, needle) support_check_contains((haystack), (needle), __FILE__, __LINE__)
+
+/* ---- images ------------------------------------------------------------------------------ */
+
+/* Returns a width x height image of channels channels with every sample set to value
+ * (channel names the image_create defaults); the caller frees it with image_free. */
+static inline rt_image make_image(int width, int height, int channels, float value)
+{
+    rt_image image;
+    rt_error error;
+    assert_int_equal(image_create(&image, width, height, channels, &error), RT_OK);
+    for (size_t i = 0; i < (size_t)width * height * channels; i++)
+        image.pixels[i] = value;
+    return image;
+}
+
+/* ---- random test data -------------------------------------------------------------------- */
+
+/* Advances *state and returns the next number of the splitmix64 sequence: the same
+ * numbers on every machine and run, so a test's random scene is always the same scene. */
+static inline uint64_t splitmix64_next(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9e3779b97f4a7c15u);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+    return z ^ (z >> 31);
+}
+
+/* ---- scratch directories ----------------------------------------------------------------- */
+
+/* A fresh directory for one test (cmocka's state), removed with what the test left in it. */
+typedef struct scratch {
+    char directory[128]; /* short, so that tests may put it in fixed-size buffers */
+    char path[512];      /* the last path made by in_scratch() */
+} scratch;
+
+/* cmocka setup: makes $TMPDIR/PROGRAM.XXXXXX (/tmp without TMPDIR) and stores a malloc'ed
+ * scratch in *state; returns 0, or -1 (the test then fails) when it cannot. */
+static inline int make_scratch(void **state)
+{
+    scratch *s = calloc(1, sizeof *s);
+    if (s == NULL)
+        return -1;
+    const char *tmp = getenv("TMPDIR");
+    snprintf(s->directory, sizeof s->directory, "%s/%s.XXXXXX", tmp && *tmp ? tmp : "/tmp",
+             program_invocation_short_name);
+    if (mkdtemp(s->directory) == NULL) {
+        free(s);
+        return -1;
+    }
+    *state = s;
+    return 0;
+}
+
+/* nftw callback of remove_scratch: removes one file, link or (already emptied) directory. */
+static inline int support_remove_entry(const char *path, const struct stat *info, int type, struct FTW *walk)
+{
+    (void)info, (void)type, (void)walk;
+    return remove(path);
+}
+
+/* cmocka teardown: removes the scratch directory and everything in it (without following
+ * links), and frees the scratch; returns 0 when all of it was removed. */
+static inline int remove_scratch(void **state)
+{
+    scratch *s = *state;
+    int result = nftw(s->directory, support_remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+    free(s);
+    return result == 0 ? 0 : -1;
+}
+
+/* Returns directory/name in the scratch's path buffer (overwritten by the next call). */
+static inline const char *in_scratch(scratch *s, const char *name)
+{
+    snprintf(s->path, sizeof s->path, "%s/%s", s->directory, name);
+    return s->path;
+}
+
+/* Writes length bytes to directory/name, making the directories name passes through when
+ * missing, and fails the test unless every byte is written; returns the path (in the
+ * scratch's buffer). */
+static inline const char *scratch_write(scratch *s, const char *name, const void *bytes, size_t length)
+{
+    for (const char *slash = strchr(name, '/'); slash != NULL; slash = strchr(slash + 1, '/')) {
+        char directory[sizeof s->path];
+        snprintf(directory, sizeof directory, "%s/%.*s", s->directory, (int)(slash - name), name);
+        if (mkdir(directory, 0700) != 0 && errno != EEXIST)
+            fail_msg("cannot make %s: %s", directory, strerror(errno));
+    }
+    const char *path = in_scratch(s, name);
+    FILE *file = fopen(path, "wb");
+    assert_non_null(file);
+    assert_int_equal(fwrite(bytes, 1, length, file), length);
+    assert_int_equal(fclose(file), 0);
+    return path;
+}
+
+/* Writes the string text to directory/name as scratch_write does; returns the path. */
+static inline const char *write_file(scratch *s, const char *name, const char *text)
+{
+    return scratch_write(s, name, text, strlen(text));
+}
+
+#endif
