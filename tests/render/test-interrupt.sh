@@ -95,9 +95,10 @@ code=$?
 if [ "$code" = 2 ]; then pass "resume refuses another size"
 else fail "resume refuses another size" "exit $code: $(cat "$scratch/err")"; fi
 
-# --checkpoint writes the partial while the render runs.
-# shellcheck disable=SC2086
-"$program" render $scene -o "$scratch/cp.exr" $options --checkpoint 0.3 --quiet &
+# --checkpoint writes the partial while the render runs. A render that cannot finish
+# before it is killed (with $options it took about 0.9 s, and it once finished and removed
+# its partial between the file's appearance and the checks below).
+"$program" render $scene -o "$scratch/cp.exr" --size 48x27 --spp 1000000 --seed 3 --checkpoint 0.3 --quiet &
 pid=$!
 if wait_for_file "$scratch/cp.partial.exr" && kill -0 "$pid" 2>/dev/null &&
    [ "$(metadata "$scratch/cp.partial.exr" complete)" = 0 ]; then
