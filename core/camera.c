@@ -38,8 +38,10 @@ rt_status camera_frame_compute(const scene_camera *camera, int width, int height
     glm_vec3_copy(w, frame->w);
     glm_vec3_scale(u, 2 * half_width, frame->horizontal);
     glm_vec3_scale(v, 2 * half_height, frame->vertical);
-    for (int i = 0; i < 3; i++)
-        frame->lower_left[i] = from[i] - half_width * u[i] - half_height * v[i] - focus * w[i];
+    glm_vec3_copy(from, frame->lower_left);
+    glm_vec3_muladds(u, -half_width, frame->lower_left);
+    glm_vec3_muladds(v, -half_height, frame->lower_left);
+    glm_vec3_muladds(w, -focus, frame->lower_left);
     frame->lens_radius = camera->aperture * 0.5f;
     frame->focus_distance = focus;
     return RT_OK;
@@ -48,9 +50,14 @@ rt_status camera_frame_compute(const scene_camera *camera, int width, int height
 void camera_frame_ray(const camera_frame *frame, float s, float t, float a, float b, float origin[3],
                       float direction[3])
 {
-    for (int i = 0; i < 3; i++) {
-        origin[i] = frame->origin[i] + frame->lens_radius * (a * frame->u[i] + b * frame->v[i]);
-        direction[i] = frame->lower_left[i] + s * frame->horizontal[i] + t * frame->vertical[i] - origin[i];
-    }
+    vec3 lens;
+    glm_vec3_scale((float *)frame->u, a, lens);
+    glm_vec3_muladds((float *)frame->v, b, lens);
+    glm_vec3_copy((float *)frame->origin, origin);
+    glm_vec3_muladds(lens, frame->lens_radius, origin);
+    glm_vec3_copy((float *)frame->lower_left, direction);
+    glm_vec3_muladds((float *)frame->horizontal, s, direction);
+    glm_vec3_muladds((float *)frame->vertical, t, direction);
+    glm_vec3_sub(direction, origin, direction);
     glm_vec3_normalize(direction);
 }

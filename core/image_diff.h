@@ -1,10 +1,12 @@
-/* image_diff.h: per-pixel comparison of two images, in the spirit of OpenImageIO's idiff.
+/* image_diff.h: per-pixel comparison of two images, in the spirit of OpenImageIO's idiff,
+ * through OpenImageIO's ImageBufAlgo::compare (a thin C shim over C++, like image_io.cpp).
  *
  * Compares the first min(3, channels) channels (colour; alpha and extra layers are not
  * compared). The error of a pixel is the largest absolute difference over its compared
- * channels. A pixel "fails" when its error exceeds fail_threshold; the comparison
- * passes when the share of failing pixels is at most fail_percent and no pixel's error
- * exceeds hard_fail (when hard_fail > 0).
+ * channels. A pixel "fails" when its error exceeds fail_threshold (taken in single
+ * precision, as compare takes it); the comparison passes when the share of failing pixels
+ * is at most fail_percent and no pixel's error exceeds hard_fail (when hard_fail > 0).
+ * Equal infinities do not differ; an infinity against anything else is an infinite error.
  *
  * Defaults of image_diff_options (zero means default):
  *   fail_threshold 0.016, fail_percent 1.0 (percent of pixels), hard_fail off,
@@ -17,6 +19,10 @@
 
 #include "image_io.h"
 #include "status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 typedef struct image_diff_options {
     double fail_threshold;
@@ -44,5 +50,9 @@ image_diff_options image_diff_options_defaults(void);
  * image_free) an RGB image of |a - b| * diff_scale per compared channel. */
 rt_status image_diff(const rt_image *a, const rt_image *b, const image_diff_options *options,
                      image_diff_result *result, rt_image *difference_image, rt_error *error);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

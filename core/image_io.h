@@ -71,8 +71,9 @@ image_write_options image_write_options_defaults(void);
 rt_status image_create(rt_image *image, int width, int height, int channels, rt_error *error);
 
 /* Makes *out (allocated; free with image_free()) holding a's channels then b's, with their
- * names, and a's place (x, y, full size). Different sizes: RT_ERROR_INPUT; more than
- * IMAGE_MAX_CHANNELS together: RT_ERROR_INPUT. */
+ * names (ImageBufAlgo::channel_append's: a name of b that a already has becomes
+ * "channelN", N its place in out), and a's place (x, y, full size). Different sizes:
+ * RT_ERROR_INPUT; more than IMAGE_MAX_CHANNELS together: RT_ERROR_INPUT. */
 rt_status image_append_channels(const rt_image *a, const rt_image *b, rt_image *out, rt_error *error);
 
 /* Frees image->pixels and zeroes *image. */

@@ -1,19 +1,23 @@
 /* obj_load.cpp: see obj_load.h. A thin extern "C" shim over tinyobjloader; no C++
  * exception crosses the C boundary.
  *
- * tinyobjloader is lenient where a renderer must not be: it reads "nan" or "abc" as 0,
- * keeps out-of-range indices of triangles, and reports an index past the end only as a
- * warning. So the file is read into memory and checked first, line by line, by the same
- * line and statement rules tinyobjloader uses (check_obj_text); then tinyobjloader parses
- * and triangulates the checked text, and every index it returns is checked again against
- * the arrays it built.
+ * tinyobjloader reads the file: which statements exist, how numbers and indices are read,
+ * how faces are triangulated, which MTL file of an `mtllib` line is used. This file only
+ * opens the files (so that errors carry errno's reason), hands tinyobjloader the MTL files
+ * through a MaterialReader (paths relative to the OBJ file), validates the arrays it
+ * returns (indices in range, finite numbers, at least one triangle, counts that fit 32
+ * bits) and turns them into the flat mesh of obj_load.h.
  *
- * Materials: tinyobjloader forgets the name of a `usemtl` that no MTL file defines (the
- * faces get material -1), but such names are how a mesh refers to the scene's own
- * materials. So the text handed to tinyobjloader starts with one extra `mtllib` line of
- * our own; our MaterialReader, called for it before any `usemtl`, loads every MTL file
- * the OBJ names and then adds an entry for every other `usemtl` name. The extra line
- * shifts tinyobjloader's line numbers by one, which its error messages are corrected for.
+ * The legacy LoadObj(istream, MaterialReader) is used rather than tinyobj::ObjReader,
+ * which takes no MaterialReader of its own: the reader is what keeps an unreadable MTL
+ * file a warning with its reason and the names of `usemtl` lines no MTL file defines.
+ *
+ * Those names: tinyobjloader gives their faces material -1 and keeps the name only in a
+ * warning ("material [ 'NAME' ] not found in .mtl"), but such names are how a mesh refers
+ * to the scene's own materials. So when that warning comes, the file is parsed once more,
+ * its text preceded by an `mtllib` line of our own for which the reader defines every such
+ * name as a placeholder. That second parse changes only the material ids; its line
+ * numbers are one off, so every message comes from the first parse.
  */
 #include "obj_load.h"
 
@@ -21,7 +25,6 @@
 
 #include <cctype>
 #include <cerrno>
-#include <cfloat>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -41,271 +44,21 @@
 
 #include <sys/stat.h>
 
+#include "hash.h"
+
 namespace {
 
 /* A reason the file cannot be loaded: thrown inside, turned into an rt_error at the edge. */
 struct obj_failure {
-    rt_status status;
     std::string reason;
 };
 
 [[noreturn]] void fail(const std::string &reason)
 {
-    throw obj_failure{RT_ERROR_INPUT, reason};
+    throw obj_failure{reason};
 }
 
-[[noreturn]] void fail_at(size_t line, const std::string &reason)
-{
-    fail("line " + std::to_string(line) + ": " + reason);
-}
-
-/* The name of our own first `mtllib` line; no real file is looked up by it. */
-const char *const synthetic_library = "<rtspheres-materials>";
-
-/* The kinds of vertex elements a face corner refers to. */
-enum element_kind { POSITION = 0, UV = 1, NORMAL = 2, ELEMENT_KINDS = 3 };
-const char *const element_names[ELEMENT_KINDS] = {"vertex", "texture coordinate", "normal"};
-const char *const element_plurals[ELEMENT_KINDS] = {"vertices", "texture coordinates", "normals"};
-
-/* What check_obj_text() learns about a file. */
-struct obj_summary {
-    long long counts[ELEMENT_KINDS] = {0, 0, 0};          /* v, vt, vn lines */
-    long long largest[ELEMENT_KINDS] = {0, 0, 0};         /* largest positive index */
-    size_t largest_line[ELEMENT_KINDS] = {0, 0, 0};       /* where it is */
-    long long faces = 0;
-    std::vector<std::string> libraries;                   /* mtllib files, first use order */
-    std::vector<std::string> used_names;                  /* usemtl names, first use order */
-};
-
-bool is_blank(char c)
-{
-    return c == ' ' || c == '\t';
-}
-
-/* Splits [begin, end) at spaces and tabs (tinyobjloader's separators). */
-std::vector<std::string> split_words(const char *begin, const char *end)
-{
-    std::vector<std::string> words;
-    const char *p = begin;
-    while (p < end) {
-        while (p < end && is_blank(*p))
-            p++;
-        const char *start = p;
-        while (p < end && !is_blank(*p))
-            p++;
-        if (p > start)
-            words.emplace_back(start, p);
-    }
-    return words;
-}
-
-/* Shortens text to show in a message. */
-std::string shown(const std::string &text)
-{
-    return text.size() <= 40 ? text : text.substr(0, 37) + "...";
-}
-
-/* Checks that word is a decimal number whose float value is finite. */
-void check_number(const std::string &word, size_t line, const char *what)
-{
-    bool decimal = !word.empty();
-    for (char c : word)
-        if (!((c >= '0' && c <= '9') || c == '+' || c == '-' || c == '.' || c == 'e' || c == 'E'))
-            decimal = false;
-    const char *text = word.c_str();
-    char *end = nullptr;
-    double value = decimal ? strtod(text, &end) : 0.0;
-    if (!decimal || end != text + word.size()) {
-        std::string lower;
-        for (char c : word)
-            lower += (char)(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-        if (lower.find("nan") != std::string::npos || lower.find("inf") != std::string::npos)
-            fail_at(line, std::string(what) + " '" + shown(word) + "' is not a finite number");
-        fail_at(line, std::string(what) + " '" + shown(word) + "' is not a number");
-    }
-    if (!std::isfinite((float)value))
-        fail_at(line, std::string(what) + " '" + shown(word)
-                          + "' is not a finite number (beyond the range of a float)");
-}
-
-/* Checks a v, vt or vn line: between least and most numbers, each finite. */
-void check_numbers(const char *begin, const char *end, size_t line, const char *statement,
-                   const char *what, size_t least, size_t most)
-{
-    std::vector<std::string> words = split_words(begin, end);
-    if (words.size() < least || words.size() > most) {
-        std::string wanted = least == most ? std::to_string(least)
-                                           : std::to_string(least) + " to " + std::to_string(most);
-        fail_at(line, std::string("'") + statement + "' needs " + wanted + " numbers, found "
-                          + std::to_string(words.size()));
-    }
-    for (const std::string &word : words)
-        check_number(word, line, what);
-}
-
-/* Parses a face index (an optional sign and decimal digits); fails on anything else. */
-long long parse_index(const std::string &text, const std::string &corner, size_t line)
-{
-    size_t digits = text.size() > 0 && (text[0] == '-' || text[0] == '+') ? 1 : 0;
-    bool valid = text.size() > digits;
-    for (size_t i = digits; i < text.size(); i++)
-        if (text[i] < '0' || text[i] > '9')
-            valid = false;
-    if (!valid)
-        fail_at(line, "face corner '" + shown(corner) + "' is not of the form v, v/vt, v//vn or "
-                      "v/vt/vn with whole numbers");
-    return strtoll(text.c_str(), nullptr, 10);  /* saturates: check_index reports the range */
-}
-
-/* Checks one index of a face corner against what is known at this line. */
-void check_index(obj_summary &summary, element_kind kind, long long index, size_t line)
-{
-    const char *name = element_names[kind];
-    if (index == 0)
-        fail_at(line, std::string(name) + " index 0 in a face (OBJ indices start at 1)");
-    if (index > INT_MAX || index < -(long long)INT_MAX)
-        fail_at(line, std::string(name) + " index " + std::to_string(index) + " is out of range");
-    if (index > 0) {
-        if (index > summary.largest[kind]) {
-            summary.largest[kind] = index;
-            summary.largest_line[kind] = line;
-        }
-        return;
-    }
-    if (summary.counts[kind] + index < 0)
-        fail_at(line, "relative " + std::string(name) + " index " + std::to_string(index)
-                          + " is out of range: there are " + std::to_string(summary.counts[kind])
-                          + " " + element_plurals[kind] + " before this line");
-}
-
-/* Checks an f line: at least three corners i, i/j, i//k or i/j/k of valid indices. */
-void check_face(obj_summary &summary, const char *begin, const char *end, size_t line)
-{
-    std::vector<std::string> corners = split_words(begin, end);
-    if (corners.size() < 3)
-        fail_at(line, "a face needs at least 3 corners, found " + std::to_string(corners.size()));
-    for (const std::string &corner : corners) {
-        std::vector<std::string> parts(1);
-        for (char c : corner) {
-            if (c == '/')
-                parts.emplace_back();
-            else
-                parts.back() += c;
-        }
-        bool valid = parts.size() <= 3 && !parts[0].empty()
-                     && (parts.size() != 2 || !parts[1].empty())
-                     && (parts.size() != 3 || !parts[2].empty());
-        if (!valid)
-            fail_at(line, "face corner '" + shown(corner) + "' is not of the form v, v/vt, v//vn "
-                          "or v/vt/vn");
-        check_index(summary, POSITION, parse_index(parts[0], corner, line), line);
-        if (parts.size() >= 2 && !parts[1].empty())
-            check_index(summary, UV, parse_index(parts[1], corner, line), line);
-        if (parts.size() == 3)
-            check_index(summary, NORMAL, parse_index(parts[2], corner, line), line);
-    }
-    summary.faces++;
-}
-
-void add_unique(std::vector<std::string> &list, const std::string &item)
-{
-    for (const std::string &existing : list)
-        if (existing == item)
-            return;
-    list.push_back(item);
-}
-
-/* Checks one line (without its line ending) the way tinyobjloader reads it. */
-void check_line(obj_summary &summary, const char *begin, const char *end, size_t line)
-{
-    const char *p = begin;
-    while (p < end && is_blank(*p))
-        p++;
-    if (p == end || *p == '#')
-        return;
-    size_t length = (size_t)(end - p);
-    auto is_statement = [&](const char *word) {
-        size_t n = strlen(word);
-        return length >= n && memcmp(p, word, n) == 0 && (length == n || is_blank(p[n]));
-    };
-    if (is_statement("v")) {
-        /* x y z, optionally w or a colour r g b (tinyobjloader's extension) */
-        check_numbers(p + 1, end, line, "v", "vertex coordinate", 3, 7);
-        if (++summary.counts[POSITION] > INT_MAX)
-            fail_at(line, "more than 2^31 - 1 vertices are not supported");
-    } else if (is_statement("vn")) {
-        check_numbers(p + 2, end, line, "vn", "normal coordinate", 3, 3);
-        if (++summary.counts[NORMAL] > INT_MAX)
-            fail_at(line, "more than 2^31 - 1 normals are not supported");
-    } else if (is_statement("vt")) {
-        check_numbers(p + 2, end, line, "vt", "texture coordinate", 1, 3);
-        if (++summary.counts[UV] > INT_MAX)
-            fail_at(line, "more than 2^31 - 1 texture coordinates are not supported");
-    } else if (is_statement("f")) {
-        check_face(summary, p + 1, end, line);
-    } else if (length >= 6 && memcmp(p, "usemtl", 6) == 0) {
-        /* tinyobjloader: the name is the first word after "usemtl" */
-        const char *name = p + 6;
-        while (name < end && is_blank(*name))
-            name++;
-        const char *name_end = name;
-        while (name_end < end && !is_blank(*name_end))
-            name_end++;
-        if (name_end > name)
-            add_unique(summary.used_names, std::string(name, name_end));
-    } else if (length >= 7 && memcmp(p, "mtllib", 6) == 0 && is_blank(p[6])) {
-        /* tinyobjloader: file names separated by spaces, '\' escapes the next character */
-        std::string name;
-        bool escaping = false;
-        for (const char *c = p + 7; c <= end; c++) {
-            if (c < end && escaping) {
-                name += *c;
-                escaping = false;
-            } else if (c < end && *c == '\\') {
-                escaping = true;
-            } else if (c == end || is_blank(*c)) {
-                if (!name.empty())
-                    add_unique(summary.libraries, name);
-                name.clear();
-            } else {
-                name += *c;
-            }
-        }
-    }
-    /* Every other statement (o, g, s, l, p, vp, ...) is left to tinyobjloader, which
-     * ignores what it does not know. */
-}
-
-/* Checks the text of an OBJ file (from offset start), line by line; line endings are
- * "\n", "\r\n" or "\r", as tinyobjloader reads them. */
-obj_summary check_obj_text(const std::string &text, size_t start)
-{
-    obj_summary summary;
-    size_t line = 0;
-    size_t i = start;
-    const size_t n = text.size();
-    while (i < n) {
-        size_t begin = i;
-        while (i < n && text[i] != '\n' && text[i] != '\r')
-            i++;
-        size_t end = i;
-        if (i < n)
-            i += text[i] == '\r' && i + 1 < n && text[i + 1] == '\n' ? 2 : 1;
-        line++;
-        check_line(summary, text.data() + begin, text.data() + end, line);
-    }
-    for (int kind = 0; kind < ELEMENT_KINDS; kind++)
-        if (summary.largest[kind] > summary.counts[kind])
-            fail_at(summary.largest_line[kind],
-                    std::string(element_names[kind]) + " index "
-                        + std::to_string(summary.largest[kind]) + " is out of range: the file has "
-                        + std::to_string(summary.counts[kind]) + " " + element_plurals[kind]);
-    if (summary.faces == 0)
-        fail("has no faces");
-    return summary;
-}
-
-/* Reads the whole file. */
+/* Reads the whole file; fails with errno's reason when it cannot. */
 std::string read_file(const char *path)
 {
     struct stat info;
@@ -328,6 +81,22 @@ std::string read_file(const char *path)
     return text;
 }
 
+/* tinyobjloader reads a line only up to a NUL byte and silently drops the rest, so a
+ * binary file would load as whatever its first bytes happen to say. Refuses it, naming the
+ * line (line ends as tinyobjloader counts them: "\n", "\r\n" or "\r"). */
+void refuse_nul_bytes(const std::string &text)
+{
+    const void *nul = memchr(text.data(), '\0', text.size());
+    if (nul == nullptr)
+        return;
+    size_t at = (size_t)((const char *)nul - text.data());
+    size_t line = 1;
+    for (size_t i = 0; i < at; i++)
+        if (text[i] == '\n' || (text[i] == '\r' && text[i + 1] != '\n'))
+            line++;
+    fail("line " + std::to_string(line) + ": a NUL byte (is it a binary file?)");
+}
+
 /* The directory part of path ("" for a bare file name). */
 std::string directory_of(const std::string &path)
 {
@@ -337,88 +106,104 @@ std::string directory_of(const std::string &path)
     return slash == 0 ? "/" : path.substr(0, slash);
 }
 
-/* An istream source over a string's bytes, without a copy. */
+/* An istream source over bytes in memory, without a copy. */
 struct memory_buffer : std::streambuf {
-    explicit memory_buffer(const std::string &text)
+    memory_buffer(const char *begin, size_t size)
     {
-        char *begin = const_cast<char *>(text.data());
-        setg(begin, begin, begin + text.size());
+        char *start = const_cast<char *>(begin);
+        setg(start, start, start + size);
     }
 };
 
-/* The lines of a tinyobjloader message (warnings come several to a string, some with a
- * stray "." line), trimmed of trailing spaces and dots, empty ones left out; each "line N"
- * and "line: N" number less shift (1 for the OBJ file, whose text has our extra first
- * line; 0 for an MTL file). */
-std::vector<std::string> tinyobj_lines(const std::string &message, unsigned long long shift)
+/* Shortens text to show in a message. */
+std::string shown(const std::string &text)
+{
+    return text.size() <= 40 ? text : text.substr(0, 37) + "...";
+}
+
+/* Appends item to list unless it is there already. */
+void add_unique(std::vector<std::string> &list, const std::string &item)
+{
+    for (const std::string &existing : list)
+        if (existing == item)
+            return;
+    list.push_back(item);
+}
+
+/* The warnings in a tinyobjloader warning string, one per line, as it wrote them. Lines
+ * without a letter are left out: it ends some warnings with a stray "." line. */
+std::vector<std::string> warning_lines(const std::string &text)
 {
     std::vector<std::string> lines;
     size_t begin = 0;
-    while (begin <= message.size()) {
-        size_t end = message.find('\n', begin);
+    while (begin < text.size()) {
+        size_t end = text.find('\n', begin);
         if (end == std::string::npos)
-            end = message.size();
-        std::string line = message.substr(begin, end - begin), out;
+            end = text.size();
+        std::string line = text.substr(begin, end - begin);
         begin = end + 1;
-        size_t i = 0;
-        while (i < line.size()) {
-            size_t digits = line.compare(i, 5, "line ") == 0 ? i + 5 : line.compare(i, 6, "line: ") == 0 ? i + 6 : 0;
-            if (digits != 0 && digits < line.size() && isdigit((unsigned char)line[digits])) {
-                size_t j = digits;
-                unsigned long long number = 0;
-                while (j < line.size() && isdigit((unsigned char)line[j]))
-                    number = number * 10 + (unsigned long long)(line[j++] - '0');
-                out += line.substr(i, digits - i) + std::to_string(number > shift ? number - shift : 0);
-                i = j;
-            } else {
-                out += line[i++];
-            }
-        }
-        while (!out.empty() && (out.back() == ' ' || out.back() == '.' || out.back() == '\r'))
-            out.pop_back();
-        if (!out.empty())
-            lines.push_back(out);
+        while (!line.empty() && isspace((unsigned char)line.back()))
+            line.pop_back();
+        bool has_letter = false;
+        for (char c : line)
+            has_letter |= isalpha((unsigned char)c) != 0;
+        if (has_letter)
+            lines.push_back(line);
     }
     return lines;
 }
 
-/* Loads the MTL files and adds the usemtl-only names, on its first call (our own first
- * mtllib line); later calls (the file's own mtllib lines) have nothing left to do. */
-class material_loader : public tinyobj::MaterialReader {
-public:
-    material_loader(const std::string &directory, const obj_summary &summary)
-        : directory_(directory), summary_(summary) {}
+/* The NAME of tinyobjloader's warning "material [ 'NAME' ] not found in .mtl" (a `usemtl`
+ * naming no material of a loaded MTL file), or false when line is another warning. */
+bool unknown_material_name(const std::string &line, std::string *name)
+{
+    static const std::string head = "material [ '", tail = "' ] not found in .mtl";
+    if (line.size() < head.size() + tail.size() || line.compare(0, head.size(), head) != 0
+        || line.compare(line.size() - tail.size(), tail.size(), tail) != 0)
+        return false;
+    *name = line.substr(head.size(), line.size() - head.size() - tail.size());
+    return true;
+}
 
-    bool operator()(const std::string &, std::vector<tinyobj::material_t> *materials,
+/* The MaterialReader tinyobjloader calls for every file of an `mtllib` line, until one
+ * loads. Paths are relative to the OBJ file's directory. With placeholder names, its first
+ * call (our own first `mtllib` line) defines each of them as an empty material instead; a
+ * later MTL definition of such a name replaces the placeholder from there on. */
+class material_libraries : public tinyobj::MaterialReader {
+public:
+    material_libraries(const std::string &directory, const std::vector<std::string> &placeholders)
+        : directory_(directory), placeholders_(placeholders) {}
+
+    bool operator()(const std::string &library, std::vector<tinyobj::material_t> *materials,
                     std::map<std::string, int> *map, std::string *, std::string *) override
     {
-        if (loaded_)
+        if (!placeholders_.empty() && !placeholders_defined_) {
+            placeholders_defined_ = true;
+            for (const std::string &name : placeholders_) {
+                tinyobj::material_t placeholder = tinyobj::material_t();
+                placeholder.name = name;
+                map->insert(std::make_pair(name, (int)materials->size()));
+                materials->push_back(placeholder);
+            }
             return true;
-        loaded_ = true;
-        for (const std::string &library : summary_.libraries)
-            load_library(library, materials, map);
-        defined_count_ = materials->size();
-        for (const std::string &name : summary_.used_names) {
-            if (map->count(name) != 0)
-                continue;
-            tinyobj::material_t placeholder = tinyobj::material_t();
-            placeholder.name = name;
-            map->insert(std::make_pair(name, (int)materials->size()));
-            materials->push_back(placeholder);
         }
-        return true;
+        return load(library, materials, map);
     }
 
-    size_t defined_count() const { return defined_count_; }
+    /* Materials below this index are placeholders (not defined by an MTL file). */
+    size_t placeholder_count() const { return placeholders_defined_ ? placeholders_.size() : 0; }
     const std::vector<std::string> &warnings() const { return warnings_; }
+    /* Why the materials cannot be used, or "": kept rather than thrown, so that no
+     * exception unwinds through tinyobjloader's frames. */
     const std::string &failure() const { return failure_; }
 
 private:
-    void load_library(const std::string &library, std::vector<tinyobj::material_t> *materials,
-                      std::map<std::string, int> *map)
+    bool load(const std::string &library, std::vector<tinyobj::material_t> *materials,
+              std::map<std::string, int> *map)
     {
-        std::string path = library[0] == '/' || directory_.empty() ? library
-                                                                  : directory_ + "/" + library;
+        std::string path = library.empty() || library[0] == '/' || directory_.empty()
+                               ? library
+                               : directory_ + "/" + library;
         struct stat info;
         const char *why = nullptr;
         if (stat(path.c_str(), &info) != 0)
@@ -434,14 +219,14 @@ private:
         if (why != nullptr) {
             add_unique(warnings_, "cannot read material library '" + path + "': " + why
                                       + "; its materials are left out");
-            return;
+            return false;
         }
         size_t first = materials->size();
         std::string warnings, errors;
         tinyobj::LoadMtl(map, materials, &stream, &warnings, &errors);
-        for (const std::string &warning : tinyobj_lines(warnings, 0))
+        for (const std::string &warning : warning_lines(warnings))
             add_unique(warnings_, "tinyobjloader, in '" + path + "': " + warning);
-        for (size_t i = first; i < materials->size() && failure_.empty(); i++) {
+        for (size_t i = first; i < materials->size(); i++) {
             const tinyobj::material_t &m = (*materials)[i];
             float values[] = {m.diffuse[0],  m.diffuse[1],  m.diffuse[2],  m.specular[0],
                               m.specular[1], m.specular[2], m.emission[0], m.emission[1],
@@ -450,45 +235,99 @@ private:
                 if (!std::isfinite(value) && failure_.empty())
                     failure_ = "material '" + shown(m.name) + "' of '" + path
                                + "' has a value that is not a finite number";
+            auto named = map->find(m.name);
+            if (named != map->end() && (size_t)named->second < placeholder_count())
+                named->second = (int)i;
         }
+        return true;
     }
 
     std::string directory_;
-    const obj_summary &summary_;
-    bool loaded_ = false;
-    size_t defined_count_ = 0;
+    std::vector<std::string> placeholders_;
+    bool placeholders_defined_ = false;
     std::vector<std::string> warnings_;
     std::string failure_;
 };
 
-/* The first line of a tinyobjloader error message, its line numbers corrected for our
- * extra first line. */
-std::string tinyobj_message(const std::string &message)
+/* What one tinyobjloader parse returned. */
+struct parsed_obj {
+    tinyobj::attrib_t attrib;
+    std::vector<tinyobj::shape_t> shapes;
+    std::vector<tinyobj::material_t> materials;
+    size_t placeholder_count = 0;
+    std::vector<std::string> warnings;   /* ours, then tinyobjloader's, each once */
+};
+
+/* Has tinyobjloader parse text (with a first `mtllib` line of ours when there are
+ * placeholder names, see the top). Fails with tinyobjloader's message when it refuses. */
+parsed_obj parse(const std::string &text, const std::string &directory,
+                 const std::vector<std::string> &placeholders)
 {
-    std::vector<std::string> lines = tinyobj_lines(message, 1);
-    return lines.empty() ? "tinyobjloader could not parse it" : "tinyobjloader: " + lines[0];
+    std::string source;
+    if (!placeholders.empty())
+        source = "mtllib rtspheres:usemtl-placeholders\n" + text;
+    const std::string &parsed_text = placeholders.empty() ? text : source;
+    memory_buffer buffer(parsed_text.data(), parsed_text.size());
+    std::istream stream(&buffer);
+    material_libraries libraries(directory, placeholders);
+    parsed_obj out;
+    std::string warnings, errors;
+    bool parsed = tinyobj::LoadObj(&out.attrib, &out.shapes, &out.materials, &warnings, &errors,
+                                   &stream, &libraries, true, false);
+    if (!parsed) {
+        std::vector<std::string> lines = warning_lines(errors);
+        fail(lines.empty() ? "tinyobjloader could not parse it" : "tinyobjloader: " + lines[0]);
+    }
+    if (!libraries.failure().empty())
+        fail(libraries.failure());
+    out.placeholder_count = libraries.placeholder_count();
+    out.warnings = libraries.warnings();
+    for (const std::string &warning : warning_lines(warnings))
+        add_unique(out.warnings, "tinyobjloader: " + warning);
+    return out;
 }
 
-/* One output vertex: a position with a normal (an index of the file's, or -2 - t for the
- * geometric normal of triangle t) and a texture coordinate (or -1). */
+/* Checks that every value of an attribute array is finite; what names one element of
+ * width values in the message ("vertex 12 has a coordinate that is not a finite number"). */
+void check_finite(const std::vector<tinyobj::real_t> &values, size_t width, const char *what)
+{
+    for (size_t i = 0; i < values.size(); i++)
+        if (!std::isfinite(values[i]))
+            fail(std::string(what) + " " + std::to_string(i / width + 1)
+                 + " has a coordinate that is not a finite number (beyond the range of a float)");
+}
+
+/* Checks one index of one triangle corner: -1 (none) is allowed only where optional. */
+void check_index(int index, long long count, bool optional, size_t triangle, const char *name,
+                 const char *plural)
+{
+    if (index >= 0 && index < count)
+        return;
+    if (optional && index == -1)
+        return;
+    std::string where = "triangle " + std::to_string(triangle + 1) + ": ";
+    if (index < 0)
+        fail(where + "a relative " + name + " index points before the first " + name);
+    fail(where + name + " index " + std::to_string((long long)index + 1)
+         + " is out of range: the file has " + std::to_string(count) + " " + plural);
+}
+
+/* One output vertex: a position with a normal (an index of the file's, -1 for none, or
+ * -2 - t for the geometric normal of triangle t) and a texture coordinate (or -1). Fields
+ * ordered so the struct has no padding: it is hashed as bytes. */
 struct corner_key {
-    int position;
-    long long normal;
-    int uv;
+    int32_t position;
+    int32_t uv;
+    int64_t normal;
     bool operator==(const corner_key &other) const
     {
         return position == other.position && normal == other.normal && uv == other.uv;
     }
 };
 
+/* Hashes a corner_key with the code base's one hash (core/hash.h). */
 struct corner_hash {
-    size_t operator()(const corner_key &k) const
-    {
-        uint64_t h = (uint64_t)(uint32_t)k.position * 0x9E3779B97F4A7C15ull;
-        h ^= (uint64_t)k.normal * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
-        h ^= (uint64_t)(uint32_t)k.uv * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
-        return (size_t)h;
-    }
+    size_t operator()(const corner_key &k) const { return (size_t)hash_bytes(HASH_START, &k, sizeof k); }
 };
 
 /* Copies a vector into a malloc'd array (NULL for an empty vector). */
@@ -503,9 +342,10 @@ template <typename T> T *to_malloc(const std::vector<T> &values)
     return copy;
 }
 
-/* Makes v unit length, or zero when it is zero. In double: the squares of floats near
- * the float range (1e38) overflow a float and those of tiny ones (1e-40) underflow it,
- * but not a double, so every finite non-zero v becomes a unit vector. */
+/* Makes v unit length, or zero when it is zero. In double, not cglm's float: the squares
+ * of floats near the float range (1e38) overflow a float and those of tiny ones (1e-40)
+ * underflow it, but not a double, so every finite non-zero v becomes a unit vector
+ * (tests/fuzz/regressions/fuzz_obj_load/normal-overflow-near-float-range.obj). */
 void normalize(float *v)
 {
     double x = v[0], y = v[1], z = v[2];
@@ -519,33 +359,43 @@ void normalize(float *v)
     }
 }
 
-/* Fills out from what tinyobjloader returned, checking every index. */
-void build_mesh(const tinyobj::attrib_t &attrib, const std::vector<tinyobj::shape_t> &shapes,
-                const std::vector<tinyobj::material_t> &materials, size_t defined_count,
-                obj_mesh *out)
+/* The unit normal of triangle p0 p1 p2 (zero when degenerate), in double and scaled down
+ * before the cross product: edges of vertices near the float range (1e38) would overflow a
+ * float cross product to inf or NaN. */
+void geometric_normal(const float *p0, const float *p1, const float *p2, float out[3])
 {
-    const std::vector<float> &v = attrib.vertices;
-    const std::vector<float> &vn = attrib.normals;
-    const std::vector<float> &vt = attrib.texcoords;
-    for (const std::vector<float> *values : {&v, &vn, &vt})
-        for (float value : *values)
-            if (!std::isfinite(value))
-                fail("a coordinate is not a finite number");
-    const long long position_count = (long long)(v.size() / 3);
-    const long long normal_count = (long long)(vn.size() / 3);
-    const long long uv_count = (long long)(vt.size() / 2);
+    double e1[3], e2[3], largest = 0;
+    for (int i = 0; i < 3; i++) {
+        e1[i] = (double)p1[i] - p0[i];
+        e2[i] = (double)p2[i] - p0[i];
+        largest = std::fmax(largest, std::fmax(std::fabs(e1[i]), std::fabs(e2[i])));
+    }
+    if (largest > 0)
+        for (int i = 0; i < 3; i++) {
+            e1[i] /= largest;
+            e2[i] /= largest;
+        }
+    double cross[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+    double length = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+    for (int i = 0; i < 3; i++)
+        out[i] = length > 0 ? (float)(cross[i] / length) : 0.0f;
+}
 
-    /* Materials: drop unnamed entries (tinyobjloader makes one of an MTL file's start). */
-    std::vector<int> material_index(materials.size(), -1);
-    std::vector<obj_material> out_materials;
-    for (size_t i = 0; i < materials.size(); i++) {
-        const tinyobj::material_t &m = materials[i];
+/* The mesh's materials: tinyobjloader's, less the unnamed entries it makes of an MTL
+ * file's start; material_index maps each of its indices to ours (or -1). */
+std::vector<obj_material> convert_materials(const parsed_obj &obj, std::vector<int> *material_index)
+{
+    std::vector<obj_material> out;
+    material_index->assign(obj.materials.size(), -1);
+    for (size_t i = 0; i < obj.materials.size(); i++) {
+        const tinyobj::material_t &m = obj.materials[i];
         if (m.name.empty())
             continue;
         obj_material o;
         memset(&o, 0, sizeof o);
         snprintf(o.name, sizeof o.name, "%s", m.name.c_str());
-        o.defined = i < defined_count;
+        o.defined = i >= obj.placeholder_count;
         o.shininess = 1.0f;
         o.index_of_refraction = 1.0f;
         o.dissolve = 1.0f;
@@ -559,57 +409,79 @@ void build_mesh(const tinyobj::attrib_t &attrib, const std::vector<tinyobj::shap
             o.index_of_refraction = m.ior;
             o.dissolve = m.dissolve;
         }
-        material_index[i] = (int)out_materials.size();
-        out_materials.push_back(o);
+        (*material_index)[i] = (int)out.size();
+        out.push_back(o);
     }
+    return out;
+}
 
-    /* Triangles, in file order: corners (position, normal, uv) as tinyobjloader made them. */
+/* The triangles tinyobjloader made, in file order, every index checked; their materials
+ * (ours) go to triangle_materials. Fails with the first bad index. */
+std::vector<tinyobj::index_t> checked_triangles(const parsed_obj &obj, const std::vector<int> &material_index,
+                                                std::vector<int> *triangle_materials)
+{
+    const long long position_count = (long long)(obj.attrib.vertices.size() / 3);
+    const long long normal_count = (long long)(obj.attrib.normals.size() / 3);
+    const long long uv_count = (long long)(obj.attrib.texcoords.size() / 2);
     std::vector<tinyobj::index_t> corners;
-    std::vector<int> triangle_materials;
-    bool any_normal = false, any_uv = false;
-    for (const tinyobj::shape_t &shape : shapes) {
+    for (const tinyobj::shape_t &shape : obj.shapes) {
         const tinyobj::mesh_t &mesh = shape.mesh;
         size_t offset = 0;
         for (size_t face = 0; face < mesh.num_face_vertices.size(); face++) {
-            size_t count = mesh.num_face_vertices[face];
-            if (offset + count > mesh.indices.size())
-                fail("tinyobjloader returned a face past the end of its index list");
+            size_t triangle = triangle_materials->size();
+            if (mesh.num_face_vertices[face] != 3 || offset + 3 > mesh.indices.size())
+                fail("tinyobjloader returned face " + std::to_string(triangle + 1) + " with "
+                     + std::to_string(mesh.num_face_vertices[face]) + " corners, not a triangle");
             int material = face < mesh.material_ids.size() ? mesh.material_ids[face] : -1;
-            if (material < -1 || material >= (int)materials.size())
+            if (material < -1 || material >= (int)obj.materials.size())
                 fail("tinyobjloader returned a material index out of range");
-            int out_material = material < 0 ? -1 : material_index[(size_t)material];
-            for (size_t k = 0; k < count; k++) {
+            for (size_t k = 0; k < 3; k++) {
                 const tinyobj::index_t &c = mesh.indices[offset + k];
-                if (c.vertex_index < 0 || c.vertex_index >= position_count)
-                    fail("a face refers to vertex " + std::to_string((long long)c.vertex_index + 1)
-                         + ", out of range: the file has " + std::to_string(position_count)
-                         + " vertices");
-                if (c.normal_index < -1 || c.normal_index >= normal_count)
-                    fail("a face refers to normal " + std::to_string((long long)c.normal_index + 1)
-                         + ", out of range: the file has " + std::to_string(normal_count)
-                         + " normals");
-                if (c.texcoord_index < -1 || c.texcoord_index >= uv_count)
-                    fail("a face refers to texture coordinate "
-                         + std::to_string((long long)c.texcoord_index + 1)
-                         + ", out of range: the file has " + std::to_string(uv_count)
-                         + " texture coordinates");
-                any_normal |= c.normal_index >= 0;
-                any_uv |= c.texcoord_index >= 0;
+                check_index(c.vertex_index, position_count, false, triangle, "vertex", "vertices");
+                check_index(c.normal_index, normal_count, true, triangle, "normal", "normals");
+                check_index(c.texcoord_index, uv_count, true, triangle, "texture coordinate",
+                            "texture coordinates");
+                corners.push_back(c);
             }
-            /* With triangulation on every face is a triangle; a fan covers anything else. */
-            for (size_t k = 1; count >= 3 && k + 1 < count; k++) {
-                corners.push_back(mesh.indices[offset]);
-                corners.push_back(mesh.indices[offset + k]);
-                corners.push_back(mesh.indices[offset + k + 1]);
-                triangle_materials.push_back(out_material);
-            }
-            offset += count;
+            triangle_materials->push_back(material < 0 ? -1 : material_index[(size_t)material]);
+            offset += 3;
         }
     }
-    if (triangle_materials.empty())
-        fail("has no faces (tinyobjloader made no triangles of them)");
-    if (triangle_materials.size() > (size_t)INT_MAX)
+    if (triangle_materials->size() > (size_t)INT_MAX)
         fail("more than 2^31 - 1 triangles are not supported");
+    return corners;
+}
+
+/* Fills out from what tinyobjloader returned (see obj_load.h), checking it first. */
+void build_mesh(const parsed_obj &obj, obj_mesh *out)
+{
+    const std::vector<float> &v = obj.attrib.vertices;
+    const std::vector<float> &vn = obj.attrib.normals;
+    const std::vector<float> &vt = obj.attrib.texcoords;
+    check_finite(v, 3, "vertex");
+    check_finite(vn, 3, "normal");
+    check_finite(vt, 2, "texture coordinate");
+    if (v.size() / 3 > (size_t)INT_MAX || vn.size() / 3 > (size_t)INT_MAX || vt.size() / 2 > (size_t)INT_MAX)
+        fail("more than 2^31 - 1 vertices, normals or texture coordinates are not supported");
+
+    std::vector<int> material_index;
+    std::vector<obj_material> materials = convert_materials(obj, &material_index);
+    std::vector<int> triangle_materials;
+    std::vector<tinyobj::index_t> corners = checked_triangles(obj, material_index, &triangle_materials);
+    if (triangle_materials.empty()) {
+        /* tinyobjloader drops the faces it cannot use (fewer than 3 corners, a quad with an
+         * index out of range) with a warning: its warnings say why. */
+        std::string why;
+        for (const std::string &warning : obj.warnings)
+            if (warning.compare(0, 15, "tinyobjloader: ") == 0)
+                why += (why.empty() ? " (tinyobjloader made no triangles; it warned: " : "; ") + warning.substr(15);
+        fail("has no faces" + (why.empty() ? "" : why + ")"));
+    }
+    bool any_normal = false, any_uv = false;
+    for (const tinyobj::index_t &c : corners) {
+        any_normal |= c.normal_index >= 0;
+        any_uv |= c.texcoord_index >= 0;
+    }
 
     /* One vertex per distinct corner. */
     std::unordered_map<corner_key, uint32_t, corner_hash> vertex_of;
@@ -620,38 +492,14 @@ void build_mesh(const tinyobj::attrib_t &attrib, const std::vector<tinyobj::shap
     for (size_t t = 0; t < triangle_count; t++) {
         const tinyobj::index_t *c = &corners[3 * t];
         float geometric[3] = {0, 0, 0};
-        bool need_geometric = any_normal && (c[0].normal_index < 0 || c[1].normal_index < 0
-                                             || c[2].normal_index < 0);
-        if (need_geometric) {
-            const float *p0 = &v[3 * (size_t)c[0].vertex_index];
-            const float *p1 = &v[3 * (size_t)c[1].vertex_index];
-            const float *p2 = &v[3 * (size_t)c[2].vertex_index];
-            /* In double, scaled down before the cross product: edges of vertices near the
-             * float range (1e38) would overflow a float cross product to inf or NaN. */
-            double e1[3], e2[3], largest = 0;
-            for (int i = 0; i < 3; i++) {
-                e1[i] = (double)p1[i] - p0[i];
-                e2[i] = (double)p2[i] - p0[i];
-                largest = std::fmax(largest, std::fmax(std::fabs(e1[i]), std::fabs(e2[i])));
-            }
-            if (largest > 0)
-                for (int i = 0; i < 3; i++) {
-                    e1[i] /= largest;
-                    e2[i] /= largest;
-                }
-            double cross[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                               e1[0] * e2[1] - e1[1] * e2[0]};
-            double length = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
-            if (length > 0)
-                for (int i = 0; i < 3; i++)
-                    geometric[i] = (float)(cross[i] / length);
-        }
+        if (any_normal && (c[0].normal_index < 0 || c[1].normal_index < 0 || c[2].normal_index < 0))
+            geometric_normal(&v[3 * (size_t)c[0].vertex_index], &v[3 * (size_t)c[1].vertex_index],
+                             &v[3 * (size_t)c[2].vertex_index], geometric);
         for (int k = 0; k < 3; k++) {
-            corner_key key = {c[k].vertex_index,
+            corner_key key = {c[k].vertex_index, any_uv ? c[k].texcoord_index : -1,
                               !any_normal              ? -1LL
                               : c[k].normal_index >= 0 ? (long long)c[k].normal_index
-                                                       : -2LL - (long long)t,
-                              any_uv ? c[k].texcoord_index : -1};
+                                                       : -2LL - (long long)t};
             auto found = vertex_of.find(key);
             if (found != vertex_of.end()) {
                 indices.push_back(found->second);
@@ -667,20 +515,15 @@ void build_mesh(const tinyobj::attrib_t &attrib, const std::vector<tinyobj::shap
             if (any_normal) {
                 float n[3] = {geometric[0], geometric[1], geometric[2]};
                 if (key.normal >= 0) {
-                    const float *file_normal = &vn[3 * (size_t)key.normal];
-                    n[0] = file_normal[0];
-                    n[1] = file_normal[1];
-                    n[2] = file_normal[2];
+                    memcpy(n, &vn[3 * (size_t)key.normal], sizeof n);
                     normalize(n);
                 }
                 normals.insert(normals.end(), n, n + 3);
             }
             if (any_uv) {
                 float uv[2] = {0, 0};
-                if (key.uv >= 0) {
-                    uv[0] = vt[2 * (size_t)key.uv];
-                    uv[1] = vt[2 * (size_t)key.uv + 1];
-                }
+                if (key.uv >= 0)
+                    memcpy(uv, &vt[2 * (size_t)key.uv], sizeof uv);
                 uvs.insert(uvs.end(), uv, uv + 2);
             }
         }
@@ -691,53 +534,48 @@ void build_mesh(const tinyobj::attrib_t &attrib, const std::vector<tinyobj::shap
     out->uvs = to_malloc(uvs);
     out->indices = to_malloc(indices);
     out->triangle_materials = to_malloc(triangle_materials);
-    out->materials = to_malloc(out_materials);
+    out->materials = to_malloc(materials);
     out->vertex_count = (int)vertex_of.size();
     out->triangle_count = (int)triangle_count;
-    out->material_count = (int)out_materials.size();
+    out->material_count = (int)materials.size();
 }
 
+/* Loads the OBJ file at path into out (zeroed by the caller); throws obj_failure or
+ * std::bad_alloc, after which the caller frees out. */
 void load(const char *path, obj_mesh *out)
 {
     std::string text = read_file(path);
-    const void *nul = memchr(text.data(), '\0', text.size());
-    if (nul != nullptr) {
-        size_t at = (size_t)((const char *)nul - text.data());
-        size_t line = 1;
-        for (size_t i = 0; i < at; i++)
-            if (text[i] == '\n' || (text[i] == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n')))
-                line++;
-        fail_at(line, "a NUL byte (is it a binary file?)");
-    }
-    const size_t start = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  /* a UTF-8 BOM */
-    obj_summary summary = check_obj_text(text, start);
+    refuse_nul_bytes(text);
+    /* tinyobjloader does not know a UTF-8 byte order mark: it would take the first line
+     * for an unknown statement and drop it. */
+    if (text.compare(0, 3, "\xEF\xBB\xBF") == 0)
+        text.erase(0, 3);
+    const std::string directory = directory_of(path);
 
-    std::string source = std::string("mtllib ") + synthetic_library + "\n";
-    source.append(text, start, std::string::npos);
+    parsed_obj obj = parse(text, directory, {});
+    std::vector<std::string> warnings, unknown_names;
+    for (const std::string &warning : obj.warnings) {
+        std::string name;
+        if (warning.compare(0, 15, "tinyobjloader: ") == 0 && unknown_material_name(warning.substr(15), &name))
+            add_unique(unknown_names, name);
+        else
+            warnings.push_back(warning);
+    }
+    if (!unknown_names.empty()) {
+        parsed_obj named = parse(text, directory, unknown_names);
+        std::swap(obj.shapes, named.shapes);
+        std::swap(obj.materials, named.materials);
+        obj.placeholder_count = named.placeholder_count;
+    }
     std::string().swap(text);
-    memory_buffer buffer(source);
-    std::istream stream(&buffer);
-    material_loader loader(directory_of(path), summary);
-    tinyobj::attrib_t attrib;
-    std::vector<tinyobj::shape_t> shapes;
-    std::vector<tinyobj::material_t> materials;
-    std::string warnings, errors;
-    bool parsed = tinyobj::LoadObj(&attrib, &shapes, &materials, &warnings, &errors, &stream,
-                                   &loader, true, false);
-    if (!parsed)
-        fail(tinyobj_message(errors));
-    if (!loader.failure().empty())
-        fail(loader.failure());
-    std::string().swap(source);
-    build_mesh(attrib, shapes, materials, loader.defined_count(), out);
-    std::vector<std::string> found = loader.warnings();
-    for (const std::string &warning : tinyobj_lines(warnings, 1))
-        add_unique(found, "tinyobjloader: " + warning);
-    out->warning_count = found.size() > INT_MAX ? INT_MAX : (int)found.size();
-    for (size_t i = 0; i < found.size() && i < OBJ_MAX_WARNINGS; i++)
-        snprintf(out->warnings[i], sizeof out->warnings[i], "%s", found[i].c_str());
+    obj.warnings = warnings;
+    build_mesh(obj, out);
+    out->warning_count = warnings.size() > INT_MAX ? INT_MAX : (int)warnings.size();
+    for (size_t i = 0; i < warnings.size() && i < OBJ_MAX_WARNINGS; i++)
+        snprintf(out->warnings[i], sizeof out->warnings[i], "%s", warnings[i].c_str());
 }
 
+/* Sets the error "OBJ: cannot read 'PATH': WHY" and returns status. */
 rt_status load_failed(rt_error *error, rt_status status, const char *path, const std::string &why)
 {
     return rt_error_set(error, status, "OBJ: cannot read '%s': %s", path, why.c_str());
@@ -759,7 +597,7 @@ rt_status obj_load(const char *path, obj_mesh *out, rt_error *error)
         return RT_OK;
     } catch (const obj_failure &failure) {
         obj_mesh_free(out);
-        return load_failed(error, failure.status, path, failure.reason);
+        return load_failed(error, RT_ERROR_INPUT, path, failure.reason);
     } catch (const std::bad_alloc &) {
         obj_mesh_free(out);
         return load_failed(error, RT_ERROR_RUNTIME, path, "out of memory");

@@ -1,14 +1,21 @@
 /* obj_load.h: reading a Wavefront OBJ file (and its MTL files) into a flat triangle mesh,
  * through tinyobjloader (a thin C shim over C++, like image_io.cpp).
  *
+ * tinyobjloader (Debian's 2.0.0rc10) reads the file; obj_load() validates what it returns.
+ * So the file means what tinyobjloader reads in it: a number it cannot read ("abc", "nan",
+ * "inf") is 0, missing numbers of a v, vn or vt line are 0 and extra ones are ignored, a
+ * statement it does not know is skipped; a face index that is 0 or not a number stops it.
+ *
  * What comes back:
  *   - one vertex per distinct (position, normal, uv) corner of the file, so that a
  *     position used with two normals (a hard edge) becomes two vertices;
  *   - triangles: tinyobjloader triangulates quads along their shorter diagonal and larger
  *     polygons by ear clipping; faces it cannot triangulate (collinear corners) give fewer
- *     triangles;
+ *     triangles, and faces it drops give none (fewer than 3 corners, or a quad with an
+ *     index out of range: it warns);
  *   - per triangle, the material named by the last `usemtl` before it (or -1), as an index
- *     into materials: every name a `usemtl` uses and every material the MTL files define.
+ *     into materials: every material the MTL files define, and every name a `usemtl`
+ *     uses that none defines where it is used.
  *
  * Normals: NULL when no face corner of the file names one (the renderer shades flat).
  * When some corners name normals and others do not, the others get their triangle's
@@ -17,25 +24,36 @@
  * UVs: NULL when no corner names one; otherwise corners without one get (0, 0). UVs are
  * as in the file (v upwards, the OBJ convention).
  *
- * MTL files: every file of every `mtllib` line is looked up relative to the OBJ file's
- * directory (absolute paths as they are) and all are loaded, wherever the `mtllib` line
- * stands. A missing MTL file is not an error: the mesh loads, the names its `usemtl`
- * lines use are still listed (defined = false), and a warning says which file is missing.
+ * MTL files: for each `mtllib` line tinyobjloader asks for its files in turn until one
+ * loads; they are looked up relative to the OBJ file's directory (absolute paths as they
+ * are), and their materials count from that line on. A missing MTL file is not an error:
+ * the mesh loads, the names its `usemtl` lines use are still listed (defined = false),
+ * and warnings say which file is missing.
  *
  * Warnings (warnings, warning_count): what does not stop the load but is worth telling:
  * an unreadable MTL file ("cannot read material library 'PATH': REASON; its materials
  * are left out"), and every warning tinyobjloader gives for the OBJ file or an MTL file,
- * as "tinyobjloader: TEXT" (an MTL file's as "tinyobjloader, in 'MTL PATH': TEXT"), line
- * numbers those of the file. Each once, in the order found; obj_load() prints nothing.
+ * one per line as it writes them, as "tinyobjloader: TEXT" (an MTL file's as
+ * "tinyobjloader, in 'MTL PATH': TEXT"). Not its "material [ 'NAME' ] not found in .mtl":
+ * that name becomes a material (defined = false) instead. Each once, in the order found;
+ * obj_load() prints nothing.
  *
- * Errors (RT_ERROR_INPUT, the message "OBJ: cannot read 'PATH': REASON", with "line N: "
- * in REASON where there is a line): a missing or unreadable file, a number that is not a
- * number or not finite (NaN, inf, beyond the float range) in v/vn/vt lines, a face with
- * fewer than 3 corners, a face index that is 0, malformed or out of range (relative
- * indices are checked against the elements before the line, positive ones against the
- * whole file), a NUL byte, no faces at all ("has no faces"), more than 2^31 - 1 vertices,
- * a non-finite value in an MTL colour. Out of memory: RT_ERROR_RUNTIME. No C++ exception
- * crosses into C.
+ * Errors (RT_ERROR_INPUT, the message "OBJ: cannot read 'PATH': REASON"):
+ *   - a missing or unreadable file, a directory (errno's reason, "it is a directory");
+ *   - a NUL byte ("line N: a NUL byte (is it a binary file?)": tinyobjloader would
+ *     silently drop the rest of its line);
+ *   - what tinyobjloader refuses, in its words with its line number ("tinyobjloader:
+ *     Failed parse `f' line(e.g. zero value for face index. line 4.)");
+ *   - what validating its arrays finds, named by the place in them (tinyobjloader keeps
+ *     no line numbers there): "vertex 12 has a coordinate that is not a finite number
+ *     (beyond the range of a float)" (likewise "normal", "texture coordinate");
+ *     "triangle 7: vertex index 40 is out of range: the file has 30 vertices" (triangles
+ *     counted in file order after triangulation; likewise normal and texture coordinate
+ *     indices); "triangle 7: a relative vertex index points before the first vertex";
+ *     no triangles ("has no faces", followed by tinyobjloader's warnings when it dropped
+ *     faces); more than 2^31 - 1 vertices or triangles; a non-finite value in an MTL
+ *     colour ("material 'NAME' of 'PATH' has a value that is not a finite number").
+ * Out of memory: RT_ERROR_RUNTIME. No C++ exception crosses into C.
  */
 #ifndef RT_OBJ_LOAD_H
 #define RT_OBJ_LOAD_H
@@ -54,7 +72,7 @@ extern "C" {
 #define OBJ_WARNING_MAX 256      /* bytes of one warning, with the NUL */
 
 /* One material: from an MTL file (defined), or only named by a `usemtl` (not defined:
- * no MTL file defines it; the colours are then tinyobjloader's defaults and meaningless). */
+ * no MTL file loaded by then defines it; the colours are then zero and meaningless). */
 typedef struct obj_material {
     char name[OBJ_NAME_MAX];     /* as in the file, cut to OBJ_NAME_MAX - 1 bytes */
     bool defined;

@@ -1,6 +1,7 @@
 /* postprocess.c: see postprocess.h. */
 #include "postprocess.h"
 
+#include <cglm/cglm.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -215,14 +216,10 @@ static float guide_weight(const denoiser *d, const guide_pixel *p, const guide_p
     if (!p->hit)
         return 1.0f;
     float exponent = 0.0f;
-    if (d->use_normal) {
-        float n0 = q->normal[0] - p->normal[0], n1 = q->normal[1] - p->normal[1], n2 = q->normal[2] - p->normal[2];
-        exponent += (n0 * n0 + n1 * n1 + n2 * n2) * d->inverse_normal_sigma2;
-    }
-    if (d->use_albedo) {
-        float a0 = q->albedo[0] - p->albedo[0], a1 = q->albedo[1] - p->albedo[1], a2 = q->albedo[2] - p->albedo[2];
-        exponent += (a0 * a0 + a1 * a1 + a2 * a2) * d->inverse_albedo_sigma2;
-    }
+    if (d->use_normal)
+        exponent += glm_vec3_distance2((float *)q->normal, (float *)p->normal) * d->inverse_normal_sigma2;
+    if (d->use_albedo)
+        exponent += glm_vec3_distance2((float *)q->albedo, (float *)p->albedo) * d->inverse_albedo_sigma2;
     if (d->use_depth) {
         float predicted = p->depth + p->gradient[0] * (float)dx + p->gradient[1] * (float)dy;
         exponent += fabsf(q->depth - predicted) / (d->sigma_depth * p->depth);
@@ -300,7 +297,7 @@ static void atrous_iteration(const denoiser *d, int step, const float *signal, c
             const float *cp = &signal[3 * p];
             /* The noise floor keeps the weight finite on a noise-free image: differences
              * of a thousandth of the pixel's own level count as equal. */
-            float level = (fabsf(cp[0]) + fabsf(cp[1]) + fabsf(cp[2])) / 3.0f;
+            float level = glm_vec3_norm_one((float *)cp) / 3.0f;
             float colour_scale = d->sigma_colour * sqrtf(blurred_variance[p]) + 1e-3f * level + 1e-8f;
             float inverse_colour_scale = 1.0f / colour_scale;
             double sum[3] = {0, 0, 0}, weight_sum = 0.0, variance_sum = 0.0;
@@ -312,9 +309,7 @@ static void atrous_iteration(const denoiser *d, int step, const float *signal, c
                     size_t q = (size_t)qy * d->width + qx;
                     float w = b3[i + 2] * b3[j + 2];
                     if (q != p) {
-                        const float *cq = &signal[3 * q];
-                        float c0 = cq[0] - cp[0], c1 = cq[1] - cp[1], c2 = cq[2] - cp[2];
-                        float rms = sqrtf((c0 * c0 + c1 * c1 + c2 * c2) / 3.0f);
+                        float rms = sqrtf(glm_vec3_distance2((float *)&signal[3 * q], (float *)cp) / 3.0f);
                         w *= guide_weight(d, &d->guides[p], &d->guides[q], dx, dy) * expf(-rms * inverse_colour_scale);
                     }
                     weight_sum += w;
@@ -487,18 +482,17 @@ static void reinhard_pixel(float *rgb)
             rgb[c] = isinf(rgb[c]) ? 1.0f : 0.0f;
         return;
     }
-    float luminance = 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
+    vec3 rec709_luminance = {0.2126f, 0.7152f, 0.0722f};
+    float luminance = glm_vec3_dot(rec709_luminance, rgb);
     if (luminance <= 0.0f) {
-        for (int c = 0; c < 3; c++)
-            rgb[c] = 0.0f;
+        glm_vec3_zero(rgb);
         return;
     }
     float scale = 1.0f / (1.0f + luminance);   /* (L / (1 + L)) / L */
-    float largest = fmaxf(rgb[0], fmaxf(rgb[1], rgb[2])) * scale;
+    float largest = glm_vec3_max(rgb) * scale;
     if (largest > 1.0f)
         scale /= largest;
-    for (int c = 0; c < 3; c++)
-        rgb[c] *= scale;
+    glm_vec3_scale(rgb, scale, rgb);
 }
 
 rt_status postprocess_tonemap(rt_image *image, postprocess_tonemap_operator op, float exposure_stops,

@@ -1,6 +1,7 @@
 /* scene_assets.c: see scene_assets.h. */
 #include "scene_assets.h"
 
+#include <cglm/cglm.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,18 +46,12 @@ static float clamp01(float x)
     return x > 1.0f ? 1.0f : x > 0.0f ? x : 0.0f;
 }
 
-static float largest_of(const float v[3])
-{
-    float m = v[0] > v[1] ? v[0] : v[1];
-    return m > v[2] ? m : v[2];
-}
-
 /* Returns the scene material an MTL material becomes (see scene_assets.h), named name. */
 static scene_material material_from_mtl(const obj_material *m, const char *name)
 {
     scene_material out = scene_material_defaults();
     snprintf(out.name, sizeof out.name, "%.*s", SCENE_NAME_MAX - 1, name);
-    if (largest_of(m->emission) > 0.0f) {
+    if (glm_vec3_max((float *)m->emission) > 0.0f) {
         out.type = MATERIAL_EMISSIVE;
         for (int c = 0; c < 3; c++)
             out.emission[c] = m->emission[c] > 0.0f ? m->emission[c] : 0.0f;
@@ -64,7 +59,7 @@ static scene_material material_from_mtl(const obj_material *m, const char *name)
         out.type = MATERIAL_DIELECTRIC;
         float ior = m->index_of_refraction;
         out.index_of_refraction = ior > 0.0f && ior != 1.0f ? ior : DEFAULT_INDEX_OF_REFRACTION;
-    } else if (largest_of(m->specular) > BRIGHT_SPECULAR && largest_of(m->diffuse) <= DARK_DIFFUSE) {
+    } else if (glm_vec3_max((float *)m->specular) > BRIGHT_SPECULAR && glm_vec3_max((float *)m->diffuse) <= DARK_DIFFUSE) {
         out.type = MATERIAL_METAL;
         for (int c = 0; c < 3; c++)
             out.albedo[c] = clamp01(m->specular[c]);

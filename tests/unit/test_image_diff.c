@@ -261,6 +261,59 @@ static void test_infinities(void **state)
     image_free(&b);
 }
 
+/* +inf against -inf is an infinite error like any other, each counted once per pixel
+ * however many; in the difference image equal infinities are 0 and others infinite. */
+static void test_infinities_of_both_signs(void **state)
+{
+    (void)state;
+    rt_image a = make_image(3, 1, 3, 0.0f), b = make_image(3, 1, 3, 0.0f);
+    *sample(&a, 0, 0, 1) = *sample(&b, 0, 0, 1) = -INFINITY;
+    *sample(&a, 1, 0, 0) = INFINITY;
+    *sample(&b, 1, 0, 0) = -INFINITY;
+    *sample(&b, 2, 0, 2) = INFINITY;
+    image_diff_options options = image_diff_options_defaults();
+    options.fail_percent = 100;
+    image_diff_result result;
+    rt_image difference;
+    rt_error error;
+    assert_int_equal(image_diff(&a, &b, &options, &result, &difference, &error), RT_OK);
+    assert_true(isinf(result.max_error) && isinf(result.mean_error) && isinf(result.rms_error));
+    assert_int_equal(result.max_x, 1);
+    assert_int_equal(result.failing_pixels, 2);
+    assert_true(result.passed);
+    assert_close(*sample(&difference, 0, 0, 1), 0, 0);
+    assert_true(isinf(*sample(&difference, 1, 0, 0)));
+    assert_true(isinf(*sample(&difference, 2, 0, 2)));
+    assert_close(*sample(&difference, 2, 0, 0), 0, 0);
+    image_free(&difference);
+    image_free(&a);
+    image_free(&b);
+}
+
+/* Large images: the sums stay exact enough (OIIO sums in batches of pixels); 640x360,
+ * every green sample off by 2^-8 and one red by 0.75. */
+static void test_large_image(void **state)
+{
+    (void)state;
+    rt_image a = make_image(640, 360, 3, 0.25f), b = make_image(640, 360, 3, 0.25f);
+    for (int y = 0; y < 360; y++)
+        for (int x = 0; x < 640; x++)
+            *sample(&b, x, y, 1) = 0.25f + 1.0f / 256;
+    *sample(&b, 600, 300, 0) = 1.0f;
+    image_diff_result result;
+    rt_error error;
+    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    double samples = 640.0 * 360 * 3;
+    assert_close(result.mean_error, (640.0 * 360 / 256 + 0.75) / samples, 1e-15);
+    assert_close(result.rms_error, sqrt((640.0 * 360 / 65536 + 0.5625) / samples), 1e-15);
+    assert_close(result.max_error, 0.75, 0);
+    assert_int_equal(result.max_x, 600);
+    assert_int_equal(result.max_y, 300);
+    assert_int_equal(result.failing_pixels, 1);
+    image_free(&a);
+    image_free(&b);
+}
+
 /* Only the first three channels count: alpha and extra channels may differ freely, and
  * the channel counts may differ. */
 static void test_compares_at_most_three_channels(void **state)
@@ -397,6 +450,8 @@ int main(void)
         cmocka_unit_test(test_size_mismatch),
         cmocka_unit_test(test_nan_is_an_error_naming_image_and_pixel),
         cmocka_unit_test(test_infinities),
+        cmocka_unit_test(test_infinities_of_both_signs),
+        cmocka_unit_test(test_large_image),
         cmocka_unit_test(test_compares_at_most_three_channels),
         cmocka_unit_test(test_single_channel_against_rgb),
         cmocka_unit_test(test_difference_image),

@@ -133,6 +133,53 @@ static void test_create_and_free(void **state)
 }
 
 /* EXR keeps float32 bit for bit: huge, tiny, negative, beyond half precision. */
+/* image_append_channels: a's channels then b's, pixel by pixel, names kept (unnamed
+ * ones by their defaults), a's place; sizes must match and the channels fit. */
+static void test_append_channels(void **state)
+{
+    (void)state;
+    rt_image a, b, joined;
+    rt_error error;
+    assert_int_equal(image_create(&a, 3, 2, 3, &error), RT_OK);
+    assert_int_equal(image_create(&b, 3, 2, 2, &error), RT_OK);
+    strcpy(b.channel_names[0], "albedo.R");
+    strcpy(b.channel_names[1], "samples");
+    for (int i = 0; i < 3 * 2 * 3; i++)
+        a.pixels[i] = (float)i;
+    for (int i = 0; i < 3 * 2 * 2; i++)
+        b.pixels[i] = 100.0f + (float)i;
+    a.x = 4, a.y = 5, a.full_width = 20, a.full_height = 10;
+    assert_int_equal(image_append_channels(&a, &b, &joined, &error), RT_OK);
+    assert_int_equal(joined.width, 3);
+    assert_int_equal(joined.height, 2);
+    assert_int_equal(joined.channels, 5);
+    const char *names[5] = {"R", "G", "B", "albedo.R", "samples"};
+    for (int c = 0; c < 5; c++)
+        assert_string_equal(joined.channel_names[c], names[c]);
+    for (int p = 0; p < 6; p++)
+        for (int c = 0; c < 5; c++)
+            assert_true(joined.pixels[p * 5 + c] == (c < 3 ? a.pixels[p * 3 + c] : b.pixels[p * 2 + c - 3]));
+    assert_int_equal(joined.x, 4);
+    assert_int_equal(joined.y, 5);
+    assert_int_equal(joined.full_width, 20);
+    assert_int_equal(joined.full_height, 10);
+    image_free(&joined);
+
+    rt_image wide;
+    assert_int_equal(image_create(&wide, 4, 2, 1, &error), RT_OK);
+    assert_int_equal(image_append_channels(&a, &wide, &joined, &error), RT_ERROR_INPUT);
+    assert_string_equal(error.message, "IMAGE: cannot join a 3x2 and a 4x2 image");
+    assert_null(joined.pixels);
+    rt_image many;
+    assert_int_equal(image_create(&many, 3, 2, IMAGE_MAX_CHANNELS - 2, &error), RT_OK);
+    assert_int_equal(image_append_channels(&a, &many, &joined, &error), RT_ERROR_INPUT);
+    assert_null(joined.pixels);
+    image_free(&many);
+    image_free(&wide);
+    image_free(&a);
+    image_free(&b);
+}
+
 static void test_exr_round_trip_exact(void **state)
 {
     scratch *s = *state;
@@ -613,6 +660,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_create_and_free),
+        cmocka_unit_test(test_append_channels),
         cmocka_unit_test_setup_teardown(test_exr_round_trip_exact, make_scratch, remove_scratch),
         cmocka_unit_test_setup_teardown(test_exr_channel_names_and_attributes, make_scratch,
                                         remove_scratch),

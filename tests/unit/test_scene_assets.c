@@ -1,5 +1,6 @@
 /* test_scene_assets.c: the asset loader. OBJ files through obj_load() (triangulation,
- * relative indices, vertex unification, every malformed-file error with its line) and
+ * relative indices, vertex unification, what tinyobjloader refuses or reads leniently,
+ * every error the validation of its arrays finds) and
  * scene_load_assets() (usemtl to scene materials, MTL-derived materials, images decoded
  * to linear RGBA, the sky box check, errors prefixed with the naming statement's
  * position). Each test writes its small files into its own mkdtemp directory. */
@@ -296,41 +297,42 @@ static void test_crlf_bom_comments_and_groups(void **state)
     obj_mesh_free(&mesh);
 
     rt_error error;
-    /* line numbers count CRLF, CR and LF line endings alike */
-    load_fails(*state, "windows-bad.obj", "v 0 0 0\r\nv 1 0 0\rv 0 1 0\r\nf 1 2 4\r\n", &error);
-    assert_contains(error.message, "line 4: vertex index 4 is out of range: the file has 3 vertices");
+    /* line numbers (tinyobjloader's) count CRLF, CR and LF line endings alike */
+    load_fails(*state, "windows-bad.obj", "v 0 0 0\r\nv 1 0 0\rv 0 1 0\r\nf 1 2 0\r\n", &error);
+    assert_contains(error.message, "zero value for face index. line 4.");
 }
 
 /* ---- obj_load: errors ---------------------------------------------------------------- */
 
+/* Faces tinyobjloader cannot read stop it, in its words with the file's line number. */
 static void test_malformed_lines(void **state)
 {
     rt_error error;
-    load_fails(*state, "a.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n", &error);
-    assert_contains(error.message, "line 2: vertex coordinate 'abc' is not a number");
-
-    load_fails(*state, "b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", &error);
-    assert_contains(error.message, "line 4: a face needs at least 3 corners, found 2");
-
     load_fails(*state, "c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", &error);
-    assert_contains(error.message, "line 4: face corner '1/1/1/1' is not of the form");
+    assert_contains(error.message, "': tinyobjloader: Failed parse `f' line(e.g. zero value for face index. line 4.)");
 
     load_fails(*state, "d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", &error);
-    assert_contains(error.message, "line 4: vertex index 0 in a face (OBJ indices start at 1)");
-
-    load_fails(*state, "e.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 1\nf 1 2 3\n", &error);
-    assert_contains(error.message, "line 4: 'vn' needs 3 numbers, found 2");
+    assert_contains(error.message, "': tinyobjloader: Failed parse `f' line(e.g. zero value for face index. line 4.)");
 
     load_fails(*state, "f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x3\n", &error);
-    assert_contains(error.message, "line 4: face corner 'x3' is not of the form");
+    assert_contains(error.message, "zero value for face index. line 4.");
 
     load_fails(*state, "g.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2/ 3/\n", &error);
-    assert_contains(error.message, "line 4: face corner '1/' is not of the form");
+    assert_contains(error.message, "zero value for face index. line 4.");
 
-    /* an error tinyobjloader finds itself: its line number is the file's */
     load_fails(*state, "h.obj", "v 0 0 0\nv 1 0 0\nl 0 1\nv 0 1 0\nf 1 2 3\n", &error);
-    assert_contains(error.message, "tinyobjloader");
+    assert_contains(error.message, "tinyobjloader: Failed parse `l' line");
     assert_contains(error.message, "line 3");
+
+    /* a face of two corners: tinyobjloader drops it with a warning; with no other face
+     * the file has none */
+    load_fails(*state, "b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", &error);
+    assert_contains(error.message, "': has no faces (tinyobjloader made no triangles; it warned: Degenerated face found)");
+    obj_mesh mesh = load_ok(*state, "b2.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\n");
+    assert_int_equal(mesh.triangle_count, 1);
+    assert_int_equal(mesh.warning_count, 1);
+    assert_string_equal(mesh.warnings[0], "tinyobjloader: Degenerated face found");
+    obj_mesh_free(&mesh);
 
     const char binary[] = "v 0 0 0\nv 1\0 0 0\n";
     const char *path = in_scratch(*state, "binary.obj");
@@ -338,35 +340,69 @@ static void test_malformed_lines(void **state)
     assert_non_null(file);
     fwrite(binary, 1, sizeof binary - 1, file);
     fclose(file);
-    obj_mesh mesh;
     assert_int_equal(obj_load(path, &mesh, &error), RT_ERROR_INPUT);
     assert_contains(error.message, "line 2: a NUL byte");
+}
+
+/* What tinyobjloader reads leniently is read as it reads it (obj_load.h): a number it
+ * cannot read is 0, a missing one is 0. */
+static void test_tinyobjloader_reads_leniently(void **state)
+{
+    obj_mesh mesh = load_ok(*state, "lenient.obj",
+                            "v 0 0 0\nv 1 abc 0\nv nan 1 0\n"
+                            "vn -inf 0 1\nvn 0 1\n"
+                            "vt NaN 0.5\n"
+                            "f 1/1/1 2/1/1 3/1/2\n");
+    assert_int_equal(mesh.triangle_count, 1);
+    assert_int_equal(mesh.vertex_count, 3);
+    const float expected[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    for (int k = 0; k < 3; k++)
+        for (int c = 0; c < 3; c++)
+            assert_close(vertex_of(&mesh, 0, k)[c], expected[k][c], 0);
+    const float *n0 = &mesh.normals[3 * mesh.indices[0]], *n2 = &mesh.normals[3 * mesh.indices[2]];
+    assert_close(n0[0], 0, 0);  /* (-inf, 0, 1) read as (0, 0, 1) */
+    assert_close(n0[2], 1, 0);
+    assert_close(n2[1], 1, 0);  /* (0, 1) read as (0, 1, 0) */
+    assert_close(mesh.uvs[2 * mesh.indices[0]], 0, 0);
+    assert_close(mesh.uvs[2 * mesh.indices[0] + 1], 0.5, 0);
+    obj_mesh_free(&mesh);
 }
 
 static void test_out_of_range_indices(void **state)
 {
     rt_error error;
-    load_fails(*state, "a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", &error);
-    assert_contains(error.message, "line 4: vertex index 9 is out of range: the file has 3 vertices");
+    /* tinyobjloader keeps no line numbers in its arrays: the triangle is named, counted
+     * in file order */
+    load_fails(*state, "a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n", &error);
+    assert_contains(error.message, "': triangle 2: vertex index 9 is out of range: the file has 3 vertices");
 
     load_fails(*state, "b.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n", &error);
-    assert_contains(error.message, "line 3: relative vertex index -3 is out of range: there are 2 vertices before this line");
+    assert_contains(error.message, "': triangle 1: a relative vertex index points before the first vertex");
 
     load_fails(*state, "c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n", &error);
-    assert_contains(error.message, "line 5: normal index 2 is out of range: the file has 1 normals");
+    assert_contains(error.message, "': triangle 1: normal index 2 is out of range: the file has 1 normals");
 
     load_fails(*state, "d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n", &error);
-    assert_contains(error.message, "line 4: texture coordinate index 1 is out of range: the file has 0 texture coordinates");
+    assert_contains(error.message,
+                    "': triangle 1: texture coordinate index 1 is out of range: the file has 0 texture coordinates");
 
     load_fails(*state, "e.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999\n", &error);
-    assert_contains(error.message, "line 4: ");
+    assert_contains(error.message, "': triangle 1: vertex index ");
     assert_contains(error.message, "out of range");
 
-    /* a quad and an n-gon with an index past the end (tinyobjloader reads such corners) */
-    load_fails(*state, "f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n", &error);
-    assert_contains(error.message, "line 4: vertex index 4 is out of range");
+    /* an n-gon with an index past the end: tinyobjloader triangulates it as it is */
     load_fails(*state, "g.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 1 7\n", &error);
-    assert_contains(error.message, "line 4: vertex index 7 is out of range");
+    assert_contains(error.message, "': triangle 1: vertex index 7 is out of range");
+    /* a quad with one: tinyobjloader drops it with a warning */
+    load_fails(*state, "f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n", &error);
+    assert_contains(error.message, "': has no faces (tinyobjloader made no triangles; it warned: ");
+    assert_contains(error.message, "Face with invalid vertex index found.)");
+    obj_mesh mesh = load_ok(*state, "f2.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3\n");
+    assert_int_equal(mesh.triangle_count, 1);
+    assert_int_equal(mesh.warning_count, 2);
+    assert_string_equal(mesh.warnings[0], "tinyobjloader: Vertex indices out of bounds (line 5.)");
+    assert_string_equal(mesh.warnings[1], "tinyobjloader: Face with invalid vertex index found.");
+    obj_mesh_free(&mesh);
 }
 
 static void test_empty_files_have_no_faces(void **state)
@@ -382,15 +418,17 @@ static void test_empty_files_have_no_faces(void **state)
 
 static void test_non_finite_numbers(void **state)
 {
+    /* tinyobjloader reads "nan" and "inf" as 0 (test_tinyobjloader_reads_leniently), but
+     * numbers beyond the float range as infinities */
     rt_error error;
-    load_fails(*state, "nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", &error);
-    assert_contains(error.message, "nan.obj': line 2: vertex coordinate 'nan' is not a finite number");
-    load_fails(*state, "inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn -inf 0 1\nf 1//1 2//1 3//1\n", &error);
-    assert_contains(error.message, "line 4: normal coordinate '-inf' is not a finite number");
     load_fails(*state, "big.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n", &error);
-    assert_contains(error.message, "line 2: vertex coordinate '1e39' is not a finite number");
-    load_fails(*state, "uvnan.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt NaN 0\nf 1/1 2/1 3/1\n", &error);
-    assert_contains(error.message, "line 4: texture coordinate 'NaN' is not a finite number");
+    assert_contains(error.message,
+                    "big.obj': vertex 2 has a coordinate that is not a finite number (beyond the range of a float)");
+    load_fails(*state, "bign.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 -1e39 1\nf 1//1 2//1 3//1\n",
+               &error);
+    assert_contains(error.message, "bign.obj': normal 2 has a coordinate that is not a finite number");
+    load_fails(*state, "bigt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 -1e40\nf 1/1 2/1 3/1\n", &error);
+    assert_contains(error.message, "bigt.obj': texture coordinate 1 has a coordinate that is not a finite number");
 }
 
 static void test_missing_and_directory_files(void **state)
@@ -448,9 +486,10 @@ static void test_missing_mtl_still_loads(void **state)
                             "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
                             "f 1 2 3\nusemtl red\nf 1 2 3\n");
     assert_int_equal(mesh.triangle_count, 2);
-    assert_int_equal(mesh.warning_count, 1);
+    assert_int_equal(mesh.warning_count, 2);
     assert_contains(mesh.warnings[0], "cannot read material library '");
     assert_contains(mesh.warnings[0], "nothere.mtl': No such file or directory; its materials are left out");
+    assert_string_equal(mesh.warnings[1], "tinyobjloader: Failed to load material file(s). Use default material.");
     assert_int_equal(mesh.material_count, 1);
     assert_string_equal(mesh.materials[0].name, "red");
     assert_false(mesh.materials[0].defined);
@@ -475,15 +514,18 @@ static void test_missing_mtl_in_a_scene(void **state)
     assert_int_equal(sc.meshes[0].triangle_count, 2);
     assert_int_equal(sc.meshes[0].triangle_materials[0], red);  /* the scene's, by name */
     assert_int_equal(sc.meshes[0].triangle_materials[1], -1);   /* no such material anywhere */
-    /* The warning is the scene's, for the caller to show, prefixed like an error. */
-    assert_int_equal(sc.warning_count, 1);
+    /* The warnings are the scene's, for the caller to show, prefixed like an error. */
+    assert_int_equal(sc.warning_count, 2);
     char expected[2048];
     snprintf(expected, sizeof expected, POSITION ": mesh '%s': cannot read material library '%s/lost.mtl': No such "
              "file or directory; its materials are left out", path, s->directory);
     assert_string_equal(sc.warnings[0].message, expected);
+    snprintf(expected, sizeof expected, POSITION ": mesh '%s': tinyobjloader: Failed to load material file(s). Use "
+             "default material.", path);
+    assert_string_equal(sc.warnings[1].message, expected);
     /* A second call loads nothing again, so it warns nothing again. */
     load_scene_ok(&sc);
-    assert_int_equal(sc.warning_count, 1);
+    assert_int_equal(sc.warning_count, 2);
     scene_free(&sc);
     assert_int_equal(sc.warning_count, 0);
     assert_null(sc.warnings);
@@ -510,14 +552,15 @@ static void test_tinyobjloader_warnings_are_kept(void **state)
     obj_mesh_free(&mesh);
     assert_int_equal(mesh.warning_count, 0);
 
-    /* Ten missing MTL files: eight warnings kept, ten counted; the scene says so. */
+    /* Ten missing MTL files and tinyobjloader's own warning that none loaded: eight
+     * warnings kept, eleven counted; the scene says so. */
     const char *path = write_file(s, "many.obj",
                                   "mtllib a0.mtl a1.mtl a2.mtl a3.mtl a4.mtl a5.mtl a6.mtl a7.mtl a8.mtl a9.mtl\n"
                                   "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     mesh = load_ok(s, "many.obj",
                    "mtllib a0.mtl a1.mtl a2.mtl a3.mtl a4.mtl a5.mtl a6.mtl a7.mtl a8.mtl a9.mtl\n"
                    "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    assert_int_equal(mesh.warning_count, 10);
+    assert_int_equal(mesh.warning_count, 11);
     assert_contains(mesh.warnings[OBJ_MAX_WARNINGS - 1], "a7.mtl'");
     obj_mesh_free(&mesh);
     scene sc;
@@ -526,9 +569,39 @@ static void test_tinyobjloader_warnings_are_kept(void **state)
     load_scene_ok(&sc);
     assert_int_equal(sc.warning_count, OBJ_MAX_WARNINGS + 1);
     assert_contains(sc.warnings[0].message, "a0.mtl'");
-    snprintf(expected, sizeof expected, POSITION ": mesh '%s': 2 more warnings left out", path);
+    snprintf(expected, sizeof expected, POSITION ": mesh '%s': 3 more warnings left out", path);
     assert_string_equal(sc.warnings[OBJ_MAX_WARNINGS].message, expected);
     scene_free(&sc);
+}
+
+/* A usemtl name no MTL file defines where it is used is kept as a material (defined =
+ * false) and not warned about; tinyobjloader's other warnings keep the file's line
+ * numbers, and an MTL definition counts from its mtllib line on. */
+static void test_usemtl_names_without_a_definition_are_kept(void **state)
+{
+    scratch *s = *state;
+    write_file(s, "late.mtl", "newmtl blue\nKd 0 0 0.9\n");
+    obj_mesh mesh = load_ok(s, "late.obj",
+                            "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                            "usemtl blue\nf 1 2 3\n"
+                            "usemtl red\nf 1 2 3\n"
+                            "mtllib late.mtl\n"
+                            "g \n"
+                            "usemtl blue\nf 1 2 3\n");
+    assert_int_equal(mesh.triangle_count, 3);
+    assert_int_equal(mesh.warning_count, 1);
+    assert_string_equal(mesh.warnings[0], "tinyobjloader: Empty group name. line: 9");
+    const obj_material *first = &mesh.materials[mesh.triangle_materials[0]];
+    const obj_material *second = &mesh.materials[mesh.triangle_materials[1]];
+    const obj_material *third = &mesh.materials[mesh.triangle_materials[2]];
+    assert_string_equal(first->name, "blue");
+    assert_false(first->defined);
+    assert_string_equal(second->name, "red");
+    assert_false(second->defined);
+    assert_string_equal(third->name, "blue");
+    assert_true(third->defined);
+    assert_close(third->diffuse[2], 0.9, 1e-6);
+    obj_mesh_free(&mesh);
 }
 
 /* A volume's boundary must be closed: a mesh of fewer than 4 triangles cannot be. */
@@ -703,7 +776,7 @@ static void test_mesh_errors_carry_the_position(void **state)
     add_mesh(&sc, write_file(s, "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 5\n"), -1);
     assert_int_equal(scene_load_assets(&sc, &error), RT_ERROR_INPUT);
     snprintf(expected, sizeof expected,
-             POSITION ": cannot read mesh '%s': line 4: vertex index 5 is out of range: the file has 3 vertices",
+             POSITION ": cannot read mesh '%s': triangle 1: vertex index 5 is out of range: the file has 3 vertices",
              in_scratch(s, "bad.obj"));
     assert_string_equal(error.message, expected);
     assert_null(sc.meshes[0].positions);
@@ -996,6 +1069,7 @@ int main(void)
     T(test_normals_stay_unit_near_the_float_range),
         T(test_crlf_bom_comments_and_groups),
         T(test_malformed_lines),
+        T(test_tinyobjloader_reads_leniently),
         T(test_out_of_range_indices),
         T(test_empty_files_have_no_faces),
         T(test_non_finite_numbers),
@@ -1003,6 +1077,7 @@ int main(void)
         T(test_missing_mtl_still_loads),
         T(test_missing_mtl_in_a_scene),
         T(test_tinyobjloader_warnings_are_kept),
+        T(test_usemtl_names_without_a_definition_are_kept),
         T(test_volume_mesh_too_small_to_close),
         T(test_usemtl_names_scene_materials),
         T(test_mtl_materials_become_scene_materials),
