@@ -320,26 +320,30 @@ bool builder_finish(scene_builder *builder)
 
 /* ------------------------------------------------------------------ geometry */
 
-bool builder_begin_content(scene_builder *builder, const char *keyword, const source_position *where)
+bool builder_begin_content(scene_builder *builder, const char *keyword, size_t length, const source_position *where)
 {
     scene_block *b = current_block(builder);
+    char word[QUOTE_BUFFER];
     if (b->kind == BLOCK_INSTANCE)
         return fail_at_position(builder->report, where, "only transforms (translate, rotate, scale, matrix) may "
-                                "appear inside an instance block, found %s", keyword);
+                                "appear inside an instance block, found %s",
+                                quote_text(word, sizeof word, keyword, length));
     b->content_seen = true;
     return true;
 }
 
-bool builder_begin_transform(scene_builder *builder, const char *keyword, const source_position *where)
+bool builder_begin_transform(scene_builder *builder, const char *keyword, size_t length,
+                             const source_position *where)
 {
+    char word[QUOTE_BUFFER];
     if (builder->block_count == 1)
         return fail_at_position(builder->report, where, "%s outside a block: a transform applies to the contents of "
-                                "a group, instance or volume", keyword);
+                                "a group, instance or volume", quote_text(word, sizeof word, keyword, length));
     const scene_block *b = current_block(builder);
     if (b->content_seen)
         return fail_at_position(builder->report, where, "%s after the %s's contents: transforms come first in a "
-                                "group (before its shapes, meshes, groups, instances and volumes)", keyword,
-                                block_noun(b->kind));
+                                "group (before its shapes, meshes, groups, instances and volumes)",
+                                quote_text(word, sizeof word, keyword, length), block_noun(b->kind));
     return true;
 }
 

@@ -170,12 +170,14 @@ void builder_mark_image_data(scene_builder *builder, int image);
 
 /* Starts a statement that adds content to the current block: after it no transform may
  * follow in the block, and an instance block takes nothing but transforms. keyword is
- * the statement's keyword as messages quote it ('sphere'), where its position. */
-bool builder_begin_content(scene_builder *builder, const char *keyword, const source_position *where);
+ * the statement's keyword (length bytes, not NUL-terminated; a message quotes it), where
+ * its position. */
+bool builder_begin_content(scene_builder *builder, const char *keyword, size_t length, const source_position *where);
 
 /* Checks that a transform statement may stand here: inside a block, before its
- * contents; keyword and where as for builder_begin_content. */
-bool builder_begin_transform(scene_builder *builder, const char *keyword, const source_position *where);
+ * contents; keyword, length and where as for builder_begin_content. */
+bool builder_begin_transform(scene_builder *builder, const char *keyword, size_t length,
+                             const source_position *where);
 
 /* Makes transform apply after the transforms the current block already has. */
 void builder_append_transform(scene_builder *builder, const affine *transform);

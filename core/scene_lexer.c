@@ -409,12 +409,6 @@ bool is_last_word(source_line *line, token *t)
     return ok && after.kind == TOKEN_END;
 }
 
-bool token_is(const source_line *line, const token *t, const char *word)
-{
-    size_t length = strlen(word);
-    return t->kind == TOKEN_WORD && t->length == length && memcmp(line->text + t->offset, word, length) == 0;
-}
-
 bool expect_end_of_line(source_line *line, const char *after)
 {
     token t = {.kind = TOKEN_END};

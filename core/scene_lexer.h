@@ -33,6 +33,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <string.h>
 #include <sys/types.h>
 
 #include "scene_report.h"
@@ -148,8 +149,13 @@ bool peek_token(source_line *line, token *t);
  * statement's last word). */
 bool is_last_word(source_line *line, token *t);
 
-/* True when t is the bare word `word`. */
-bool token_is(const source_line *line, const token *t, const char *word);
+/* True when t is the bare word `word`. Inline: the statement table compares every
+ * statement's keyword with it. */
+static inline bool token_is(const source_line *line, const token *t, const char *word)
+{
+    size_t length = strlen(word);
+    return t->kind == TOKEN_WORD && t->length == length && memcmp(line->text + t->offset, word, length) == 0;
+}
 
 /* Fails unless the rest of the line is empty; after names what came last, for the
  * message ("unexpected 'x' after the translation (expected end of line)"). */

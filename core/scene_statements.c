@@ -57,16 +57,16 @@ static bool parse_statement(scene_parser *p, source_line *line)
         return statement_close(p, line, &keyword);
     if (keyword.kind == TOKEN_OPEN_BRACE)
         return fail_at(line, keyword.offset, "unexpected '{' (only a group, instance or volume line ends with '{')");
-    char word[FOUND_BUFFER];
     for (size_t i = 0; i < sizeof statements / sizeof statements[0]; i++) {
         if (!token_is(line, &keyword, statements[i].keyword))
             continue;
         source_position where = token_position(line, &keyword);
         if (statements[i].is_content &&
-            !builder_begin_content(&p->builder, describe_token(line, &keyword, word, sizeof word), &where))
+            !builder_begin_content(&p->builder, line->text + keyword.offset, keyword.length, &where))
             return false;
         return statements[i].parse(p, line, &keyword);
     }
+    char word[FOUND_BUFFER];
     return fail_at(line, keyword.offset, "unknown statement %s (expected include, set, camera, render, sky, "
                    "ambient, light, texture, material, sphere, moving_sphere, triangle, quad, box, mesh, group, "
                    "instance, volume, translate, rotate, scale or matrix)",

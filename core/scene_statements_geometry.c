@@ -15,9 +15,8 @@
 /* Checks that the transform statement whose keyword is keyword may stand here. */
 static bool begin_transform(scene_parser *p, const source_line *line, const token *keyword)
 {
-    char word[FOUND_BUFFER];
     source_position where = token_position(line, keyword);
-    return builder_begin_transform(&p->builder, describe_token(line, keyword, word, sizeof word), &where);
+    return builder_begin_transform(&p->builder, line->text + keyword->offset, keyword->length, &where);
 }
 
 /* translate X Y Z */
