@@ -65,6 +65,20 @@ const char *format_number(char *buffer, size_t size, double value)
     return buffer;
 }
 
+const char *format_word_list(char *buffer, size_t size, const char *const *words, int count)
+{
+    size_t used = 0;
+    buffer[0] = '\0';
+    for (int i = 0; i < count && used < size; i++) {
+        int written = snprintf(buffer + used, size - used, "%s%s", i == 0 ? "" : i == count - 1 ? " or " : ", ",
+                               words[i]);
+        if (written < 0)
+            break;
+        used += (size_t)written;
+    }
+    return buffer;
+}
+
 void format_position(char *buffer, size_t size, const source_position *where)
 {
     snprintf(buffer, size, "%s:%d:%zu", where->path, where->line, where->column);

@@ -75,6 +75,10 @@ const char *quote_text(char *buffer, size_t size, const char *text, size_t lengt
  * whole number of the integer ranges exactly. */
 const char *format_number(char *buffer, size_t size, double value);
 
+/* Writes the count words as a list for a message, "a, b or c", into buffer and returns
+ * buffer (cut to size). */
+const char *format_word_list(char *buffer, size_t size, const char *const *words, int count);
+
 /* Writes "FILE:LINE:COLUMN" of where into buffer, for the asset loader's messages
  * (scene_image.position, scene_mesh.position). */
 void format_position(char *buffer, size_t size, const source_position *where);

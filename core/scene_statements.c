@@ -14,8 +14,9 @@
 
 /* ------------------------------------------------------------------ the table */
 
-/* The statements, by their first word. Transforms and include do not count as a block's
- * content (transforms must come first; an include's own statements count). */
+/* The statements, by their first word, in the order the "unknown statement" message lists
+ * them. Transforms and include do not count as a block's content (transforms must come
+ * first; an include's own statements count). */
 static const struct {
     const char *keyword;
     statement_parser parse;
@@ -66,11 +67,13 @@ static bool parse_statement(scene_parser *p, source_line *line)
             return false;
         return statements[i].parse(p, line, &keyword);
     }
-    char word[FOUND_BUFFER];
-    return fail_at(line, keyword.offset, "unknown statement %s (expected include, set, camera, render, sky, "
-                   "ambient, light, texture, material, sphere, moving_sphere, triangle, quad, box, mesh, group, "
-                   "instance, volume, translate, rotate, scale or matrix)",
-                   describe_token(line, &keyword, word, sizeof word));
+    const char *keywords[sizeof statements / sizeof statements[0]];
+    for (size_t i = 0; i < sizeof statements / sizeof statements[0]; i++)
+        keywords[i] = statements[i].keyword;
+    char word[FOUND_BUFFER], expected[2 * DESCRIPTION_BUFFER];
+    return fail_at(line, keyword.offset, "unknown statement %s (expected %s)",
+                   describe_token(line, &keyword, word, sizeof word),
+                   format_word_list(expected, sizeof expected, keywords, (int)(sizeof keywords / sizeof keywords[0])));
 }
 
 bool parse_source(scene_parser *p, const source_file *file)

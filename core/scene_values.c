@@ -389,15 +389,10 @@ bool match_clause(const source_line *line, const token *t, const char *statement
         *index = i;
         return true;
     }
-    char expected[DESCRIPTION_BUFFER] = "";
-    for (int i = 0; i < count; i++) {
-        size_t used = strlen(expected);
-        snprintf(expected + used, sizeof expected - used, "%s%s", i == 0 ? "" : i == count - 1 ? " or " : ", ",
-                 names[i]);
-    }
-    char found[FOUND_BUFFER];
+    char expected[DESCRIPTION_BUFFER], found[FOUND_BUFFER];
     return fail_at(line, t->offset, "unknown %s clause %s (expected %s)", statement,
-                   describe_token(line, t, found, sizeof found), expected);
+                   describe_token(line, t, found, sizeof found),
+                   format_word_list(expected, sizeof expected, names, count));
 }
 
 bool is_plain_name(const char *text, size_t length)
