@@ -12,21 +12,25 @@
 
 #include "scene_lexer.h"
 
-/* A lexer, its report and one file of text (the caller's string) named "t.txt". */
+/* A lexer, its report and one file of text (the caller's string) named "t.txt", with its
+ * first line cut. */
 typedef struct fixture {
     rt_error error;
     scene_report report;
     scene_lexer lexer;
     source_file file;
+    source_line line;
 } fixture;
 
-/* Opens text as the top file of a fresh lexer in *f; lexer_free(&f->lexer) ends it. */
+/* Opens text as the top file of a fresh lexer in *f and cuts its first line into f->line;
+ * lexer_free(&f->lexer) ends it. */
 static void open_text(fixture *f, const char *text)
 {
     memset(f, 0, sizeof *f);
     f->report = (scene_report){.error = &f->error, .status = RT_OK};
     lexer_init(&f->lexer, &f->report, 16);
     assert_true(lexer_open_string(&f->lexer, text, "t.txt", &f->file));
+    assert_true(source_file_next_line(&f->file, &f->line));
 }
 
 /* Counts the lines of text and checks the text of line number `which` (1-based). */
@@ -34,16 +38,16 @@ static int count_lines(const char *text, int which, const char *expected)
 {
     fixture f;
     open_text(&f, text);
-    source_line line = {0};
+    source_line line = f.line;
     int count = 0;
-    while (source_file_next_line(&f.file, &line)) {
+    do {
         count++;
         assert_int_equal(line.number, count);
         if (count == which) {
             assert_int_equal(line.length, strlen(expected));
             assert_memory_equal(line.text, expected, line.length);
         }
-    }
+    } while (source_file_next_line(&f.file, &line));
     lexer_free(&f.lexer);
     return count;
 }
@@ -66,8 +70,7 @@ static int lex_all(const char *text, token_kind kinds[16], char words[256])
 {
     fixture f;
     open_text(&f, text);
-    source_line line = {0};
-    assert_true(source_file_next_line(&f.file, &line));
+    source_line line = f.line;
     int count = 0;
     words[0] = '\0';
     for (;;) {
@@ -110,8 +113,7 @@ static void test_positions_and_errors(void **state)
     (void)state;
     fixture f;
     open_text(&f, "\nradius 2   # c\nbad }");
-    source_line line = {0};
-    assert_true(source_file_next_line(&f.file, &line));
+    source_line line = f.line;
     assert_true(source_file_next_line(&f.file, &line));
     token t;
     assert_true(next_token(&line, &t));
@@ -146,10 +148,8 @@ static void test_statement_bytes(void **state)
     (void)state;
     fixture f;
     open_text(&f, "camera \x01");
-    source_line line = {0};
-    assert_true(source_file_next_line(&f.file, &line));
     token keyword;
-    assert_false(lexer_start_statement(&line, &keyword));
+    assert_false(lexer_start_statement(&f.line, &keyword));
     assert_string_equal(f.error.message,
                         "t.txt:1:8: unexpected byte 0x01 (a control character; scene files are text)");
     lexer_free(&f.lexer);
