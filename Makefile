@@ -186,13 +186,17 @@ FUZZ_FLAGS := -std=c11 -D_GNU_SOURCE -g -O1 -fno-omit-frame-pointer -Icore -Igls
 # The packer and the CPU traversal of what it packs (core/pack_internal.h lists its files).
 FUZZ_PACK_SOURCES := core/pack.c core/pack_collect.c core/pack_geometry.c core/pack_lights.c \
 	core/pack_materials.c core/packed_traverse.c
-FUZZ_SCENE_SOURCES := tests/fuzz/fuzz_scene_parse.c core/scene_parse.c core/expression.c core/scene.c \
+# The scene parser's parts (core/scene_parse.c lists what each does).
+FUZZ_PARSER_SOURCES := core/scene_parse.c core/scene_report.c core/scene_lexer.c core/scene_values.c \
+	core/scene_statements.c core/scene_statements_appearance.c core/scene_statements_geometry.c \
+	core/scene_builder.c core/scene_validate.c core/affine.c
+FUZZ_SCENE_SOURCES := tests/fuzz/fuzz_scene_parse.c $(FUZZ_PARSER_SOURCES) core/expression.c core/scene.c \
 	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c
 FUZZ_EXPRESSION_SOURCES := tests/fuzz/fuzz_expression.c core/expression.c core/status.c
 # The OBJ harness runs scene_load_assets(), which links the C++ shims (tinyobjloader and,
 # for images, OpenImageIO); the libraries themselves are not instrumented.
 FUZZ_CXX ?= clang++
-FUZZ_OBJ_C_SOURCES := tests/fuzz/fuzz_obj_load.c core/scene_parse.c core/expression.c core/scene.c \
+FUZZ_OBJ_C_SOURCES := tests/fuzz/fuzz_obj_load.c $(FUZZ_PARSER_SOURCES) core/expression.c core/scene.c \
 	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c core/scene_assets.c
 FUZZ_OBJ_CXX_SOURCES := core/obj_load.cpp core/image_io.cpp
 FUZZ_HARNESSES := $(FUZZ_DIR)/fuzz_scene_parse $(FUZZ_DIR)/fuzz_expression $(FUZZ_DIR)/fuzz_obj_load
