@@ -4,6 +4,7 @@
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,16 +12,6 @@
 #include "hash.h"
 #include "scene.h"
 #include "shader_sources.h"
-
-#define STATE_TARGET_COUNT 7
-enum {
-    STATE_ORIGIN, STATE_DIRECTION, STATE_THROUGHPUT, STATE_RADIANCE,
-    STATE_COUNTERS, STATE_ACCUMULATED, STATE_STATISTICS,
-};
-static const char *const state_sampler_names[STATE_TARGET_COUNT] = {
-    "state_origin", "state_direction", "state_throughput", "state_radiance",
-    "state_counters", "state_accumulated", "state_statistics",
-};
 
 /* Tracer variants kept per context: a render uses one (and the AOV pass one more); an
  * animation or sweep keeps using the same few. */
@@ -52,9 +43,10 @@ struct gpu_tracer {
     GLuint vertex_array;
     GLuint packed_texture;
     GLuint packed_buffer;
-    GLuint state_textures[2][STATE_TARGET_COUNT];
+    GLuint state_textures[2][TRACER_STATE_COUNT];
     GLuint framebuffers[2];
     GLuint counter_buffer;
+    GLuint parameter_buffer;     /* the parameter block (tracer_parameter_block) */
     int current;                 /* which state set holds the latest pass */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
     bool reused_scene;           /* the packed scene was already on the device */
@@ -475,19 +467,83 @@ static GLuint link_program(GLuint vertex, GLuint fragment, rt_error *error)
     return program;
 }
 
-/* Builds a tracer program: "#version 450 core" + defines + packed_layout.h + random.glsl +
- * tracer.frag. defines selects the variant ("" the path tracer, the AOV pass otherwise).
- * Returns the program or 0 with error set. */
-static GLuint build_tracer_program(const char *defines, rt_error *error)
+/* The most modules a fragment program may have (shader_sources.S's table). */
+#define GPU_MAX_SHADER_MODULES 48
+/* Module i's lines are numbered from (i + 1) * GPU_MODULE_LINES + 1 (a #line before it), so
+ * that a compiler message's line says which module it is in: Mesa's messages do not
+ * carry the source string number of #line. No module is that long. */
+#define GPU_MODULE_LINES 10000
+
+/* Rewrites the compiler log in error (after "compile: ") so that each message's
+ * "SOURCE:LINE(" names the module and its own line ("glsl/sky.glsl:8("). */
+static void name_modules_in_log(rt_error *error)
 {
-    const char *version = "#version 450 core\n";
-    const char *vertex_parts[] = {version, shader_source_fullscreen_vertex};
-    const char *fragment_parts[] = {version, defines, shader_source_packed_layout, shader_source_random,
-                                    "#line 1 1\n", shader_source_tracer_fragment};
+    char *log = strstr(error->message, "compile: ");
+    if (log == NULL)
+        return;
+    log += strlen("compile: ");
+    char named[sizeof error->message];
+    size_t used = 0;
+    for (const char *line = log; *line != '\0' && used + 1 < sizeof named;) {
+        const char *end = strchr(line, '\n');
+        size_t length = end ? (size_t)(end - line) + 1 : strlen(line);
+        int source = 0, number = 0, consumed = 0;
+        int module = -1;
+        if (sscanf(line, "%d:%d(%n", &source, &number, &consumed) == 2 && consumed > 0)
+            module = source > 0 ? source - 1 : number / GPU_MODULE_LINES - 1;
+        for (int i = 0; module >= 0 && shader_modules[i].path != NULL; i++)
+            if (i == module) {
+                used += (size_t)snprintf(named + used, sizeof named - used, "%s:%d(%.*s", shader_modules[i].path,
+                                         number % GPU_MODULE_LINES, (int)(length - (size_t)consumed),
+                                         line + consumed);
+                module = -2;
+            }
+        if (module != -2)
+            used += (size_t)snprintf(named + used, sizeof named - used, "%.*s", (int)length, line);
+        line += length;
+    }
+    snprintf(log, sizeof error->message - (size_t)(log - error->message), "%s", named);
+}
+
+/* Compiles a fragment shader: "#version 450 core" + defines + every module of the table of
+ * core/shader_sources.S whose programs include program (a SHADER_PROGRAM_* bit), in the
+ * table's order, each after a #line that numbers it by its place in the table. Returns
+ * the shader or 0 with error set, its messages naming the modules. */
+static GLuint compile_fragment_program(uintptr_t program, const char *defines, rt_error *error)
+{
+    const char *parts[2 + 2 * GPU_MAX_SHADER_MODULES];
+    char line_directives[GPU_MAX_SHADER_MODULES][32];
+    int count = 0;
+    parts[count++] = "#version 450 core\n";
+    parts[count++] = defines;
+    for (int i = 0; shader_modules[i].path != NULL; i++) {
+        if (i == GPU_MAX_SHADER_MODULES) {
+            rt_error_set(error, RT_ERROR_RUNTIME, "GPU: core/shader_sources.S lists more than %d shader modules "
+                         "(GPU_MAX_SHADER_MODULES in core/gpu.c)", GPU_MAX_SHADER_MODULES);
+            return 0;
+        }
+        if ((shader_modules[i].programs & program) == 0)
+            continue;
+        snprintf(line_directives[i], sizeof line_directives[i], "#line %d %d\n", (i + 1) * GPU_MODULE_LINES + 1,
+                 i + 1);
+        parts[count++] = line_directives[i];
+        parts[count++] = shader_modules[i].source;
+    }
+    GLuint shader = compile_stage(GL_FRAGMENT_SHADER, parts, count, error);
+    if (shader == 0)
+        name_modules_in_log(error);
+    return shader;
+}
+
+/* Builds a program of the shared vertex shader and the fragment program (SHADER_PROGRAM_*)
+ * with defines. Returns the program or 0 with error set. */
+static GLuint build_fragment_program(uintptr_t program, const char *defines, rt_error *error)
+{
+    const char *vertex_parts[] = {"#version 450 core\n", shader_source_fullscreen_vertex};
     GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
     if (vertex == 0)
         return 0;
-    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 6, error);
+    GLuint fragment = compile_fragment_program(program, defines, error);
     if (fragment == 0) {
         glDeleteShader(vertex);
         return 0;
@@ -495,20 +551,36 @@ static GLuint build_tracer_program(const char *defines, rt_error *error)
     return link_program(vertex, fragment, error);
 }
 
-/* Writes the #defines of a tracer variant into defines (size bytes): the GPU_OMIT_* bits
- * of omitted, and with GPU_FIX_UNIFORMS the integrator and sky type as constants. */
+/* Writes the #defines of a tracer variant into defines (size bytes): every
+ * RTSPHERES_OMIT_* as 1 when its GPU_OMIT_* bit is in omitted, else 0 (glsl/variant.glsl
+ * reads them), and RTSPHERES_FIX_UNIFORMS with the integrator and sky type it compiles in
+ * (0 when not fixed, so the source does not vary with the parameters). */
 static void variant_defines(uint32_t omitted, int integrator, int sky_type, char *defines, size_t size)
 {
-    static const char *const names[] = {"DIRECT_LIGHT", "VOLUMES", "TEXTURES", "SPHERES", "MOVING_SPHERES",
-                                        "TRIANGLES", "INSTANCES", "EMITTERS", "QUADS"};
+    static const struct {
+        uint32_t bit;
+        const char *name;
+    } features[] = {
+        {GPU_OMIT_DIRECT_LIGHT, "RTSPHERES_OMIT_DIRECT_LIGHT"},
+        {GPU_OMIT_VOLUMES, "RTSPHERES_OMIT_VOLUMES"},
+        {GPU_OMIT_TEXTURES, "RTSPHERES_OMIT_TEXTURES"},
+        {GPU_OMIT_SPHERES, "RTSPHERES_OMIT_SPHERES"},
+        {GPU_OMIT_MOVING_SPHERES, "RTSPHERES_OMIT_MOVING_SPHERES"},
+        {GPU_OMIT_TRIANGLES, "RTSPHERES_OMIT_TRIANGLES"},
+        {GPU_OMIT_INSTANCES, "RTSPHERES_OMIT_INSTANCES"},
+        {GPU_OMIT_EMITTERS, "RTSPHERES_OMIT_EMITTERS"},
+        {GPU_OMIT_QUADS, "RTSPHERES_OMIT_QUADS"},
+        {GPU_FIX_UNIFORMS, "RTSPHERES_FIX_UNIFORMS"},
+    };
+    bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;
     defines[0] = '\0';
-    for (unsigned bit = 0; bit < sizeof names / sizeof names[0]; bit++)
-        if (omitted & (1u << bit))
-            used += (size_t)snprintf(defines + used, size - used, "#define RTSPHERES_OMIT_%s 1\n", names[bit]);
-    if (omitted & GPU_FIX_UNIFORMS)
+    for (size_t i = 0; i < sizeof features / sizeof features[0] && used < size; i++)
+        used += (size_t)snprintf(defines + used, size - used, "#define %s %d\n", features[i].name,
+                                 (omitted & features[i].bit) != 0);
+    if (used < size)
         snprintf(defines + used, size - used, "#define RTSPHERES_INTEGRATOR %d\n#define RTSPHERES_SKY_TYPE %d\n",
-                 integrator, sky_type);
+                 fixed ? integrator : 0, fixed ? sky_type : 0);
 }
 
 /* The key of a variant in the context's program cache: the bits, and the constants
@@ -528,15 +600,16 @@ static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *
 {
     gpu_context *context = tracer->context;
     uint32_t omitted = parameters->omitted_features;
-    uint32_t key = variant_key(omitted, parameters->integrator, parameters->sky_type);
+    int integrator = parameters->shader.integrator, sky_type = parameters->shader.sky_type;
+    uint32_t key = variant_key(omitted, integrator, sky_type);
     for (int i = 0; i < context->tracer_program_count; i++)
         if (context->tracer_programs[i].key == key) {
             tracer->program = context->tracer_programs[i].program;
             return RT_OK;
         }
-    char defines[512];
-    variant_defines(omitted, parameters->integrator, parameters->sky_type, defines, sizeof defines);
-    GLuint program = build_tracer_program(defines, error);
+    char defines[1024];
+    variant_defines(omitted, integrator, sky_type, defines, sizeof defines);
+    GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
     int slot = context->tracer_program_count;
@@ -556,8 +629,8 @@ static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *
 /* Uploads the packed scene into a buffer object read through an RGBA32UI buffer texture
  * (usamplerBuffer), checked against GL_MAX_TEXTURE_BUFFER_SIZE. A buffer texture rather
  * than a 2D one because a fetch from it is a bounds check and a load: on llvmpipe a 2D
- * texelFetch also looks up each lane's mip level and row pitch, and the weekend scene
- * traced 1.7x faster with the buffer (docs/performance.md). */
+ * texelFetch also looks up each lane's mip level and row pitch (docs/performance.md
+ * has what that cost). */
 static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels, uint32_t texel_count,
                                      rt_error *error)
 {
@@ -590,16 +663,16 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
                             "GPU: the image %dx%d is larger than the device's textures (GL_MAX_TEXTURE_SIZE %d): "
                             "render it in tiles (--tile, --crop) of at most %d pixels a side",
                             tracer->width, tracer->height, max_size, max_size);
-    if (tracer->context->info.max_draw_buffers < STATE_TARGET_COUNT)
+    if (tracer->context->info.max_draw_buffers < TRACER_STATE_COUNT)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
-                            STATE_TARGET_COUNT, tracer->context->info.max_draw_buffers);
-    GLenum draw_buffers[STATE_TARGET_COUNT];
+                            TRACER_STATE_COUNT, tracer->context->info.max_draw_buffers);
+    GLenum draw_buffers[TRACER_STATE_COUNT];
     for (int set = 0; set < 2; set++) {
-        glGenTextures(STATE_TARGET_COUNT, tracer->state_textures[set]);
+        glGenTextures(TRACER_STATE_COUNT, tracer->state_textures[set]);
         glGenFramebuffers(1, &tracer->framebuffers[set]);
         glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[set]);
-        for (int target = 0; target < STATE_TARGET_COUNT; target++) {
-            bool integer = target == STATE_COUNTERS;
+        for (int target = 0; target < TRACER_STATE_COUNT; target++) {
+            bool integer = target == TRACER_STATE_COUNTERS;
             glBindTexture(GL_TEXTURE_2D, tracer->state_textures[set][target]);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -608,15 +681,15 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
                                    tracer->state_textures[set][target], 0);
             draw_buffers[target] = GL_COLOR_ATTACHMENT0 + target;
         }
-        glDrawBuffers(STATE_TARGET_COUNT, draw_buffers);
+        glDrawBuffers(TRACER_STATE_COUNT, draw_buffers);
         GLenum complete = glCheckFramebufferStatus(GL_FRAMEBUFFER);
         if (complete != GL_FRAMEBUFFER_COMPLETE)
             return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the state framebuffer is incomplete (0x%04x)",
                                 complete);
         const GLfloat zero[4] = {0, 0, 0, 0};
         const GLuint zero_uint[4] = {0, 0, 0, 0};
-        for (int target = 0; target < STATE_TARGET_COUNT; target++) {
-            if (target == STATE_COUNTERS)
+        for (int target = 0; target < TRACER_STATE_COUNT; target++) {
+            if (target == TRACER_STATE_COUNTERS)
                 glClearBufferuiv(GL_COLOR, target, zero_uint);
             else
                 glClearBufferfv(GL_COLOR, target, zero);
@@ -626,7 +699,7 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
         return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for a %dx%d image's state (%d MB)",
                             tracer->width, tracer->height,
-                            (int)((double)tracer->width * tracer->height * 16 * 2 * STATE_TARGET_COUNT / 1e6));
+                            (int)((double)tracer->width * tracer->height * 16 * 2 * TRACER_STATE_COUNT / 1e6));
     return status;
 }
 
@@ -651,18 +724,13 @@ static rt_status load_resume_state(gpu_tracer *tracer, const float *resume, rt_e
         for (int x = 0; x < tracer->width; x++)
             counters[((size_t)row * tracer->width + x) * 4] = (uint32_t)source[x * 4 + 3];
     }
-    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][STATE_ACCUMULATED]);
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][TRACER_STATE_ACCUMULATED]);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA, GL_FLOAT, sums);
-    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][STATE_COUNTERS]);
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][TRACER_STATE_COUNTERS]);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA_INTEGER, GL_UNSIGNED_INT, counters);
     free(sums);
     free(counters);
     return check_gl("loading the partial render", error);
-}
-
-static void set_vec3(GLuint program, const char *name, const float value[3])
-{
-    glUniform3f(glGetUniformLocation(program, name), value[0], value[1], value[2]);
 }
 
 /* Returns budget within what the device's work bound allows (gpu.h). */
@@ -672,44 +740,29 @@ static uint32_t clamp_budget(const gpu_info *info, uint32_t budget)
     return budget < 1 ? 1 : budget > most ? most : budget;
 }
 
-/* Sets every uniform of the tracer from the parameters. */
-static void set_parameters(const gpu_info *info, GLuint program, const gpu_tracer_parameters *p)
+/* Uploads the tracer's parameter block: the parameters' block with what the device
+ * decides (the work cap, the budget within its bound) and full_size defaulted. */
+static void upload_parameters(gpu_tracer *tracer)
 {
-    glUseProgram(program);
-    glUniform2i(glGetUniformLocation(program, "image_size"), p->width, p->height);
-    glUniform2i(glGetUniformLocation(program, "region_origin"), p->region_x, p->region_y);
-    glUniform2i(glGetUniformLocation(program, "full_size"), p->full_width ? p->full_width : p->width,
-                p->full_height ? p->full_height : p->height);
-    set_vec3(program, "camera_origin", p->camera_origin);
-    set_vec3(program, "camera_lower_left", p->camera_lower_left);
-    set_vec3(program, "camera_horizontal", p->camera_horizontal);
-    set_vec3(program, "camera_vertical", p->camera_vertical);
-    set_vec3(program, "camera_u", p->camera_u);
-    set_vec3(program, "camera_v", p->camera_v);
-    glUniform1f(glGetUniformLocation(program, "lens_radius"), p->lens_radius);
-    glUniform1f(glGetUniformLocation(program, "shutter_open"), p->shutter_open);
-    glUniform1f(glGetUniformLocation(program, "shutter_close"), p->shutter_close);
-    glUniform1ui(glGetUniformLocation(program, "camera_media"), p->camera_media);
-    glUniform1f(glGetUniformLocation(program, "sky_intensity"), p->sky_intensity);
-    glUniform1f(glGetUniformLocation(program, "sky_rotation"), p->sky_rotation_radians);
-    glUniform1uiv(glGetUniformLocation(program, "sky_faces"), 6, p->sky_faces);
-    glUniform1ui(glGetUniformLocation(program, "sky_environment"), p->sky_environment);
-    glUniform1i(glGetUniformLocation(program, "sky_type"), p->sky_type);
-    set_vec3(program, "sky_bottom", p->sky_bottom);
-    set_vec3(program, "sky_top", p->sky_top);
-    glUniform1ui(glGetUniformLocation(program, "seed"), p->seed);
-    glUniform1ui(glGetUniformLocation(program, "sample_start"), p->sample_start);
-    glUniform1ui(glGetUniformLocation(program, "samples_per_pixel"), p->samples_per_pixel);
-    glUniform1ui(glGetUniformLocation(program, "max_depth"), p->max_depth);
-    glUniform1ui(glGetUniformLocation(program, "russian_roulette_depth"), p->russian_roulette_depth);
-    glUniform1i(glGetUniformLocation(program, "pass_work_budget"), (GLint)clamp_budget(info, p->pass_work_budget));
-    glUniform1i(glGetUniformLocation(program, "work_cap"), info->work_cap);
-    glUniform1i(glGetUniformLocation(program, "light_sampling"), p->light_sampling ? 1 : 0);
-    glUniform1i(glGetUniformLocation(program, "integrator"), p->integrator);
-    glUniform3f(glGetUniformLocation(program, "ambient"), p->ambient[0], p->ambient[1], p->ambient[2]);
-    glUniform1i(glGetUniformLocation(program, "packed_scene"), STATE_TARGET_COUNT);
-    for (int target = 0; target < STATE_TARGET_COUNT; target++)
-        glUniform1i(glGetUniformLocation(program, state_sampler_names[target]), target);
+    const gpu_info *info = &tracer->context->info;
+    tracer_parameter_block block = tracer->parameters.shader;
+    if (block.full_size[0] == 0 || block.full_size[1] == 0) {
+        block.full_size[0] = block.image_size[0];
+        block.full_size[1] = block.image_size[1];
+    }
+    block.pass_work_budget = (int32_t)clamp_budget(info, (uint32_t)block.pass_work_budget);
+    block.work_cap = info->work_cap;
+    tracer->parameters.shader = block;
+    glBindBuffer(GL_UNIFORM_BUFFER, tracer->parameter_buffer);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof block, &block, GL_DYNAMIC_DRAW);
+    glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
+}
+
+/* Changes one int member of the uploaded parameter block (at offset). */
+static void update_parameter(gpu_tracer *tracer, size_t offset, int32_t value)
+{
+    glBindBuffer(GL_UNIFORM_BUFFER, tracer->parameter_buffer);
+    glBufferSubData(GL_UNIFORM_BUFFER, (GLintptr)offset, sizeof value, &value);
 }
 
 rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
@@ -720,8 +773,8 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     if (tracer == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory");
     tracer->context = context;
-    tracer->width = parameters->width;
-    tracer->height = parameters->height;
+    tracer->width = parameters->shader.image_size[0];
+    tracer->height = parameters->shader.image_size[1];
     rt_status status = build_program(tracer, parameters, error);
     uint64_t hash = hash_bytes(HASH_START, packed_texels, (size_t)texel_count * 16u);
     if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == hash
@@ -756,10 +809,11 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     glGenBuffers(1, &tracer->counter_buffer);
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
     glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), NULL, GL_DYNAMIC_READ);
-    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, tracer->counter_buffer);
-    set_parameters(&context->info, tracer->program, parameters);
+    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
     tracer->parameters = *parameters;
     tracer->parameters.resume = NULL;
+    glGenBuffers(1, &tracer->parameter_buffer);
+    upload_parameters(tracer);
     status = check_gl("setting up the tracer", error);
     if (status != RT_OK) {
         gpu_tracer_destroy(tracer);
@@ -778,11 +832,13 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[target]);
     glViewport(0, 0, tracer->width, tracer->height);
     glUseProgram(tracer->program);
-    for (int state = 0; state < STATE_TARGET_COUNT; state++) {
+    glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
+    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
+    for (int state = 0; state < TRACER_STATE_COUNT; state++) {
         glActiveTexture(GL_TEXTURE0 + state);
         glBindTexture(GL_TEXTURE_2D, tracer->state_textures[source][state]);
     }
-    glActiveTexture(GL_TEXTURE0 + STATE_TARGET_COUNT);
+    glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
     glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
     glBindVertexArray(tracer->vertex_array);
     glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -797,9 +853,9 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
 
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
 {
-    glUseProgram(tracer->program);
-    glUniform1i(glGetUniformLocation(tracer->program, "pass_work_budget"),
-                (GLint)clamp_budget(&tracer->context->info, budget));
+    tracer->parameters.shader.pass_work_budget = (int32_t)clamp_budget(&tracer->context->info, budget);
+    update_parameter(tracer, offsetof(tracer_parameter_block, pass_work_budget),
+                     tracer->parameters.shader.pass_work_budget);
 }
 
 /* Reads one state texture of the latest set into rows top to bottom. */
@@ -822,13 +878,13 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
                           rt_error *error)
 {
     glActiveTexture(GL_TEXTURE0);
-    read_state(tracer, STATE_ACCUMULATED, rgba);
+    read_state(tracer, TRACER_STATE_ACCUMULATED, rgba);
     if (totals != NULL || luminance_squares != NULL) {
         size_t count = (size_t)tracer->width * tracer->height;
         float *statistics = malloc(count * 4 * sizeof(float));
         if (statistics == NULL)
             return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading statistics");
-        read_state(tracer, STATE_STATISTICS, statistics);
+        read_state(tracer, TRACER_STATE_STATISTICS, statistics);
         gpu_tracer_totals sums = {0};
         for (size_t i = 0; i < count; i++) {
             sums.path_segments += statistics[i * 4 + 0];
@@ -847,11 +903,10 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
                                  rt_error *error)
 {
     /* The render's variant: the AOV pass reaches no more of the tracer than the render. */
-    char defines[512];
+    char defines[1024];
     const gpu_tracer_parameters *p = &tracer->parameters;
-    variant_defines(p->omitted_features, p->integrator, p->sky_type, defines, sizeof defines);
-    strncat(defines, "#define RTSPHERES_AOV_PASS 1\n", sizeof defines - strlen(defines) - 1);
-    GLuint program = build_tracer_program(defines, error);
+    variant_defines(p->omitted_features, p->shader.integrator, p->shader.sky_type, defines, sizeof defines);
+    GLuint program = build_fragment_program(SHADER_PROGRAM_AOV, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
     int width = tracer->width, height = tracer->height;
@@ -870,10 +925,11 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the AOV framebuffer is incomplete");
     if (status == RT_OK) {
-        set_parameters(&tracer->context->info, program, &tracer->parameters);
-        glUniform1i(glGetUniformLocation(program, "aov_samples"), samples);
+        update_parameter(tracer, offsetof(tracer_parameter_block, aov_samples), samples);
+        glUseProgram(program);
+        glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
         glViewport(0, 0, width, height);
-        glActiveTexture(GL_TEXTURE0 + STATE_TARGET_COUNT);
+        glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
         glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
         glBindVertexArray(tracer->vertex_array);
         glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -911,7 +967,7 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
     if (tracer == NULL)
         return;
     for (int set = 0; set < 2; set++) {
-        glDeleteTextures(STATE_TARGET_COUNT, tracer->state_textures[set]);
+        glDeleteTextures(TRACER_STATE_COUNT, tracer->state_textures[set]);
         glDeleteFramebuffers(1, &tracer->framebuffers[set]);
     }
     /* The program and the packed scene belong to the context (kept for the next frame). */
@@ -920,6 +976,7 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
         glDeleteBuffers(1, &tracer->packed_buffer);
     }
     glDeleteBuffers(1, &tracer->counter_buffer);
+    glDeleteBuffers(1, &tracer->parameter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);
     free(tracer);
 }
@@ -928,18 +985,7 @@ rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32
                              uint32_t dimension, float *rgba, rt_error *error)
 {
     (void)context;
-    const char *version = "#version 450 core\n";
-    const char *vertex_parts[] = {version, shader_source_fullscreen_vertex};
-    const char *fragment_parts[] = {version, shader_source_random, shader_source_random_test_fragment};
-    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
-    if (vertex == 0)
-        return RT_ERROR_RUNTIME;
-    GLuint fragment = compile_stage(GL_FRAGMENT_SHADER, fragment_parts, 3, error);
-    if (fragment == 0) {
-        glDeleteShader(vertex);
-        return RT_ERROR_RUNTIME;
-    }
-    GLuint program = link_program(vertex, fragment, error);
+    GLuint program = build_fragment_program(SHADER_PROGRAM_RANDOM_TEST, "", error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
     GLuint texture, framebuffer, vertex_array;
@@ -977,4 +1023,28 @@ rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32
     if (bottom_up == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading random numbers");
     return check_gl("drawing random numbers", error);
+}
+
+rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const char *const *names, int *offsets,
+                                      int *block_size, rt_error *error)
+{
+    (void)context;
+    char defines[1024];
+    variant_defines(0, 0, 0, defines, sizeof defines);
+    GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    for (int i = 0; i < count; i++) {
+        GLuint index = GL_INVALID_INDEX;
+        glGetUniformIndices(program, 1, &names[i], &index);
+        offsets[i] = -1;
+        if (index != GL_INVALID_INDEX)
+            glGetActiveUniformsiv(program, 1, &index, GL_UNIFORM_OFFSET, &offsets[i]);
+    }
+    *block_size = 0;
+    GLuint block = glGetUniformBlockIndex(program, "tracer_parameter_block");
+    if (block != GL_INVALID_INDEX)
+        glGetActiveUniformBlockiv(program, block, GL_UNIFORM_BLOCK_DATA_SIZE, block_size);
+    glDeleteProgram(program);
+    return check_gl("reading the parameter block's layout", error);
 }
