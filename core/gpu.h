@@ -1,4 +1,5 @@
-/* gpu.h: the only module that talks to EGL and OpenGL.
+/* gpu.h: the only module that talks to EGL and OpenGL: core/gpu.c (the context) and
+ * core/gpu_tracer.c (the tracer on it) implement it.
  *
  * Context set-up, in order (as piglit does it): check EGL client extensions; try the
  * EGL devices of EGL_EXT_platform_device (hardware devices first, so a real GPU wins;
@@ -144,7 +145,7 @@ typedef struct tracer_parameter_block {
 
 /* Per-render parameters of the tracer. */
 typedef struct gpu_tracer_parameters {
-    tracer_parameter_block shader;        /* what the shader reads. gpu.c sets work_cap (from
+    tracer_parameter_block shader;        /* what the shader reads. gpu_tracer.c sets work_cap (from
                                            * the device) and clamps pass_work_budget to what
                                            * the device allows; full_size 0 means image_size */
     uint32_t omitted_features;            /* GPU_OMIT_* and GPU_FIX_UNIFORMS bits: code this

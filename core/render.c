@@ -28,7 +28,7 @@ render_options render_options_defaults(void)
 }
 
 /* Fills the tracer's parameters from the scene, its camera frame and the options
- * (tracer_interface.h says what each is); gpu.c adds the device's work cap. */
+ * (tracer_interface.h says what each is); core/gpu_tracer.c adds the device's work cap. */
 static void tracer_parameters(const scene *s, const camera_frame *frame, const render_options *options,
                               const int region[4], gpu_tracer_parameters *parameters)
 {

@@ -9,12 +9,12 @@
  *
  * The parameter list is expanded twice: into the C struct tracer_parameter_block
  * (core/gpu.h) and into the GLSL uniform block of the same name (glsl/parameters.glsl),
- * a std140 block that core/gpu.c uploads with one glBufferData. Each entry is
+ * a std140 block that core/gpu_tracer.c uploads with one glBufferData. Each entry is
  * P(GLSL type, name); the types used are float, int, uint, ivec2, uvec2 and vec3 (core/gpu.h
  * maps each to a C type with its std140 alignment; tests/unit/test_tracer_parameters.c
  * checks the C offsets against the std140 rules and against what the GL reports).
  * Adding a parameter: one line here (any order: C and std140 agree on every layout these
- * types make), then set it in core/render.c tracer_parameters() or core/gpu.c and read it
+ * types make), then set it in core/render.c tracer_parameters() or core/gpu_tracer.c and read it
  * by name in the GLSL.
  */
 #ifndef RT_TRACER_INTERFACE_H
@@ -89,9 +89,9 @@
     P(int, integrator)               /* INTEGRATOR_* */ \
     P(int, light_sampling)           /* 0: BSDF sampling only (to compare the estimators) */ \
     P(vec3, ambient)                 /* Whitted: ambient light */ \
-    P(int, pass_work_budget)         /* work units a pixel may start in one pass (core/gpu.c */ \
+    P(int, pass_work_budget)         /* work units a pixel may start in one pass (core/gpu_tracer.c */ \
                                      /* clamps it to what the device allows) */ \
-    P(int, work_cap)                 /* no invocation does more (core/gpu.c, from the device) */ \
+    P(int, work_cap)                 /* no invocation does more (core/gpu_tracer.c, from the device) */ \
     P(int, aov_samples)              /* the AOV pass: jittered camera rays per pixel */
 
 #endif

@@ -1,6 +1,6 @@
 // main.glsl: one pass of the tracer: one invocation per pixel reads the pixel's state
 // from the previous pass, lets the integrator continue it, and writes it for the next
-// (core/gpu.c ping-pongs two sets of state textures, TRACER_STATE_* of
+// (core/gpu_tracer.c ping-pongs two sets of state textures, TRACER_STATE_* of
 // core/tracer_interface.h).
 
 layout(binding = TRACER_STATE_ORIGIN) uniform sampler2D state_origin;
@@ -19,7 +19,7 @@ layout(location = TRACER_STATE_COUNTERS) out uvec4 out_counters;       // sample
 layout(location = TRACER_STATE_ACCUMULATED) out vec4 out_accumulated;
 layout(location = TRACER_STATE_STATISTICS) out vec4 out_statistics;
 
-// Pixels with samples left, and samples finished in this pass (read by core/gpu.c).
+// Pixels with samples left, and samples finished in this pass (read by core/gpu_tracer.c).
 layout(binding = TRACER_COUNTER_BINDING, offset = 0) uniform atomic_uint unfinished_pixels;
 layout(binding = TRACER_COUNTER_BINDING, offset = 4) uniform atomic_uint samples_finished;
 

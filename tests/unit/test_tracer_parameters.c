@@ -1,6 +1,6 @@
 /* test_tracer_parameters.c: the C struct tracer_parameter_block (core/gpu.h) and the GLSL
  * uniform block of the same name (glsl/parameters.glsl) come from one list
- * (core/tracer_interface.h) and must agree byte for byte, since core/gpu.c uploads the
+ * (core/tracer_interface.h) and must agree byte for byte, since core/gpu_tracer.c uploads the
  * struct as it is. Checked twice: against the std140 layout rules (no device needed),
  * and against the offsets the GL reports for the compiled tracer. */
 #include <stdarg.h>
