@@ -43,6 +43,29 @@ static rt_status check_gl(const char *step, rt_error *error)
     return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s failed (%s, 0x%04x)", step, name, code);
 }
 
+/* True when a shader compiled (program false) or a program linked (program true);
+ * otherwise deletes it and sets error to "GPU: WHAT: " and its info log. */
+static bool gl_object_built(GLuint object, bool program, const char *what, rt_error *error)
+{
+    GLint ok = 0;
+    if (program)
+        glGetProgramiv(object, GL_LINK_STATUS, &ok);
+    else
+        glGetShaderiv(object, GL_COMPILE_STATUS, &ok);
+    if (ok)
+        return true;
+    char log[800];
+    if (program) {
+        glGetProgramInfoLog(object, sizeof log, NULL, log);
+        glDeleteProgram(object);
+    } else {
+        glGetShaderInfoLog(object, sizeof log, NULL, log);
+        glDeleteShader(object);
+    }
+    rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s: %s", what, log);
+    return false;
+}
+
 /* Compiles one shader stage from the given source parts. Returns the shader, or 0 with
  * the compiler's log in error. */
 static GLuint compile_stage(GLenum stage, const char *const *parts, int part_count, rt_error *error)
@@ -50,17 +73,9 @@ static GLuint compile_stage(GLenum stage, const char *const *parts, int part_cou
     GLuint shader = glCreateShader(stage);
     glShaderSource(shader, part_count, parts, NULL);
     glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[800];
-        glGetShaderInfoLog(shader, sizeof log, NULL, log);
-        rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the %s shader does not compile: %s",
-                     stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
-        glDeleteShader(shader);
-        return 0;
-    }
-    return shader;
+    const char *what = stage == GL_VERTEX_SHADER ? "the vertex shader does not compile"
+                                                 : "the fragment shader does not compile";
+    return gl_object_built(shader, false, what, error) ? shader : 0;
 }
 
 /* Links a vertex and a fragment shader into a program. Returns the program, or 0 with
@@ -73,16 +88,7 @@ static GLuint link_program(GLuint vertex, GLuint fragment, rt_error *error)
     glLinkProgram(program);
     glDeleteShader(vertex);
     glDeleteShader(fragment);
-    GLint ok = 0;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[800];
-        glGetProgramInfoLog(program, sizeof log, NULL, log);
-        glDeleteProgram(program);
-        rt_error_set(error, RT_ERROR_RUNTIME, "GPU: a shader program does not link: %s", log);
-        return 0;
-    }
-    return program;
+    return gl_object_built(program, true, "a shader program does not link", error) ? program : 0;
 }
 
 /* The most modules a fragment program may have (shader_sources.S's table). */

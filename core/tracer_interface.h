@@ -71,7 +71,7 @@
     P(float, shutter_open)           /* ray times are uniform in [open, close] */ \
     P(float, shutter_close) \
     P(uint, camera_media)            /* volumes the camera is in, as a path keeps them */ \
-                                     /* (glsl/media.glsl; core/pack.h packed_media_at) */ \
+                                     /* (glsl/media.glsl; the packer's packed_media_at) */ \
     P(int, sky_type)                 /* SKY_* */ \
     P(vec3, sky_bottom)              /* gradient: colour straight down; constant: the colour */ \
     P(vec3, sky_top)                 /* gradient: colour straight up */ \
