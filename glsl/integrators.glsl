@@ -13,7 +13,8 @@
 //                                 at a surface: where the path goes on (sampled is the
 //                                 material's own choice) and where direct light is gathered
 //   bool NAME_survives(inout PixelState s)
-//                                 after the path went on from a surface: whether it lives
+//                                 after the path went on (from a surface or through a
+//                                 volume boundary): whether it lives
 // One loop rather than one per integrator: the whole tracer (--full-tracer) has every
 // integrator, and llvmpipe runs all of a shader's code, so one traversal and one
 // direct-light call serve them all (docs/performance.md). Variants compile the integrator

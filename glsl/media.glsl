@@ -3,7 +3,7 @@
 // much light gets through them to a light.
 //
 // A path's media are two 16-bit volume instance numbers + 1 in one uint, the inner one
-// low (0: none); core/pack.c packed_media_at computes the camera's the same way.
+// low (0: none); the packer's packed_media_at computes the camera's the same way.
 
 // The inner medium (a volume instance number + 1), 0 when the path is in none.
 uint media_inner(uint media) { return media & 0xffffu; }

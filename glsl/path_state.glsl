@@ -106,8 +106,9 @@ void cross_volume_boundary(inout PixelState s, Surface surface, bool front_face,
 // light sampling could have found it too. The caller ends the path.
 void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material)
 {
-    // since_vertex is 0 here (surface hits reset it), so the vertex is the segment's
-    // origin even after volume boundaries; kept as it was, since changing it changes images.
+    // MIS wants the path's last scattering vertex, origin - since_vertex * direction. But
+    // since_vertex is 0 here (a surface hit resets it first), so after volume boundaries
+    // this is the last boundary instead. Kept as it was: fixing it changes images.
     vec3 vertex = s.origin - s.since_vertex * s.direction;
     float weight = emitter_mis_weight(hit, s.previous_pdf, vertex, surface.position, surface.geometric);
     s.radiance += s.throughput * material_emitted(material, surface.position, surface.uv) * weight;

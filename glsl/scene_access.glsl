@@ -48,7 +48,7 @@ void read_header()
     uv_offset = header5.z;
 }
 
-// A vertex normal from its octahedral encoding (core/pack.c packed_encode_normal).
+// A vertex normal from its octahedral encoding (core/pack.h packed_encode_normal).
 vec3 decode_normal(uint bits)
 {
     vec2 f = unpackSnorm2x16(bits);
