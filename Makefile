@@ -66,7 +66,7 @@ CORE_CXX := $(wildcard core/*.cpp)
 CORE_ASM := $(wildcard core/*.S)
 CLI_C := $(wildcard cli/*.c)
 UNIT_TESTS_C := $(wildcard tests/unit/test_*.c)
-SHADERS := $(wildcard glsl/*) core/packed_layout.h
+SHADERS := $(wildcard glsl/*) core/packed_layout.h core/tracer_interface.h core/shader_sources.h
 
 CORE_OBJ := $(CORE_C:%.c=$(BUILD)/%.o) $(CORE_CXX:%.cpp=$(BUILD)/%.o) $(CORE_ASM:%.S=$(BUILD)/%.o)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/%.o)

@@ -1,4 +1,5 @@
-/* gpu.h: the only module that talks to EGL and OpenGL.
+/* gpu.h: the only module that talks to EGL and OpenGL: core/gpu.c (the context) and
+ * core/gpu_tracer.c (the tracer on it) implement it.
  *
  * Context set-up, in order (as piglit does it): check EGL client extensions; try the
  * EGL devices of EGL_EXT_platform_device (hardware devices first, so a real GPU wins;
@@ -10,8 +11,8 @@
  * all (the message says what to install), RT_ERROR_RUNTIME when one is there but the
  * driver fails (the message names the EGL/GL call and its error).
  *
- * The tracer part runs the GLSL path tracer (glsl/tracer.frag) over ping-pong state
- * textures, one bounded pass at a time (see render.h for why).
+ * The tracer part runs the GLSL tracer (glsl/, joined as core/shader_sources.S lists it)
+ * over ping-pong state textures, one bounded pass at a time (see render.h for why).
  *
  * Defaults of gpu_options (all zero): automatic device choice, no GL debug output.
  */
@@ -22,6 +23,7 @@
 #include <stdint.h>
 
 #include "status.h"
+#include "tracer_interface.h"
 
 typedef struct gpu_options {
     int device;                  /* 0: automatic; N >= 1: use EGL device N-1 (see `info`) */
@@ -60,7 +62,7 @@ typedef struct gpu_info {
     int max_color_attachments;
     int max_fragment_atomic_counters;
     bool software;               /* a CPU rasteriser (llvmpipe, softpipe) */
-    /* The work bound (glsl/tracer.frag, "the work bound"). On llvmpipe, which ends all
+    /* The work bound (glsl/work.glsl). On llvmpipe, which ends all
      * loops of an invocation after 65,535 iterations together and runs simd_lanes pixels
      * as one invocation: work_cap = 65535 / (simd_lanes + 1) - 1024 (1024: what a pixel
      * may still run after reaching the cap), and passes of at most work_cap / 2. On
@@ -91,8 +93,8 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 /* Parts of the tracer a scene may not need (omitted_features below). Leaving them out of
  * the shader changes no image: a scene without lights never samples one. It makes the
  * shader smaller, and llvmpipe runs both sides of every branch (only loops really jump),
- * so every piece of code in the tracer's loops costs on every iteration, run or not: the
- * weekend scene traced about 1.5x faster with only what it uses (docs/performance.md).
+ * so every piece of code in the tracer's loops costs on every iteration, run or not
+ * (docs/performance.md has what leaving it out gained).
  * Each combination is compiled once per context, on first use.
  *   GPU_OMIT_DIRECT_LIGHT    no light sampling: path tracing of a scene with no lights,
  *                            or with light sampling off (never for Whitted: ambient)
@@ -105,7 +107,9 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_EMITTERS        no emissive material
  *   GPU_OMIT_QUADS           no quad
  *   GPU_FIX_UNIFORMS         the integrator and the sky type compiled in as constants
- *                            (the values in the parameters), not read from uniforms */
+ *                            (the values in the parameters), not read from the
+ *                            parameter block
+ * glsl/variant.glsl turns them into the constants HAS_* the tracer tests. */
 #define GPU_OMIT_DIRECT_LIGHT (1u << 0)
 #define GPU_OMIT_VOLUMES (1u << 1)
 #define GPU_OMIT_TEXTURES (1u << 2)
@@ -118,34 +122,32 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_FIX_UNIFORMS (1u << 9)
 #define GPU_VARIANT_BITS 10
 
-/* Per-render parameters of the tracer shader. Vectors are world space. */
+/* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
+ * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct
+ * out as std140 lays out the GLSL block (tests/unit/test_tracer_parameters.c checks it).
+ * Uploaded as it is (one glBufferData); see tracer_interface.h for what each member is. */
+typedef float gpu_glsl_float;
+typedef int32_t gpu_glsl_int;
+typedef uint32_t gpu_glsl_uint;
+typedef int32_t gpu_glsl_ivec2[2];
+typedef uint32_t gpu_glsl_uvec2[2];
+typedef float gpu_glsl_vec3[3];
+#define GPU_STD140_ALIGN_float 4
+#define GPU_STD140_ALIGN_int 4
+#define GPU_STD140_ALIGN_uint 4
+#define GPU_STD140_ALIGN_ivec2 8
+#define GPU_STD140_ALIGN_uvec2 8
+#define GPU_STD140_ALIGN_vec3 16
+#define GPU_TRACER_PARAMETER_MEMBER(type, name) _Alignas(GPU_STD140_ALIGN_##type) gpu_glsl_##type name;
+typedef struct tracer_parameter_block {
+    TRACER_PARAMETERS(GPU_TRACER_PARAMETER_MEMBER)
+} tracer_parameter_block;
+
+/* Per-render parameters of the tracer. */
 typedef struct gpu_tracer_parameters {
-    int width, height;                    /* the region rendered; passes cover all of it */
-    int region_x, region_y;               /* its top-left pixel in the full image (row 0 at top) */
-    int full_width, full_height;          /* the full image (0: the same as width, height) */
-    float camera_origin[3];
-    float camera_lower_left[3];           /* point on the focus plane at the image's bottom left */
-    float camera_horizontal[3];           /* focus-plane vector across the image width */
-    float camera_vertical[3];             /* focus-plane vector up the image height */
-    float camera_u[3], camera_v[3];       /* lens axes (right, up), unit length */
-    float lens_radius;
-    float shutter_open, shutter_close;    /* ray times are uniform in [open, close] */
-    uint32_t camera_media;                /* volumes the camera is in (packed_traverse.h) */
-    int sky_type;                         /* SKY_* of scene.h */
-    float sky_bottom[3], sky_top[3];
-    float sky_intensity;
-    float sky_rotation_radians;           /* about +Y */
-    uint32_t sky_faces[6];                /* image indices of the sky box faces */
-    uint32_t sky_environment;             /* image index of the environment map */
-    uint32_t seed;
-    uint32_t sample_start;                /* first sample index (sample ranges) */
-    uint32_t samples_per_pixel;
-    uint32_t max_depth;
-    uint32_t russian_roulette_depth;      /* first bounce at which paths may end at random */
-    uint32_t pass_work_budget;            /* work units a pixel may start in one pass */
-    bool light_sampling;                  /* next-event estimation with MIS at diffuse hits */
-    int integrator;                       /* 0: path tracing; 1: Whitted with Phong shading */
-    float ambient[3];                     /* Whitted's ambient light */
+    tracer_parameter_block shader;        /* what the shader reads. gpu_tracer.c sets work_cap (from
+                                           * the device) and clamps pass_work_budget to what
+                                           * the device allows; full_size 0 means image_size */
     uint32_t omitted_features;            /* GPU_OMIT_* and GPU_FIX_UNIFORMS bits: code this
                                            * scene cannot reach, left out of the compiled
                                            * tracer (0: none, the whole tracer) */
@@ -220,5 +222,12 @@ void gpu_tracer_destroy(gpu_tracer *tracer);
  * generator where it runs. */
 rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32_t sample_index, uint32_t seed,
                              uint32_t dimension, float *rgba, rt_error *error);
+
+/* Compiles the whole tracer (no part left out) and reads where the GL placed the members
+ * of its parameter block: offsets[i] receives the byte offset of the member called
+ * names[i] (-1 when the program has none of that name), *block_size the block's size
+ * (GL_UNIFORM_BLOCK_DATA_SIZE). For checking tracer_parameter_block against the GLSL. */
+rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const char *const *names, int *offsets,
+                                      int *block_size, rt_error *error);
 
 #endif

@@ -182,7 +182,8 @@
 /* Deepest BVH per level (the builder never exceeds it; deeper nodes become leaves). The
  * shader's stack holds a top-level path, one leaf's instances and a bottom-level path:
  * 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE entries, so it can never overflow. Small on
- * purpose: llvmpipe keeps the stack in memory and a larger one costs ~20% speed. */
+ * purpose: llvmpipe keeps the stack in memory, and a larger one was slower
+ * (docs/performance.md). */
 #define BVH_MAX_DEPTH 24
 #define BVH_MAX_LEAF_SIZE 4
 

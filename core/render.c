@@ -28,17 +28,19 @@ render_options render_options_defaults(void)
     return (render_options){0};
 }
 
-/* Fills the tracer's parameters from the scene, its camera frame and the options. */
+/* Fills the tracer's parameters from the scene, its camera frame and the options
+ * (tracer_interface.h says what each is); core/gpu_tracer.c adds the device's work cap. */
 static void tracer_parameters(const scene *s, const camera_frame *frame, const render_options *options,
-                              const int region[4], gpu_tracer_parameters *p)
+                              const int region[4], gpu_tracer_parameters *parameters)
 {
-    memset(p, 0, sizeof *p);
-    p->region_x = region[0];
-    p->region_y = region[1];
-    p->width = region[2] - region[0];
-    p->height = region[3] - region[1];
-    p->full_width = s->render.width;
-    p->full_height = s->render.height;
+    memset(parameters, 0, sizeof *parameters);
+    tracer_parameter_block *p = &parameters->shader;
+    p->region_origin[0] = region[0];
+    p->region_origin[1] = region[1];
+    p->image_size[0] = region[2] - region[0];
+    p->image_size[1] = region[3] - region[1];
+    p->full_size[0] = s->render.width;
+    p->full_size[1] = s->render.height;
     memcpy(p->camera_origin, frame->origin, sizeof p->camera_origin);
     memcpy(p->camera_lower_left, frame->lower_left, sizeof p->camera_lower_left);
     memcpy(p->camera_horizontal, frame->horizontal, sizeof p->camera_horizontal);
@@ -48,24 +50,26 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     p->lens_radius = frame->lens_radius;
     p->shutter_open = s->camera.shutter_open;
     p->shutter_close = s->camera.shutter_close;
-    p->sky_intensity = s->sky.intensity;
-    p->sky_rotation_radians = s->sky.rotation_degrees * 3.14159265358979f / 180.0f;
-    for (int face = 0; face < 6; face++)
-        p->sky_faces[face] = s->sky.faces[face] >= 0 ? (uint32_t)s->sky.faces[face] : 0;
-    p->sky_environment = s->sky.environment >= 0 ? (uint32_t)s->sky.environment : 0;
     p->sky_type = s->sky.type;
     memcpy(p->sky_bottom, s->sky.bottom, sizeof p->sky_bottom);
     memcpy(p->sky_top, s->sky.top, sizeof p->sky_top);
+    p->sky_intensity = s->sky.intensity;
+    p->sky_rotation = s->sky.rotation_degrees * 3.14159265358979f / 180.0f;
+    uint32_t *faces[SKY_FACE_COUNT] = {&p->sky_faces_x[0], &p->sky_faces_x[1], &p->sky_faces_y[0],
+                                       &p->sky_faces_y[1], &p->sky_faces_z[0], &p->sky_faces_z[1]};
+    for (int face = 0; face < SKY_FACE_COUNT; face++)
+        *faces[face] = s->sky.faces[face] >= 0 ? (uint32_t)s->sky.faces[face] : 0;
+    p->sky_environment = s->sky.environment >= 0 ? (uint32_t)s->sky.environment : 0;
     p->seed = s->render.seed;
     p->sample_start = options->sample_start;
     p->samples_per_pixel = (uint32_t)s->render.samples_per_pixel;
     p->max_depth = (uint32_t)s->render.max_depth;
     p->russian_roulette_depth = options->russian_roulette_depth ? options->russian_roulette_depth
                                                                 : DEFAULT_RUSSIAN_ROULETTE_DEPTH;
-    p->pass_work_budget = options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET;
-    p->light_sampling = !options->no_light_sampling;
     p->integrator = options->integrator;
+    p->light_sampling = !options->no_light_sampling;
     memcpy(p->ambient, s->ambient, sizeof p->ambient);
+    p->pass_work_budget = (int32_t)(options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET);
 }
 
 /* Returns the GPU_OMIT_* bits of the tracer code this render cannot reach (gpu.h), and
@@ -277,8 +281,8 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
 
     gpu_tracer_parameters parameters;
     tracer_parameters(s, &frame, options, region, &parameters);
-    parameters.camera_media = packed_media_at(&packed, s->camera.look_from);
-    parameters.omitted_features = omitted_features(&packed, options, parameters.camera_media);
+    parameters.shader.camera_media = packed_media_at(&packed, s->camera.look_from);
+    parameters.omitted_features = omitted_features(&packed, options, parameters.shader.camera_media);
     uint64_t samples_resumed = 0;
     float *sums = NULL;
     if (options->resume != NULL) {
@@ -312,7 +316,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
                             : device.software                ? SOFTWARE_TARGET_PASS_SECONDS
                                                              : DEFAULT_TARGET_PASS_SECONDS;
-    double budget = parameters.pass_work_budget;
+    double budget = parameters.shader.pass_work_budget;
     double most_budget = device.max_pass_work_budget < MAXIMUM_ADAPTIVE_BUDGET ? device.max_pass_work_budget
                                                                                : MAXIMUM_ADAPTIVE_BUDGET;
     for (;;) {

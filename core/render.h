@@ -1,6 +1,6 @@
 /* render.h: renders a scene: camera frame, packing, GPU tracer passes, result image.
  *
- * A render is a sequence of bounded passes (see gpu.h and glsl/tracer.frag for why:
+ * A render is a sequence of bounded passes (see gpu.h and glsl/work.glsl for why:
  * llvmpipe's 65,535-iteration loop cap and GPU watchdogs). Passes repeat until every
  * pixel has run all its samples, or until *stop_requested becomes non-zero (checked
  * between passes), in which case the samples finished so far are returned with their
@@ -38,10 +38,9 @@
 #include "scene.h"
 #include "status.h"
 
-typedef enum render_integrator {
-    INTEGRATOR_PATH = 0,         /* unbiased path tracing with light sampling (default) */
-    INTEGRATOR_WHITTED = 1,      /* Whitted recursive ray tracing with Phong shading */
-} render_integrator;
+/* The integrator: INTEGRATOR_PATH (0, the default) or INTEGRATOR_WHITTED, the ids of
+ * core/tracer_interface.h. */
+typedef int render_integrator;
 
 typedef struct render_progress {
     uint64_t samples_done;

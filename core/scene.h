@@ -22,6 +22,7 @@
 #include <stdint.h>
 
 #include "packed_layout.h"
+#include "tracer_interface.h"
 
 #define SCENE_NAME_MAX 64
 
@@ -43,19 +44,12 @@ typedef struct scene_render_settings {
     uint32_t seed;
 } scene_render_settings;
 
-typedef enum scene_sky_type {
-    SKY_GRADIENT = 0,            /* lerp(bottom, top, 0.5 * (direction.y + 1)) */
-    SKY_CONSTANT = 1,            /* bottom colour everywhere */
-    SKY_BOX = 2,                 /* a cube map from six images (faces) */
-    SKY_ENVIRONMENT = 3,         /* an equirectangular (latitude-longitude) image */
-} scene_sky_type;
-
 /* Cube-map face order, as the seed report's sky box and OpenGL use it. */
 enum { SKY_FACE_POSITIVE_X, SKY_FACE_NEGATIVE_X, SKY_FACE_POSITIVE_Y, SKY_FACE_NEGATIVE_Y, SKY_FACE_POSITIVE_Z,
        SKY_FACE_NEGATIVE_Z, SKY_FACE_COUNT };
 
 typedef struct scene_sky {
-    scene_sky_type type;
+    int type;                    /* SKY_* of tracer_interface.h: gradient, constant, box, environment */
     float bottom[3];             /* gradient: colour at direction.y = -1; constant: the colour */
     float top[3];                /* gradient: colour at direction.y = +1 */
     int faces[SKY_FACE_COUNT];   /* box: indices into scene.images, +X -X +Y -Y +Z -Z */

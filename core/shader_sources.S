@@ -1,31 +1,67 @@
-/* shader_sources.S: embeds the GLSL sources (and the shared record layout) into the
+/* shader_sources.S: embeds the GLSL sources (and the headers shared with C) into the
  * binary with the assembler's .incbin, so rtspheres runs from any directory. Paths are
- * relative to the top of the source tree (the Makefile assembles with -Wa,-I.).
- * Each source is NUL-terminated. Declared in shader_sources.h. */
-    .section .rodata
-    .global shader_source_packed_layout
-shader_source_packed_layout:
-    .incbin "core/packed_layout.h"
-    .byte 0
+ * relative to the top of the source tree (the Makefile assembles with -Wa,-I.). Each
+ * source is NUL-terminated. Declared in shader_sources.h, which says how programs are
+ * assembled from the table below.
+ *
+ * THE MODULE TABLE is the one list of the fragment programs' sources, in the order they
+ * are joined: a file may use what the files above it define. A new GLSL file is one line
+ * here (a material among the materials, an integrator before glsl/integrators.glsl), its
+ * programs being SHADER_PROGRAM_* bits of shader_sources.h. */
+#include "shader_sources.h"
 
+    /* module PATH, PROGRAMS: the file's text (NUL-terminated) and its path in .rodata, and
+     * a table entry (path, source, programs) in .data.rel.ro */
+    .macro module path, programs
+    .section .rodata
+1:  .incbin "\path"
+    .byte 0
+2:  .asciz "\path"
+    .section .data.rel.ro
+    .dc.a 2b, 1b, \programs
+    .endm
+
+    .section .data.rel.ro
+    .balign 16
+    .global shader_modules
+shader_modules:
+    module "core/tracer_interface.h", SHADER_PROGRAM_TRACER         /* ids, the parameter list */
+    module "core/packed_layout.h", SHADER_PROGRAM_TRACER            /* the packed scene's records */
+    module "glsl/random.glsl", SHADER_PROGRAM_TRACER|SHADER_PROGRAM_RANDOM_TEST
+    module "glsl/random_test.frag", SHADER_PROGRAM_RANDOM_TEST
+    module "glsl/parameters.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/variant.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/work.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/sampling.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/camera.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/scene_access.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/intersect.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/traverse.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/textures.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/sky.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/surface.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/media.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/material.glsl", SHADER_PROGRAM_TRACER              /* the material interface */
+    module "glsl/material_lambertian.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/material_metal.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/material_dielectric.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/material_emissive.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/material_phong.glsl", SHADER_PROGRAM_TRACER        /* Whitted's shading model */
+    module "glsl/material_table.glsl", SHADER_PROGRAM_TRACER        /* the table of materials */
+    module "glsl/lights.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/direct_light.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/path_state.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/integrator_path.glsl", SHADER_PROGRAM_PASS
+    module "glsl/integrator_whitted.glsl", SHADER_PROGRAM_PASS
+    module "glsl/integrators.glsl", SHADER_PROGRAM_PASS             /* the table of integrators */
+    module "glsl/main.glsl", SHADER_PROGRAM_PASS
+    module "glsl/aov.glsl", SHADER_PROGRAM_AOV
+    .dc.a 0, 0, 0
+
+    .section .rodata
     .global shader_source_fullscreen_vertex
 shader_source_fullscreen_vertex:
     .incbin "glsl/fullscreen.vert"
-    .byte 0
-
-    .global shader_source_random
-shader_source_random:
-    .incbin "glsl/random.glsl"
-    .byte 0
-
-    .global shader_source_random_test_fragment
-shader_source_random_test_fragment:
-    .incbin "glsl/random_test.frag"
-    .byte 0
-
-    .global shader_source_tracer_fragment
-shader_source_tracer_fragment:
-    .incbin "glsl/tracer.frag"
     .byte 0
 
     .section .note.GNU-stack,"",@progbits

@@ -1,11 +1,33 @@
 /* shader_sources.h: the GLSL sources embedded by shader_sources.S (NUL-terminated).
- * The tracer is compiled as "#version 450 core" + packed_layout.h + random.glsl +
- * tracer.frag; the RNG test shader as "#version 450 core" + random.glsl + random_test.frag. */
+ *
+ * The fragment programs are made of modules: core/gpu_tracer.c (compile_fragment_program) joins
+ * "#version 450 core", the program's defines and, in the order of the module table of
+ * shader_sources.S, every module whose programs include that program. The vertex shader
+ * (one triangle over the viewport) is shared by all programs.
+ *
+ * This header is also read by the assembler (for the SHADER_PROGRAM_* bits), so
+ * everything but the #defines is hidden from it. */
 #ifndef RT_SHADER_SOURCES_H
 #define RT_SHADER_SOURCES_H
-extern const char shader_source_packed_layout[];
+
+/* The fragment programs a module belongs to (shader_module.programs). */
+#define SHADER_PROGRAM_PASS 1           /* a tracer pass (glsl/main.glsl) */
+#define SHADER_PROGRAM_AOV 2            /* the AOV pass (glsl/aov.glsl) */
+#define SHADER_PROGRAM_RANDOM_TEST 4    /* the random-number test (glsl/random_test.frag) */
+#define SHADER_PROGRAM_TRACER (SHADER_PROGRAM_PASS|SHADER_PROGRAM_AOV)   /* no spaces: an assembler macro argument */
+
+#ifndef __ASSEMBLER__
+#include <stdint.h>
+
+typedef struct shader_module {
+    const char *path;            /* e.g. "glsl/traverse.glsl", for messages */
+    const char *source;
+    uintptr_t programs;          /* SHADER_PROGRAM_* bits */
+} shader_module;
+
+/* The module table, ended by an entry whose path is NULL. */
+extern const shader_module shader_modules[];
 extern const char shader_source_fullscreen_vertex[];
-extern const char shader_source_random[];
-extern const char shader_source_random_test_fragment[];
-extern const char shader_source_tracer_fragment[];
+#endif
+
 #endif

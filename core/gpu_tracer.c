@@ -1,0 +1,684 @@
+/* gpu_tracer.c: the GLSL tracer on a gpu_context (gpu.h, "the tracer"): its programs,
+ * joined from the module table of core/shader_sources.S, the parameter block, the state
+ * textures and the passes. */
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gpu_internal.h"
+#include "shader_sources.h"
+
+struct gpu_tracer {
+    gpu_context *context;
+    int width, height;
+    GLuint program;
+    GLuint vertex_array;
+    GLuint packed_texture;
+    GLuint packed_buffer;
+    GLuint state_textures[2][TRACER_STATE_COUNT];
+    GLuint framebuffers[2];
+    GLuint counter_buffer;
+    GLuint parameter_buffer;     /* the parameter block (tracer_parameter_block) */
+    int current;                 /* which state set holds the latest pass */
+    gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
+    bool reused_scene;           /* the packed scene was already on the device */
+};
+
+/* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
+static rt_status check_gl(const char *step, rt_error *error)
+{
+    GLenum code = glGetError();
+    if (code == GL_NO_ERROR)
+        return RT_OK;
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    const char *name = code == GL_OUT_OF_MEMORY ? "GL_OUT_OF_MEMORY"
+                       : code == GL_INVALID_VALUE ? "GL_INVALID_VALUE"
+                       : code == GL_INVALID_OPERATION ? "GL_INVALID_OPERATION"
+                       : code == GL_INVALID_ENUM ? "GL_INVALID_ENUM"
+                       : code == GL_INVALID_FRAMEBUFFER_OPERATION ? "GL_INVALID_FRAMEBUFFER_OPERATION"
+                                                                   : "GL error";
+    return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s failed (%s, 0x%04x)", step, name, code);
+}
+
+/* True when a shader compiled (program false) or a program linked (program true);
+ * otherwise deletes it and sets error to "GPU: WHAT: " and its info log. */
+static bool gl_object_built(GLuint object, bool program, const char *what, rt_error *error)
+{
+    GLint ok = 0;
+    if (program)
+        glGetProgramiv(object, GL_LINK_STATUS, &ok);
+    else
+        glGetShaderiv(object, GL_COMPILE_STATUS, &ok);
+    if (ok)
+        return true;
+    char log[800];
+    if (program) {
+        glGetProgramInfoLog(object, sizeof log, NULL, log);
+        glDeleteProgram(object);
+    } else {
+        glGetShaderInfoLog(object, sizeof log, NULL, log);
+        glDeleteShader(object);
+    }
+    rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s: %s", what, log);
+    return false;
+}
+
+/* Compiles one shader stage from the given source parts. Returns the shader, or 0 with
+ * the compiler's log in error. */
+static GLuint compile_stage(GLenum stage, const char *const *parts, int part_count, rt_error *error)
+{
+    GLuint shader = glCreateShader(stage);
+    glShaderSource(shader, part_count, parts, NULL);
+    glCompileShader(shader);
+    const char *what = stage == GL_VERTEX_SHADER ? "the vertex shader does not compile"
+                                                 : "the fragment shader does not compile";
+    return gl_object_built(shader, false, what, error) ? shader : 0;
+}
+
+/* Links a vertex and a fragment shader into a program. Returns the program, or 0 with
+ * the linker's log in error. The shaders are deleted either way. */
+static GLuint link_program(GLuint vertex, GLuint fragment, rt_error *error)
+{
+    GLuint program = glCreateProgram();
+    glAttachShader(program, vertex);
+    glAttachShader(program, fragment);
+    glLinkProgram(program);
+    glDeleteShader(vertex);
+    glDeleteShader(fragment);
+    return gl_object_built(program, true, "a shader program does not link", error) ? program : 0;
+}
+
+/* The most modules a fragment program may have (shader_sources.S's table). */
+#define GPU_MAX_SHADER_MODULES 48
+/* Module i's lines are numbered from (i + 1) * GPU_MODULE_LINES + 1 (a #line before it), so
+ * that a compiler message's line says which module it is in: Mesa's messages do not
+ * carry the source string number of #line. No module is that long. */
+#define GPU_MODULE_LINES 10000
+
+/* Rewrites the compiler log in error (after "compile: ") so that each message's
+ * "SOURCE:LINE(" names the module and its own line ("glsl/sky.glsl:8("). */
+static void name_modules_in_log(rt_error *error)
+{
+    char *log = strstr(error->message, "compile: ");
+    if (log == NULL)
+        return;
+    log += strlen("compile: ");
+    char named[sizeof error->message];
+    size_t used = 0;
+    for (const char *line = log; *line != '\0' && used + 1 < sizeof named;) {
+        const char *end = strchr(line, '\n');
+        size_t length = end ? (size_t)(end - line) + 1 : strlen(line);
+        int source = 0, number = 0, consumed = 0;
+        int module = -1;
+        if (sscanf(line, "%d:%d(%n", &source, &number, &consumed) == 2 && consumed > 0)
+            module = source > 0 ? source - 1 : number / GPU_MODULE_LINES - 1;
+        for (int i = 0; module >= 0 && shader_modules[i].path != NULL; i++)
+            if (i == module) {
+                used += (size_t)snprintf(named + used, sizeof named - used, "%s:%d(%.*s", shader_modules[i].path,
+                                         number % GPU_MODULE_LINES, (int)(length - (size_t)consumed),
+                                         line + consumed);
+                module = -2;
+            }
+        if (module != -2)
+            used += (size_t)snprintf(named + used, sizeof named - used, "%.*s", (int)length, line);
+        line += length;
+    }
+    snprintf(log, sizeof error->message - (size_t)(log - error->message), "%s", named);
+}
+
+/* Compiles a fragment shader: "#version 450 core" + defines + every module of the table of
+ * core/shader_sources.S whose programs include program (a SHADER_PROGRAM_* bit), in the
+ * table's order, each after a #line that numbers it by its place in the table. Returns
+ * the shader or 0 with error set, its messages naming the modules. */
+static GLuint compile_fragment_program(uintptr_t program, const char *defines, rt_error *error)
+{
+    const char *parts[2 + 2 * GPU_MAX_SHADER_MODULES];
+    char line_directives[GPU_MAX_SHADER_MODULES][32];
+    int count = 0;
+    parts[count++] = "#version 450 core\n";
+    parts[count++] = defines;
+    for (int i = 0; shader_modules[i].path != NULL; i++) {
+        if (i == GPU_MAX_SHADER_MODULES) {
+            rt_error_set(error, RT_ERROR_RUNTIME, "GPU: core/shader_sources.S lists more than %d shader modules "
+                         "(GPU_MAX_SHADER_MODULES in core/gpu_tracer.c)", GPU_MAX_SHADER_MODULES);
+            return 0;
+        }
+        if ((shader_modules[i].programs & program) == 0)
+            continue;
+        snprintf(line_directives[i], sizeof line_directives[i], "#line %d %d\n", (i + 1) * GPU_MODULE_LINES + 1,
+                 i + 1);
+        parts[count++] = line_directives[i];
+        parts[count++] = shader_modules[i].source;
+    }
+    GLuint shader = compile_stage(GL_FRAGMENT_SHADER, parts, count, error);
+    if (shader == 0)
+        name_modules_in_log(error);
+    return shader;
+}
+
+/* Builds a program of the shared vertex shader and the fragment program (SHADER_PROGRAM_*)
+ * with defines. Returns the program or 0 with error set. */
+static GLuint build_fragment_program(uintptr_t program, const char *defines, rt_error *error)
+{
+    const char *vertex_parts[] = {"#version 450 core\n", shader_source_fullscreen_vertex};
+    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
+    if (vertex == 0)
+        return 0;
+    GLuint fragment = compile_fragment_program(program, defines, error);
+    if (fragment == 0) {
+        glDeleteShader(vertex);
+        return 0;
+    }
+    return link_program(vertex, fragment, error);
+}
+
+/* Writes the #defines of a tracer variant into defines (size bytes): every
+ * RTSPHERES_OMIT_* as 1 when its GPU_OMIT_* bit is in omitted, else 0 (glsl/variant.glsl
+ * reads them), and RTSPHERES_FIX_UNIFORMS with the integrator and sky type it compiles in
+ * (0 when not fixed, so the source does not vary with the parameters). */
+static void variant_defines(uint32_t omitted, int integrator, int sky_type, char *defines, size_t size)
+{
+    static const struct {
+        uint32_t bit;
+        const char *name;
+    } features[] = {
+        {GPU_OMIT_DIRECT_LIGHT, "RTSPHERES_OMIT_DIRECT_LIGHT"},
+        {GPU_OMIT_VOLUMES, "RTSPHERES_OMIT_VOLUMES"},
+        {GPU_OMIT_TEXTURES, "RTSPHERES_OMIT_TEXTURES"},
+        {GPU_OMIT_SPHERES, "RTSPHERES_OMIT_SPHERES"},
+        {GPU_OMIT_MOVING_SPHERES, "RTSPHERES_OMIT_MOVING_SPHERES"},
+        {GPU_OMIT_TRIANGLES, "RTSPHERES_OMIT_TRIANGLES"},
+        {GPU_OMIT_INSTANCES, "RTSPHERES_OMIT_INSTANCES"},
+        {GPU_OMIT_EMITTERS, "RTSPHERES_OMIT_EMITTERS"},
+        {GPU_OMIT_QUADS, "RTSPHERES_OMIT_QUADS"},
+        {GPU_FIX_UNIFORMS, "RTSPHERES_FIX_UNIFORMS"},
+    };
+    bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
+    size_t used = 0;
+    defines[0] = '\0';
+    for (size_t i = 0; i < sizeof features / sizeof features[0] && used < size; i++)
+        used += (size_t)snprintf(defines + used, size - used, "#define %s %d\n", features[i].name,
+                                 (omitted & features[i].bit) != 0);
+    if (used < size)
+        snprintf(defines + used, size - used, "#define RTSPHERES_INTEGRATOR %d\n#define RTSPHERES_SKY_TYPE %d\n",
+                 fixed ? integrator : 0, fixed ? sky_type : 0);
+}
+
+/* The key of a variant in the context's program cache: the bits, and the constants
+ * compiled in with GPU_FIX_UNIFORMS. */
+static uint32_t variant_key(uint32_t omitted, int integrator, int sky_type)
+{
+    omitted &= (1u << GPU_VARIANT_BITS) - 1u;
+    if (omitted & GPU_FIX_UNIFORMS)
+        return omitted | (uint32_t)(integrator & 3) << 16 | (uint32_t)(sky_type & 15) << 20;
+    return omitted;
+}
+
+/* The context's tracer program for the variant of the parameters (omitted_features,
+ * integrator, sky type), compiled on first use and kept (the oldest goes when the cache
+ * is full; a render holding it still has it, since only the next render asks again). */
+static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *parameters, rt_error *error)
+{
+    gpu_context *context = tracer->context;
+    uint32_t omitted = parameters->omitted_features;
+    int integrator = parameters->shader.integrator, sky_type = parameters->shader.sky_type;
+    uint32_t key = variant_key(omitted, integrator, sky_type);
+    for (int i = 0; i < context->tracer_program_count; i++)
+        if (context->tracer_programs[i].key == key) {
+            tracer->program = context->tracer_programs[i].program;
+            return RT_OK;
+        }
+    char defines[1024];
+    variant_defines(omitted, integrator, sky_type, defines, sizeof defines);
+    GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    int slot = context->tracer_program_count;
+    if (slot == GPU_PROGRAM_CACHE_SIZE) {
+        slot = context->next_eviction;
+        context->next_eviction = (context->next_eviction + 1) % GPU_PROGRAM_CACHE_SIZE;
+        glDeleteProgram(context->tracer_programs[slot].program);
+    } else {
+        context->tracer_program_count++;
+    }
+    context->tracer_programs[slot].key = key;
+    context->tracer_programs[slot].program = program;
+    tracer->program = program;
+    return RT_OK;
+}
+
+/* Uploads the packed scene into a buffer object read through an RGBA32UI buffer texture
+ * (usamplerBuffer), checked against GL_MAX_TEXTURE_BUFFER_SIZE. A buffer texture rather
+ * than a 2D one because a fetch from it is a bounds check and a load: on llvmpipe a 2D
+ * texelFetch also looks up each lane's mip level and row pitch (docs/performance.md
+ * has what that cost). */
+static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels, uint32_t texel_count,
+                                     rt_error *error)
+{
+    int64_t max_texels = tracer->context->info.max_texture_buffer_size;
+    if ((int64_t)texel_count > max_texels)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "GPU: the packed scene needs %u texels of 16 bytes, more than this device's "
+                            "buffer textures hold (GL_MAX_TEXTURE_BUFFER_SIZE %lld): %lld texels too many",
+                            texel_count, (long long)max_texels, (long long)texel_count - (long long)max_texels);
+    /* A zero-sized buffer is not a valid texture store: keep at least one texel. */
+    static const uint32_t empty[4] = {0, 0, 0, 0};
+    glGenBuffers(1, &tracer->packed_buffer);
+    glBindBuffer(GL_TEXTURE_BUFFER, tracer->packed_buffer);
+    glBufferData(GL_TEXTURE_BUFFER, (GLsizeiptr)(texel_count ? texel_count : 1) * 4 * (GLsizeiptr)sizeof(uint32_t),
+                 texel_count ? (const void *)texels : (const void *)empty, GL_STATIC_DRAW);
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    glGenTextures(1, &tracer->packed_texture);
+    glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32UI, tracer->packed_buffer);
+    glBindTexture(GL_TEXTURE_BUFFER, 0);
+    return check_gl("uploading the packed scene", error);
+}
+
+/* Creates both sets of state textures (zeroed) and their framebuffers. */
+static rt_status create_state(gpu_tracer *tracer, rt_error *error)
+{
+    int max_size = tracer->context->info.max_texture_size;
+    if (tracer->width > max_size || tracer->height > max_size)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "GPU: the image %dx%d is larger than the device's textures (GL_MAX_TEXTURE_SIZE %d): "
+                            "render it in tiles (--tile, --crop) of at most %d pixels a side",
+                            tracer->width, tracer->height, max_size, max_size);
+    if (tracer->context->info.max_draw_buffers < TRACER_STATE_COUNT)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
+                            TRACER_STATE_COUNT, tracer->context->info.max_draw_buffers);
+    GLenum draw_buffers[TRACER_STATE_COUNT];
+    for (int set = 0; set < 2; set++) {
+        glGenTextures(TRACER_STATE_COUNT, tracer->state_textures[set]);
+        glGenFramebuffers(1, &tracer->framebuffers[set]);
+        glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[set]);
+        for (int target = 0; target < TRACER_STATE_COUNT; target++) {
+            bool integer = target == TRACER_STATE_COUNTERS;
+            glBindTexture(GL_TEXTURE_2D, tracer->state_textures[set][target]);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            glTexStorage2D(GL_TEXTURE_2D, 1, integer ? GL_RGBA32UI : GL_RGBA32F, tracer->width, tracer->height);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + target, GL_TEXTURE_2D,
+                                   tracer->state_textures[set][target], 0);
+            draw_buffers[target] = GL_COLOR_ATTACHMENT0 + target;
+        }
+        glDrawBuffers(TRACER_STATE_COUNT, draw_buffers);
+        GLenum complete = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+        if (complete != GL_FRAMEBUFFER_COMPLETE)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the state framebuffer is incomplete (0x%04x)",
+                                complete);
+        const GLfloat zero[4] = {0, 0, 0, 0};
+        const GLuint zero_uint[4] = {0, 0, 0, 0};
+        for (int target = 0; target < TRACER_STATE_COUNT; target++) {
+            if (target == TRACER_STATE_COUNTERS)
+                glClearBufferuiv(GL_COLOR, target, zero_uint);
+            else
+                glClearBufferfv(GL_COLOR, target, zero);
+        }
+    }
+    rt_status status = check_gl("creating the state textures", error);
+    if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
+        return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for a %dx%d image's state (%d MB)",
+                            tracer->width, tracer->height,
+                            (int)((double)tracer->width * tracer->height * 16 * 2 * TRACER_STATE_COUNT / 1e6));
+    return status;
+}
+
+/* Loads a partial result into the state the first pass reads: the accumulated sums
+ * and, as "samples started", the finished counts (a path that was in flight is simply
+ * traced again: its random numbers are the same). */
+static rt_status load_resume_state(gpu_tracer *tracer, const float *resume, rt_error *error)
+{
+    size_t pixel_count = (size_t)tracer->width * tracer->height;
+    float *sums = malloc(pixel_count * 4 * sizeof(float));
+    uint32_t *counters = calloc(pixel_count * 4, sizeof(uint32_t));
+    if (sums == NULL || counters == NULL) {
+        free(sums);
+        free(counters);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory loading the partial render");
+    }
+    size_t row_floats = (size_t)tracer->width * 4;
+    for (int row = 0; row < tracer->height; row++) {
+        /* Rows top to bottom in memory; GL's row 0 is the bottom. */
+        const float *source = resume + (size_t)(tracer->height - 1 - row) * row_floats;
+        memcpy(sums + (size_t)row * row_floats, source, row_floats * sizeof(float));
+        for (int x = 0; x < tracer->width; x++)
+            counters[((size_t)row * tracer->width + x) * 4] = (uint32_t)source[x * 4 + 3];
+    }
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][TRACER_STATE_ACCUMULATED]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA, GL_FLOAT, sums);
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][TRACER_STATE_COUNTERS]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA_INTEGER, GL_UNSIGNED_INT, counters);
+    free(sums);
+    free(counters);
+    return check_gl("loading the partial render", error);
+}
+
+/* Returns budget within what the device's work bound allows (gpu.h). */
+static uint32_t clamp_budget(const gpu_info *info, uint32_t budget)
+{
+    uint32_t most = (uint32_t)info->max_pass_work_budget;
+    return budget < 1 ? 1 : budget > most ? most : budget;
+}
+
+/* Uploads the tracer's parameter block: the parameters' block with what the device
+ * decides (the work cap, the budget within its bound) and full_size defaulted. */
+static void upload_parameters(gpu_tracer *tracer)
+{
+    const gpu_info *info = &tracer->context->info;
+    tracer_parameter_block block = tracer->parameters.shader;
+    if (block.full_size[0] == 0 || block.full_size[1] == 0) {
+        block.full_size[0] = block.image_size[0];
+        block.full_size[1] = block.image_size[1];
+    }
+    block.pass_work_budget = (int32_t)clamp_budget(info, (uint32_t)block.pass_work_budget);
+    block.work_cap = info->work_cap;
+    tracer->parameters.shader = block;
+    glBindBuffer(GL_UNIFORM_BUFFER, tracer->parameter_buffer);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof block, &block, GL_DYNAMIC_DRAW);
+    glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
+}
+
+/* Changes one int member of the uploaded parameter block (at offset). */
+static void update_parameter(gpu_tracer *tracer, size_t offset, int32_t value)
+{
+    glBindBuffer(GL_UNIFORM_BUFFER, tracer->parameter_buffer);
+    glBufferSubData(GL_UNIFORM_BUFFER, (GLintptr)offset, sizeof value, &value);
+}
+
+rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
+                            uint64_t texel_hash, const gpu_tracer_parameters *parameters, gpu_tracer **out,
+                            rt_error *error)
+{
+    *out = NULL;
+    gpu_tracer *tracer = calloc(1, sizeof *tracer);
+    if (tracer == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory");
+    tracer->context = context;
+    tracer->width = parameters->shader.image_size[0];
+    tracer->height = parameters->shader.image_size[1];
+    rt_status status = build_program(tracer, parameters, error);
+    if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == texel_hash
+        && context->packed_texel_count == texel_count) {
+        tracer->packed_texture = context->packed_texture;
+        tracer->packed_buffer = context->packed_buffer;
+        tracer->reused_scene = true;
+    } else if (status == RT_OK) {
+        if (context->packed_texture != 0) {
+            glDeleteTextures(1, &context->packed_texture);
+            glDeleteBuffers(1, &context->packed_buffer);
+            context->packed_texture = 0;
+            context->packed_buffer = 0;
+        }
+        status = upload_packed_scene(tracer, packed_texels, texel_count, error);
+        if (status == RT_OK) {
+            context->packed_texture = tracer->packed_texture;
+            context->packed_buffer = tracer->packed_buffer;
+            context->packed_hash = texel_hash;
+            context->packed_texel_count = texel_count;
+        }
+    }
+    if (status == RT_OK)
+        status = create_state(tracer, error);
+    if (status == RT_OK && parameters->resume != NULL)
+        status = load_resume_state(tracer, parameters->resume, error);
+    if (status != RT_OK) {
+        gpu_tracer_destroy(tracer);
+        return status;
+    }
+    glGenVertexArrays(1, &tracer->vertex_array);
+    glGenBuffers(1, &tracer->counter_buffer);
+    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
+    glBufferData(GL_ATOMIC_COUNTER_BUFFER, 2 * sizeof(GLuint), NULL, GL_DYNAMIC_READ);
+    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
+    tracer->parameters = *parameters;
+    tracer->parameters.resume = NULL;
+    glGenBuffers(1, &tracer->parameter_buffer);
+    upload_parameters(tracer);
+    status = check_gl("setting up the tracer", error);
+    if (status != RT_OK) {
+        gpu_tracer_destroy(tracer);
+        return status;
+    }
+    *out = tracer;
+    return RT_OK;
+}
+
+rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_error *error)
+{
+    int source = tracer->current, target = 1 - tracer->current;
+    const GLuint zero[2] = {0, 0};
+    glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
+    glBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof zero, zero);
+    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[target]);
+    glViewport(0, 0, tracer->width, tracer->height);
+    glUseProgram(tracer->program);
+    glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
+    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
+    for (int state = 0; state < TRACER_STATE_COUNT; state++) {
+        glActiveTexture(GL_TEXTURE0 + state);
+        glBindTexture(GL_TEXTURE_2D, tracer->state_textures[source][state]);
+    }
+    glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
+    glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
+    glBindVertexArray(tracer->vertex_array);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    GLuint counters[2] = {0, 0};
+    glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof counters, counters);
+    tracer->current = target;
+    report->unfinished_pixels = counters[0];
+    report->samples_finished = counters[1];
+    return check_gl("a tracer pass", error);
+}
+
+void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
+{
+    tracer->parameters.shader.pass_work_budget = (int32_t)clamp_budget(&tracer->context->info, budget);
+    update_parameter(tracer, offsetof(tracer_parameter_block, pass_work_budget),
+                     tracer->parameters.shader.pass_work_budget);
+}
+
+/* Reads one state texture of the latest set into rows top to bottom. */
+static void read_state(gpu_tracer *tracer, int state, float *rgba)
+{
+    size_t row_floats = (size_t)tracer->width * 4;
+    float *bottom_up = malloc(row_floats * tracer->height * sizeof(float));
+    if (bottom_up == NULL)
+        return;
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[tracer->current][state]);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, bottom_up);
+    for (int row = 0; row < tracer->height; row++)
+        memcpy(rgba + (size_t)row * row_floats, bottom_up + (size_t)(tracer->height - 1 - row) * row_floats,
+               row_floats * sizeof(float));
+    free(bottom_up);
+}
+
+rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
+                          rt_error *error)
+{
+    glActiveTexture(GL_TEXTURE0);
+    read_state(tracer, TRACER_STATE_ACCUMULATED, rgba);
+    if (totals != NULL || luminance_squares != NULL) {
+        size_t count = (size_t)tracer->width * tracer->height;
+        float *statistics = malloc(count * 4 * sizeof(float));
+        if (statistics == NULL)
+            return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading statistics");
+        read_state(tracer, TRACER_STATE_STATISTICS, statistics);
+        gpu_tracer_totals sums = {0};
+        for (size_t i = 0; i < count; i++) {
+            sums.path_segments += statistics[i * 4 + 0];
+            sums.traversal_overflows += statistics[i * 4 + 1];
+            if (luminance_squares != NULL)
+                luminance_squares[i] = statistics[i * 4 + 2];
+        }
+        if (totals != NULL)
+            *totals = sums;
+        free(statistics);
+    }
+    return check_gl("reading the result", error);
+}
+
+rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_depth, float *normal_coverage,
+                                 rt_error *error)
+{
+    /* The render's variant: the AOV pass reaches no more of the tracer than the render. */
+    char defines[1024];
+    const gpu_tracer_parameters *p = &tracer->parameters;
+    variant_defines(p->omitted_features, p->shader.integrator, p->shader.sky_type, defines, sizeof defines);
+    GLuint program = build_fragment_program(SHADER_PROGRAM_AOV, defines, error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    int width = tracer->width, height = tracer->height;
+    GLuint textures[2], framebuffer;
+    glGenTextures(2, textures);
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    for (int k = 0; k < 2; k++) {
+        glBindTexture(GL_TEXTURE_2D, textures[k]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, GL_TEXTURE_2D, textures[k], 0);
+    }
+    const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, draw_buffers);
+    rt_status status = RT_OK;
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the AOV framebuffer is incomplete");
+    if (status == RT_OK) {
+        update_parameter(tracer, offsetof(tracer_parameter_block, aov_samples), samples);
+        glUseProgram(program);
+        glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
+        glViewport(0, 0, width, height);
+        glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
+        glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
+        glBindVertexArray(tracer->vertex_array);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        float *outputs[2] = {albedo_depth, normal_coverage};
+        size_t row_floats = (size_t)width * 4;
+        float *bottom_up = malloc(row_floats * (size_t)height * sizeof(float));
+        if (bottom_up == NULL)
+            status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the AOVs");
+        for (int k = 0; k < 2 && status == RT_OK; k++) {
+            glReadBuffer(GL_COLOR_ATTACHMENT0 + k);
+            glPixelStorei(GL_PACK_ALIGNMENT, 4);
+            glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, bottom_up);
+            for (int row = 0; row < height; row++)
+                memcpy(outputs[k] + (size_t)row * row_floats, bottom_up + (size_t)(height - 1 - row) * row_floats,
+                       row_floats * sizeof(float));
+        }
+        free(bottom_up);
+    }
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(2, textures);
+    glDeleteProgram(program);
+    glUseProgram(tracer->program);
+    if (status != RT_OK)
+        return status;
+    return check_gl("the AOV pass", error);
+}
+
+bool gpu_tracer_reused_scene(const gpu_tracer *tracer)
+{
+    return tracer->reused_scene;
+}
+
+void gpu_tracer_destroy(gpu_tracer *tracer)
+{
+    if (tracer == NULL)
+        return;
+    for (int set = 0; set < 2; set++) {
+        glDeleteTextures(TRACER_STATE_COUNT, tracer->state_textures[set]);
+        glDeleteFramebuffers(1, &tracer->framebuffers[set]);
+    }
+    /* The program and the packed scene belong to the context (kept for the next frame). */
+    if (tracer->packed_texture != tracer->context->packed_texture) {
+        glDeleteTextures(1, &tracer->packed_texture);
+        glDeleteBuffers(1, &tracer->packed_buffer);
+    }
+    glDeleteBuffers(1, &tracer->counter_buffer);
+    glDeleteBuffers(1, &tracer->parameter_buffer);
+    glDeleteVertexArrays(1, &tracer->vertex_array);
+    free(tracer);
+}
+
+rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32_t sample_index, uint32_t seed,
+                             uint32_t dimension, float *rgba, rt_error *error)
+{
+    (void)context;
+    GLuint program = build_fragment_program(SHADER_PROGRAM_RANDOM_TEST, "", error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    GLuint texture, framebuffer, vertex_array;
+    glGenTextures(1, &texture);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+    GLenum draw_buffer = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &draw_buffer);
+    glGenVertexArrays(1, &vertex_array);
+    glBindVertexArray(vertex_array);
+    glViewport(0, 0, width, height);
+    glUseProgram(program);
+    glUniform1ui(glGetUniformLocation(program, "sample_index"), sample_index);
+    glUniform1ui(glGetUniformLocation(program, "seed"), seed);
+    glUniform1ui(glGetUniformLocation(program, "dimension"), dimension);
+    glUniform1i(glGetUniformLocation(program, "image_height"), height);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    size_t row_floats = (size_t)width * 4;
+    float *bottom_up = malloc(row_floats * (size_t)height * sizeof(float));
+    if (bottom_up != NULL) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, bottom_up);
+        for (int row = 0; row < height; row++)
+            memcpy(rgba + (size_t)row * row_floats, bottom_up + (size_t)(height - 1 - row) * row_floats,
+                   row_floats * sizeof(float));
+        free(bottom_up);
+    }
+    glDeleteVertexArrays(1, &vertex_array);
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(1, &texture);
+    glDeleteProgram(program);
+    if (bottom_up == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading random numbers");
+    return check_gl("drawing random numbers", error);
+}
+
+rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const char *const *names, int *offsets,
+                                      int *block_size, rt_error *error)
+{
+    (void)context;
+    char defines[1024];
+    variant_defines(0, 0, 0, defines, sizeof defines);
+    GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    for (int i = 0; i < count; i++) {
+        GLuint index = GL_INVALID_INDEX;
+        glGetUniformIndices(program, 1, &names[i], &index);
+        offsets[i] = -1;
+        if (index != GL_INVALID_INDEX)
+            glGetActiveUniformsiv(program, 1, &index, GL_UNIFORM_OFFSET, &offsets[i]);
+    }
+    *block_size = 0;
+    GLuint block = glGetUniformBlockIndex(program, "tracer_parameter_block");
+    if (block != GL_INVALID_INDEX)
+        glGetActiveUniformBlockiv(program, block, GL_UNIFORM_BLOCK_DATA_SIZE, block_size);
+    glDeleteProgram(program);
+    return check_gl("reading the parameter block's layout", error);
+}
+
+void gpu_tracer_release(gpu_context *context)
+{
+    for (int i = 0; i < context->tracer_program_count; i++)
+        if (context->tracer_programs[i].program)
+            glDeleteProgram(context->tracer_programs[i].program);
+    if (context->packed_texture)
+        glDeleteTextures(1, &context->packed_texture);
+    if (context->packed_buffer)
+        glDeleteBuffers(1, &context->packed_buffer);
+}

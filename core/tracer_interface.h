@@ -1,0 +1,97 @@
+/* tracer_interface.h: the one definition of what the C side hands the GLSL tracer besides
+ * the packed scene (core/packed_layout.h): the parameter block, the integrator ids, the
+ * sky kinds and where the pass state lives.
+ *
+ * Like packed_layout.h, this file is included by C (core/gpu.h, core/render.h,
+ * core/scene.h) and prepended, byte for byte, to the tracer's GLSL (the module table in
+ * core/shader_sources.S). It must stay valid in both languages: only comments, include
+ * guards and #define of plain integers and of the parameter list below.
+ *
+ * The parameter list is expanded twice: into the C struct tracer_parameter_block
+ * (core/gpu.h) and into the GLSL uniform block of the same name (glsl/parameters.glsl),
+ * a std140 block that core/gpu_tracer.c uploads with one glBufferData. Each entry is
+ * P(GLSL type, name); the types used are float, int, uint, ivec2, uvec2 and vec3 (core/gpu.h
+ * maps each to a C type with its std140 alignment; tests/unit/test_tracer_parameters.c
+ * checks the C offsets against the std140 rules and against what the GL reports).
+ * Adding a parameter: one line here (any order: C and std140 agree on every layout these
+ * types make), then set it in core/render.c tracer_parameters() or core/gpu_tracer.c and read it
+ * by name in the GLSL.
+ */
+#ifndef RT_TRACER_INTERFACE_H
+#define RT_TRACER_INTERFACE_H
+
+/* ---- integrators (render_options.integrator, the parameter integrator); the GLSL
+ * table of integrators is glsl/integrators.glsl */
+#define INTEGRATOR_PATH 0            /* unbiased path tracing with light sampling (default) */
+#define INTEGRATOR_WHITTED 1         /* Whitted recursive ray tracing with Phong shading */
+#define INTEGRATOR_COUNT 2
+
+/* ---- sky kinds (scene_sky.type, the parameter sky_type; glsl/sky.glsl) */
+#define SKY_GRADIENT 0               /* lerp(bottom, top, 0.5 * (direction.y + 1)) */
+#define SKY_CONSTANT 1               /* bottom colour everywhere */
+#define SKY_BOX 2                    /* a cube map from six images (faces) */
+#define SKY_ENVIRONMENT 3            /* an equirectangular (latitude-longitude) image */
+#define SKY_TYPE_COUNT 4
+
+/* ---- pass state: one texture per target, read by unit TRACER_STATE_* (sampler binding)
+ * and written to colour attachment TRACER_STATE_* (output location) of each pass
+ * (glsl/main.glsl says what each holds) */
+#define TRACER_STATE_ORIGIN 0
+#define TRACER_STATE_DIRECTION 1
+#define TRACER_STATE_THROUGHPUT 2
+#define TRACER_STATE_RADIANCE 3
+#define TRACER_STATE_COUNTERS 4      /* the one integer (RGBA32UI) target; the others are RGBA32F */
+#define TRACER_STATE_ACCUMULATED 5
+#define TRACER_STATE_STATISTICS 6
+#define TRACER_STATE_COUNT 7
+
+/* ---- the AOV pass's outputs (glsl/aov.glsl) */
+#define TRACER_AOV_ALBEDO_DEPTH 0
+#define TRACER_AOV_NORMAL 1
+#define TRACER_AOV_COUNT 2
+
+/* ---- bindings: texture unit of the packed scene, uniform buffer of the parameter block,
+ * atomic counter buffer (unfinished pixels at offset 0, finished samples at offset 4) */
+#define TRACER_PACKED_SCENE_UNIT 7
+#define TRACER_PARAMETER_BINDING 0
+#define TRACER_COUNTER_BINDING 0
+
+/* ---- the parameter block. Vectors are world space; pixels count from the top left. */
+#define TRACER_PARAMETERS(P) \
+    P(ivec2, image_size)             /* the region rendered: the whole image or a crop */ \
+    P(ivec2, region_origin)          /* its top-left pixel in the full image */ \
+    P(ivec2, full_size)              /* the full image: camera and random numbers use its pixels */ \
+    P(vec3, camera_origin) \
+    P(float, lens_radius) \
+    P(vec3, camera_lower_left)       /* point on the focus plane at the image's bottom left */ \
+    P(vec3, camera_horizontal)       /* focus-plane vector across the image width */ \
+    P(vec3, camera_vertical)         /* focus-plane vector up the image height */ \
+    P(vec3, camera_u)                /* lens axes (right, up), unit length */ \
+    P(vec3, camera_v) \
+    P(float, shutter_open)           /* ray times are uniform in [open, close] */ \
+    P(float, shutter_close) \
+    P(uint, camera_media)            /* volumes the camera is in, as a path keeps them */ \
+                                     /* (glsl/media.glsl; the packer's packed_media_at) */ \
+    P(int, sky_type)                 /* SKY_* */ \
+    P(vec3, sky_bottom)              /* gradient: colour straight down; constant: the colour */ \
+    P(vec3, sky_top)                 /* gradient: colour straight up */ \
+    P(float, sky_intensity)          /* multiplies every kind of sky */ \
+    P(float, sky_rotation)           /* box and environment: radians about +Y */ \
+    P(uvec2, sky_faces_x)            /* box: image indices of the +X and -X faces */ \
+    P(uvec2, sky_faces_y)            /* +Y, -Y */ \
+    P(uvec2, sky_faces_z)            /* +Z, -Z */ \
+    P(uint, sky_environment)         /* environment: image index */ \
+    P(uint, seed)                    /* the random seed */ \
+    P(uint, sample_start)            /* first sample index (sample ranges) */ \
+    P(uint, samples_per_pixel) \
+    P(uint, max_depth)               /* at most this many path segments per sample */ \
+    P(uint, russian_roulette_depth)  /* paths may end at random after this many segments */ \
+    P(int, integrator)               /* INTEGRATOR_* */ \
+    P(int, light_sampling)           /* 0: BSDF sampling only (to compare the estimators) */ \
+    P(vec3, ambient)                 /* Whitted: ambient light */ \
+    P(int, pass_work_budget)         /* work units a pixel may start in one pass (core/gpu_tracer.c */ \
+                                     /* clamps it to what the device allows) */ \
+    P(int, work_cap)                 /* no invocation does more (core/gpu_tracer.c, from the device) */ \
+    P(int, aov_samples)              /* the AOV pass: jittered camera rays per pixel */
+
+#endif

@@ -1,0 +1,112 @@
+// intersect.glsl: ray tests against one primitive or one box, and the move of a ray into
+// an instance's object coordinates.
+
+struct Hit {
+    float t;
+    uint primitive;   // slot in the primitive section
+    uint instance;    // NONE: a world primitive
+    vec2 barycentric; // triangles: (b1, b2) of v1, v2; quads: (a, b) along the edges
+};
+
+// Nearest root of |origin + t*direction - center| = radius with t in (0, t_max), or
+// INFINITY, for a direction of any length (instances scale it). The discriminant is
+// computed from the squared distance of the centre to the ray's closest point, which
+// keeps float32 precise for the radius-1000 ground sphere (Haines et al., Ray Tracing
+// Gems, ch. 7).
+float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direction, float t_max)
+{
+    float direction_length = length(direction);
+    vec3 unit = direction / direction_length;
+    vec3 to_origin = origin - center;
+    float b = dot(to_origin, unit);
+    vec3 closest_offset = to_origin - b * unit;
+    float discriminant = radius * radius - dot(closest_offset, closest_offset);
+    if (discriminant < 0.0)
+        return INFINITY;
+    float root = sqrt(discriminant);
+    float c = dot(to_origin, to_origin) - radius * radius;
+    float q = -b - (b >= 0.0 ? root : -root);
+    float t_near = c / q / direction_length;
+    float t_far = q / direction_length;
+    if (t_near > t_far) { float swap = t_near; t_near = t_far; t_far = swap; }
+    if (t_near > 0.0 && t_near < t_max)
+        return t_near;
+    if (t_far > 0.0 && t_far < t_max)
+        return t_far;
+    return INFINITY;
+}
+
+// Moller-Trumbore for a triangle (corner, edge1, edge2), or the parallelogram spanned by
+// the same vectors when quad is true. Returns t and the two edge coordinates.
+float intersect_flat(vec3 corner, vec3 edge1, vec3 edge2, bool quad, vec3 origin, vec3 direction, float t_max,
+                     out vec2 coordinates)
+{
+    coordinates = vec2(0.0);
+    vec3 p = cross(direction, edge2);
+    float determinant = dot(edge1, p);
+    if (abs(determinant) < 1e-20)
+        return INFINITY;
+    float inverse = 1.0 / determinant;
+    vec3 s = origin - corner;
+    float u = dot(s, p) * inverse;
+    vec3 q = cross(s, edge1);
+    float v = dot(direction, q) * inverse;
+    bool inside = quad ? (u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0) : (u >= 0.0 && v >= 0.0 && u + v <= 1.0);
+    if (!inside)
+        return INFINITY;
+    float t = dot(edge2, q) * inverse;
+    coordinates = vec2(u, v);
+    return t > 0.0 && t < t_max ? t : INFINITY;
+}
+
+// Entry distance of the ray into a box, or INFINITY when it misses or enters beyond t_max.
+float intersect_box(vec3 box_min, vec3 box_max, vec3 origin, vec3 inverse_direction, float t_max)
+{
+    vec3 t0 = (box_min - origin) * inverse_direction;
+    vec3 t1 = (box_max - origin) * inverse_direction;
+    vec3 t_small = min(t0, t1);
+    vec3 t_large = max(t0, t1);
+    float enter = max(max(t_small.x, t_small.y), max(t_small.z, 0.0));
+    float leave = min(min(t_large.x, t_large.y), min(t_large.z, t_max));
+    return enter <= leave ? enter : INFINITY;
+}
+
+// Tests one primitive (by slot, its record already read) of the current level; on a
+// nearer hit updates hit.
+void intersect_primitive(uint slot, uvec4 record, uint type, vec3 origin, vec3 direction, float time, uint instance,
+                         inout Hit hit)
+{
+    vec4 a, b, c;
+    uvec3 normal_words;
+    primitive_geometry(record, type, a, b, c, normal_words);
+    float t = INFINITY;
+    vec2 coordinates = vec2(0.0);
+    if (ONLY_SPHERES) {
+        t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
+    } else {
+        bool flat_primitive = type == uint(PRIMITIVE_TRIANGLE) || type == uint(PRIMITIVE_QUAD);
+        if (HAS_MOVING_SPHERES && type == uint(PRIMITIVE_MOVING_SPHERE))
+            a.xyz = mix(a.xyz, b.xyz, time);
+        if (HAS_SPHERES && !flat_primitive)
+            t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
+        if (HAS_FLAT && flat_primitive)
+            t = intersect_flat(a.xyz, b.xyz, c.xyz, type == uint(PRIMITIVE_QUAD), origin, direction, hit.t,
+                               coordinates);
+    }
+    if (t < hit.t) {
+        hit.t = t;
+        hit.primitive = slot;
+        hit.instance = instance;
+        hit.barycentric = coordinates;
+    }
+}
+
+// Moves a world ray into an instance's object coordinates (the direction is not
+// renormalised, so t keeps meaning the world ray's parameter).
+void to_object(uint instance, vec3 origin, vec3 direction, out vec3 object_origin, out vec3 object_direction)
+{
+    uint base = instance_offset + instance * uint(PACKED_INSTANCE_STRIDE);
+    vec4 row0 = packed_vec4(base + 1u), row1 = packed_vec4(base + 2u), row2 = packed_vec4(base + 3u);
+    object_origin = vec3(dot(row0.xyz, origin) + row0.w, dot(row1.xyz, origin) + row1.w, dot(row2.xyz, origin) + row2.w);
+    object_direction = vec3(dot(row0.xyz, direction), dot(row1.xyz, direction), dot(row2.xyz, direction));
+}

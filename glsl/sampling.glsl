@@ -1,0 +1,51 @@
+// sampling.glsl: the current sample's stream of random numbers (glsl/random.glsl) and
+// the warps that turn uniform numbers into directions and points.
+//
+// Random numbers are a pure function of (pixel, sample index, seed, bounce, stream): the
+// same sample renders the same whatever the pass split or the machine. Streams of one
+// bounce: 0 the camera ray (film, lens), 1 scattering, 2 Russian roulette, 3 the ray time
+// (bounce 0), 4 the distance to a scattering event in a medium, 5 path tracing's light
+// sample, 6 and 7 Whitted's light samples.
+
+uvec2 rng_pixel;     // pixel in image coordinates (row 0 at the top)
+uint rng_sample;     // absolute sample index
+uint rng_seed_hash;
+
+// Four uniform numbers in [0, 1) for one (bounce, stream) of the current sample.
+vec4 random4(uint bounce, uint stream)
+{
+    return random_numbers(rng_pixel, rng_sample, rng_seed_hash, bounce * 8u + stream);
+}
+
+vec3 random_unit_vector(vec2 u)
+{
+    float z = 1.0 - 2.0 * u.x;
+    float r = sqrt(max(0.0, 1.0 - z * z));
+    float phi = 2.0 * PI * u.y;
+    return vec3(r * cos(phi), r * sin(phi), z);
+}
+
+vec3 random_in_unit_sphere(vec3 u)
+{
+    return random_unit_vector(u.xy) * pow(u.z, 1.0 / 3.0);
+}
+
+vec2 random_in_unit_disk(vec2 u)
+{
+    float r = sqrt(u.x);
+    float phi = 2.0 * PI * u.y;
+    return vec2(r * cos(phi), r * sin(phi));
+}
+
+// A direction in the cone of half-angle acos(cos_max) about the unit axis, uniform in
+// solid angle; cos_theta is its cosine to the axis.
+vec3 random_in_cone(vec3 axis, float cos_max, vec2 u, out float cos_theta)
+{
+    cos_theta = 1.0 - u.x * (1.0 - cos_max);
+    float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+    float phi = 2.0 * PI * u.y;
+    vec3 helper = abs(axis.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+    vec3 tangent = normalize(cross(helper, axis));
+    vec3 bitangent = cross(axis, tangent);
+    return normalize(sin_theta * cos(phi) * tangent + sin_theta * sin(phi) * bitangent + cos_theta * axis);
+}

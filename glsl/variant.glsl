@@ -1,0 +1,30 @@
+// variant.glsl: which parts of the tracer this program has, defined once.
+//
+// core/gpu_tracer.c (variant_defines) defines every RTSPHERES_OMIT_* as 0 or 1 from the GPU_OMIT_*
+// bits of core/gpu.h, which core/render.c computes from the scene: code for what the scene
+// cannot reach is left out, because llvmpipe runs both sides of every branch and so pays
+// for all the code in a loop (docs/performance.md). Code that needs a feature says so with
+// a plain `if (HAS_...)` where it is: these are compile-time constants, so the compiler
+// drops the code behind a false one as an #if would.
+const bool HAS_DIRECT_LIGHT = RTSPHERES_OMIT_DIRECT_LIGHT == 0;   // light sampling, Whitted's lights
+const bool HAS_VOLUMES = RTSPHERES_OMIT_VOLUMES == 0;             // media, volume boundaries
+const bool HAS_TEXTURES = RTSPHERES_OMIT_TEXTURES == 0;           // textures, normal maps, uvs
+const bool HAS_SPHERES = RTSPHERES_OMIT_SPHERES == 0;             // spheres, moving or not
+const bool HAS_MOVING_SPHERES = RTSPHERES_OMIT_MOVING_SPHERES == 0;
+const bool HAS_TRIANGLES = RTSPHERES_OMIT_TRIANGLES == 0;
+const bool HAS_QUADS = RTSPHERES_OMIT_QUADS == 0;
+const bool HAS_INSTANCES = RTSPHERES_OMIT_INSTANCES == 0;         // a second BVH level
+const bool HAS_EMITTERS = RTSPHERES_OMIT_EMITTERS == 0;           // emissive materials
+
+// Derived: flat primitives (triangles, quads), and scenes of a single primitive kind, whose
+// records need no type test.
+const bool HAS_FLAT = HAS_TRIANGLES || HAS_QUADS;
+const bool ONLY_SPHERES = !HAS_TRIANGLES && !HAS_QUADS && !HAS_MOVING_SPHERES && !HAS_INSTANCES;
+const bool ONLY_TRIANGLES = !HAS_SPHERES && !HAS_QUADS && !HAS_INSTANCES;
+
+// The integrator and the sky kind: compiled in as constants (RTSPHERES_FIX_UNIFORMS 1,
+// gpu.h GPU_FIX_UNIFORMS), or read from the parameter block (the full tracer).
+const bool FIXED_SETTINGS = RTSPHERES_FIX_UNIFORMS != 0;
+
+int tracer_integrator() { return FIXED_SETTINGS ? RTSPHERES_INTEGRATOR : integrator; }
+int sky_kind() { return FIXED_SETTINGS ? RTSPHERES_SKY_TYPE : sky_type; }
