@@ -12,9 +12,7 @@
 
 render_job render_job_defaults(void)
 {
-    render_job job;
-    memset(&job, 0, sizeof job);
-    return job;
+    return (render_job){0};
 }
 
 const char *render_job_shard_kind_name(render_job_shard_kind kind)

@@ -89,6 +89,23 @@ static render_job job_for(const char *name)
     return job;
 }
 
+/* A job rendering frames[0 .. count-1] of the scratch scene to the pattern scratch/name. */
+static render_job frames_job_for(const char *name, const int *frames, int count)
+{
+    render_job job = job_for(name);
+    job.frames = frames;
+    job.frame_count = count;
+    return job;
+}
+
+/* Checks that render_job_check() accepts job and that its first output is scratch/name. */
+static void first_output_is(const render_job *job, const char *name)
+{
+    render_job_plan plan;
+    assert_int_equal(render_job_check(job, &plan, NULL), RT_OK);
+    assert_string_equal(plan.first_output, in_scratch(name));
+}
+
 /* Checks that render_job_check() refuses job with exactly message. */
 static void refused(const render_job *job, const char *message)
 {
@@ -135,33 +152,27 @@ static void defaults_are_zero(void **state)
 static void output_names(void **state)
 {
     (void)state;
-    render_job_plan plan;
     /* Without frames the pattern gets the last -D frame, else 0. */
     render_job job = job_for("f-%03d.exr");
-    assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
-    assert_string_equal(plan.first_output, in_scratch("f-000.exr"));
+    first_output_is(&job, "f-000.exr");
     scene_define defines[] = {{.name = "frame", .value = "3"}, {.name = "x", .value = "1"}, {.name = "frame", .value = "2*4"}};
     job.defines = defines;
     job.define_count = 3;
+    first_output_is(&job, "f-008.exr");
+    render_job_plan plan;
     assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
     assert_string_equal(plan.frame_define, "2*4");
-    assert_string_equal(plan.first_output, in_scratch("f-008.exr"));
     /* With frames, the first frame's name; every frame gets its own. */
     int frames[] = {12, 5};
-    job = job_for("f-%03d.exr");
-    job.frames = frames;
-    job.frame_count = 2;
+    job = frames_job_for("f-%03d.exr", frames, 2);
+    first_output_is(&job, "f-012.exr");
     assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
-    assert_string_equal(plan.first_output, in_scratch("f-012.exr"));
     char name[RENDER_JOB_PATH_MAX];
     assert_int_equal(render_job_output_name(&job, &plan, 5, name, sizeof name, NULL), RT_OK);
     assert_string_equal(name, in_scratch("f-005.exr"));
     /* One frame may go without a frame number in the name. */
-    job = job_for("still.png");
-    job.frames = frames;
-    job.frame_count = 1;
-    assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
-    assert_string_equal(plan.first_output, in_scratch("still.png"));
+    job = frames_job_for("still.png", frames, 1);
+    first_output_is(&job, "still.png");
     /* The partial file sits beside the output, whatever its format. */
     char partial[RENDER_JOB_PATH_MAX];
     render_output_partial_path("out/frame-7.png", partial, sizeof partial);
@@ -176,17 +187,13 @@ static void output_rules(void **state)
     char message[1024];
     int frames[] = {1, 2};
     scene_define frame_define = {.name = "frame", .value = "3"}, time_define = {.name = "time", .value = "0.5"};
-    render_job job = job_for("f-%d.png");
-    job.frames = frames;
-    job.frame_count = 2;
+    render_job job = frames_job_for("f-%d.png", frames, 2);
     job.defines = &frame_define;
     job.define_count = 1;
     refused(&job, "-D frame and --frames both set $frame (--frames sets $frame and $time); give one");
     job.defines = &time_define;
     refused(&job, "-D time and --frames both set $time (--frames sets $frame and $time); give one");
-    job = job_for("f.png");
-    job.frames = frames;
-    job.frame_count = 2;
+    job = frames_job_for("f.png", frames, 2);
     snprintf(message, sizeof message,
              "2 frames would all write '%s'; put a frame number pattern in the output, e.g. frame-%%04d.png",
              in_scratch("f.png"));
@@ -231,9 +238,7 @@ static void part_rules(void **state)
     snprintf(message, sizeof message, "--aovs writes extra layers, which only .exr keeps; not '%s'",
              in_scratch("a.png"));
     refused(&job, message);
-    job = job_for("a-%d.exr");
-    job.frames = frames;
-    job.frame_count = 2;
+    job = frames_job_for("a-%d.exr", frames, 2);
     job.resume_path = "x.exr";
     refused(&job, "--resume continues one image; render the frames one at a time");
     job = job_for("a.exr");
@@ -242,9 +247,7 @@ static void part_rules(void **state)
     job.shard_count = 2;
     job.shard_by = RENDER_SHARD_FRAMES;
     refused(&job, "--shard-by frames needs --frames");
-    job = job_for("a-%d.exr");
-    job.frames = frames;
-    job.frame_count = 3;
+    job = frames_job_for("a-%d.exr", frames, 3);
     job.shard_index = 3;
     job.shard_count = 4;
     refused(&job, "shard 3/4 of 3 frames is empty; use fewer shards");
@@ -271,9 +274,7 @@ static void shards(void **state)
     render_job_plan plan;
     int frames[] = {10, 11, 12, 13, 14, 15, 16};
     /* Several frames: a shard is by frames unless told otherwise; position i % N == I. */
-    render_job job = job_for("f-%d.exr");
-    job.frames = frames;
-    job.frame_count = 7;
+    render_job job = frames_job_for("f-%d.exr", frames, 7);
     job.shard_index = 1;
     job.shard_count = 3;
     assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
@@ -605,9 +606,7 @@ static void runs_that_stop_early(void **state)
     /* A stop request before the first frame: nothing is rendered or written. */
     int frames[] = {1, 2};
     volatile sig_atomic_t stop = 1;
-    job = job_for("f-%d.exr");
-    job.frames = frames;
-    job.frame_count = 2;
+    job = frames_job_for("f-%d.exr", frames, 2);
     job.stop_requested = &stop;
     assert_int_equal(render_job_run(NULL, &job, &callbacks, &summary, &error), RT_ERROR_INTERRUPTED);
     assert_int_equal(summary.failure, RENDER_JOB_FAILURE_STOPPED);
@@ -617,10 +616,8 @@ static void runs_that_stop_early(void **state)
     /* A frame whose name is the scene file (the first name was checked by the plan). */
     const char *scene_exr = in_scratch("scene-2.exr");
     write_text(scene_exr, scene_text);
-    job = job_for("scene-%d.exr");
+    job = frames_job_for("scene-%d.exr", frames, 2);
     job.scene_path = scene_exr;
-    job.frames = frames;
-    job.frame_count = 2;
     job.shard_index = 1;
     job.shard_count = 2;
     char expected[1024];
@@ -643,9 +640,7 @@ static void a_job_renders(void **state)
     events seen;
     render_job_callbacks callbacks = callbacks_for(&seen);
     int frames[] = {4, 5, 6};
-    render_job job = job_for("f-%d.exr");
-    job.frames = frames;
-    job.frame_count = 3;
+    render_job job = frames_job_for("f-%d.exr", frames, 3);
     job.shard_index = 0;
     job.shard_count = 2;
     job.samples_per_pixel = 2;
