@@ -31,12 +31,14 @@ typedef struct job_image {
 } job_image;
 
 /* Loads the scene with the variables of frame (-1: none) and its assets into *s. On
- * failure *s is freed and the error is the scene's own. */
-static rt_status load_scene(const render_job *job, int frame, scene *s, rt_error *error)
+ * failure *s is freed, and run->failure says whether the scene's own message is the error. */
+static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
 {
+    const render_job *job = run->job;
     scene_define *defines = malloc(((size_t)job->define_count + 2) * sizeof *defines);
     if (defines == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory for the scene's variables");
+    run->failure = RENDER_JOB_FAILURE_SCENE;
     render_job_frame_values values;
     scene_parse_options parse_options = scene_parse_options_defaults();
     parse_options.defines = defines;
@@ -267,18 +269,19 @@ static rt_status render_image(job_image *image, rt_error *error)
 static rt_status run_image(job_run *run, int frame, const char *output, rt_error *error)
 {
     const render_job *job = run->job;
+    run->failure = RENDER_JOB_FAILURE_IMAGE;
     job_image *image = calloc(1, sizeof *image);
     if (image == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory");
     image->run = run;
-    rt_status status = load_scene(job, frame, &image->scene, error);
+    rt_status status = load_scene(run, frame, &image->scene, error);
     if (status != RT_OK) {
-        run->failure = RENDER_JOB_FAILURE_SCENE;
         free(image);
         return status;
     }
     run->failure = RENDER_JOB_FAILURE_IMAGE;
     scene *s = &image->scene;
+    /* Asset warnings (a missing MTL file, ...): once, with the first frame of the list. */
     bool first_frame = frame < 0 || frame == job->frames[0];
     for (int i = 0; i < s->warning_count && first_frame && run->callbacks.warning != NULL; i++)
         run->callbacks.warning(run->callbacks.user, s->warnings[i].message);

@@ -50,11 +50,12 @@
  *
  * ## Running
  * render_job_run() renders the images in order on one GPU context. Each image: the scene
- * is loaded with its variables (asset warnings go to the warning callback, with the first
- * frame only), planned, rendered (render_scene()), post-processed, and written; on success
- * its partial file is removed. A stop request during a render writes the samples done to
- * the partial file (never over the output) and ends the job; one between frames ends it
- * before the next frame. The first failing image ends the job.
+ * is loaded with its variables (asset warnings go to the warning callback with the image
+ * of the list's first frame only, so a shard by frames without it shows none), planned,
+ * rendered (render_scene()), post-processed, and written; on success its partial file is
+ * removed. A stop request during a render writes the samples done, post-processed like the
+ * output, to the partial file (never over the output) and ends the job; one between
+ * frames ends it before the next frame. The first failing image ends the job.
  *
  * Messages name the job's fields by the render command's options (--crop, --shard, ...),
  * the words a user sets them in, and carry no module tag: the command prints them after
