@@ -61,21 +61,16 @@ int command_info(int argc, char **argv)
     while ((option = getopt_long(argc, argv, "h", long_options, NULL)) != -1) {
         switch (option) {
         case 'd': {
-            char *end = NULL;
-            long device = strtol(optarg, &end, 10);
-            if (end == optarg || *end != '\0' || device < 0 || device > 255) {
+            long long device;
+            if (command_parse_integer(optarg, 0, 255, &device) != 0) {
                 fprintf(stderr, "rtspheres info: --device wants a device number (0, 1, ...), not '%s'\n", optarg);
                 return EXIT_BAD_INPUT;
             }
             options.device = (int)device + 1;
             break;
         }
-        case 'h':
-            print_help(stdout);
-            return EXIT_OK;
         default:
-            print_help(stderr);
-            return EXIT_BAD_INPUT;
+            return command_help_exit(option, print_help);
         }
     }
     if (optind < argc) {

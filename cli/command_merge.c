@@ -7,13 +7,12 @@
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 #include "commands.h"
 #include "image_io.h"
 #include "merge.h"
-#include "version.h"
+#include "paths.h"
+#include "render_output.h"
 
 static void print_help(FILE *stream)
 {
@@ -38,79 +37,26 @@ static void print_help(FILE *stream)
             "missing parts, unreadable files)\n");
 }
 
-/* True when the two paths name the same existing file. */
-static bool same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-}
-
-/* Returns path's extension including the dot, or "" when its last component has none. */
-static const char *extension_of(const char *path)
-{
-    const char *dot = strrchr(path, '.');
-    return dot != NULL && strchr(dot, '/') == NULL ? dot : "";
-}
-
-static bool is_exr(const char *path)
-{
-    return strcasecmp(extension_of(path), ".exr") == 0;
-}
-
-/* True for the formats image_write knows, so a bad -o is refused before any part is read. */
-static bool known_output(const char *path)
-{
-    static const char *const extensions[] = {".exr", ".hdr", ".png", ".jpg", ".jpeg", ".tif", ".tiff"};
-    for (size_t i = 0; i < sizeof extensions / sizeof extensions[0]; i++)
-        if (strcasecmp(extension_of(path), extensions[i]) == 0)
-            return true;
-    return false;
-}
-
-/* Writes merged to output: all four channels and the metadata for EXR, colour only for
- * the 8-bit and HDR formats (which cannot hold a sample count). Returns an exit code. */
+/* Writes merged to output with the merged metadata (render_output.h: all four channels
+ * for EXR, the colour only for the 8-bit and HDR formats). Returns an exit code. */
 static int write_merged(const char *output, const rt_image *merged, const merge_summary *summary)
 {
-    rt_error error = {{0}};
-    rt_image rgb = {0};
-    const rt_image *image = merged;
-    if (!is_exr(output)) {
-        if (image_create(&rgb, merged->width, merged->height, 3, &error) != RT_OK) {
-            fprintf(stderr, "rtspheres merge: %s\n", error.message);
-            return EXIT_RUNTIME;
-        }
-        size_t pixel_count = (size_t)rgb.width * rgb.height;
-        for (size_t i = 0; i < pixel_count; i++)
-            for (int c = 0; c < 3; c++)
-                rgb.pixels[3 * i + c] = merged->pixels[4 * i + c];
-        image = &rgb;
-    }
-    /* Numbers that may pass 2^31 are written as text, as render does. */
-    char seed_text[24], sample_start_text[24], samples_text[32], segments_text[32];
-    snprintf(seed_text, sizeof seed_text, "%llu", summary->metadata.seed);
-    snprintf(sample_start_text, sizeof sample_start_text, "%llu", summary->sample_start);
-    snprintf(samples_text, sizeof samples_text, "%.0f", summary->total_samples);
-    snprintf(segments_text, sizeof segments_text, "%.0f", summary->path_segments);
-    image_attribute attributes[] = {
-        {.name = "rtspheres:version", .type = IMAGE_ATTRIBUTE_STRING, .string_value = RTSPHERES_VERSION},
-        {.name = "rtspheres:scene", .type = IMAGE_ATTRIBUTE_STRING, .string_value = summary->metadata.scene},
-        {.name = "rtspheres:scene_hash", .type = IMAGE_ATTRIBUTE_STRING, .string_value = summary->metadata.scene_hash},
-        {.name = "rtspheres:spp", .type = IMAGE_ATTRIBUTE_INT, .int_value = summary->min_samples},
-        {.name = "rtspheres:sample_start", .type = IMAGE_ATTRIBUTE_STRING, .string_value = sample_start_text},
-        {.name = "rtspheres:seed", .type = IMAGE_ATTRIBUTE_STRING, .string_value = seed_text},
-        {.name = "rtspheres:max_depth", .type = IMAGE_ATTRIBUTE_INT, .int_value = summary->metadata.max_depth},
-        {.name = "rtspheres:frame", .type = IMAGE_ATTRIBUTE_INT, .int_value = summary->metadata.frame},
-        {.name = "rtspheres:samples_finished", .type = IMAGE_ATTRIBUTE_STRING, .string_value = samples_text},
-        {.name = "rtspheres:path_segments", .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
-        {.name = "rtspheres:complete", .type = IMAGE_ATTRIBUTE_INT, .int_value = summary->complete},
-        {.name = "rtspheres:render_seconds", .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = summary->render_seconds},
-        {.name = "rtspheres:merged_parts", .type = IMAGE_ATTRIBUTE_INT, .int_value = summary->part_count},
+    render_output_metadata metadata = {
+        .scene = summary->metadata.scene,
+        .scene_hash = summary->metadata.scene_hash,
+        .spp = summary->min_samples,
+        .sample_start = summary->sample_start,
+        .seed = summary->metadata.seed,
+        .max_depth = summary->metadata.max_depth,
+        .frame = summary->metadata.frame,
+        .samples_finished = (unsigned long long)summary->total_samples,
+        .path_segments = summary->path_segments,
+        .complete = summary->complete,
+        .render_seconds = summary->render_seconds,
+        .merged_parts = summary->part_count,
     };
-    image_write_options options = image_write_options_defaults();
-    options.attributes = attributes;
-    options.attribute_count = (int)(sizeof attributes / sizeof attributes[0]);
-    rt_status status = image_write(output, image, &options, &error);
-    image_free(&rgb);
+    rt_error error = {{0}};
+    rt_status status = render_output_write(output, merged, NULL, &metadata, 0.0f, &error);
     if (status != RT_OK) {
         fprintf(stderr, "rtspheres merge: %s\n", error.message);
         return exit_code_for_status(status);
@@ -138,15 +84,14 @@ int command_merge(int argc, char **argv)
         case 'o': output = optarg; break;
         case OPTION_ALLOW_MISSING: options.allow_missing = true; break;
         case 'q': quiet = true; break;
-        case 'h': print_help(stdout); return EXIT_OK;
-        default: print_help(stderr); return EXIT_BAD_INPUT;
+        default: return command_help_exit(option, print_help);
         }
     }
     if (output == NULL) {
         fprintf(stderr, "rtspheres merge: no output; give -o FILE.exr\n");
         return EXIT_BAD_INPUT;
     }
-    if (!known_output(output)) {
+    if (image_format_of(output) == IMAGE_FORMAT_UNKNOWN) {
         fprintf(stderr, "rtspheres merge: cannot tell the format of '%s'; use .exr (or .hdr, .png, .jpg, .tif for "
                         "the colour only)\n", output);
         return EXIT_BAD_INPUT;
@@ -158,13 +103,13 @@ int command_merge(int argc, char **argv)
     char **parts = argv + optind;
     int part_count = argc - optind;
     for (int i = 0; i < part_count; i++) {
-        if (strcmp(parts[i], output) == 0 || same_file(parts[i], output)) {
+        if (strcmp(parts[i], output) == 0 || path_same_file(parts[i], output)) {
             fprintf(stderr, "rtspheres merge: the output '%s' is one of the parts; refusing to overwrite it\n",
                     output);
             return EXIT_BAD_INPUT;
         }
         for (int j = 0; j < i; j++)
-            if (strcmp(parts[i], parts[j]) == 0 || same_file(parts[i], parts[j])) {
+            if (strcmp(parts[i], parts[j]) == 0 || path_same_file(parts[i], parts[j])) {
                 fprintf(stderr, "rtspheres merge: '%s' and '%s' are the same file; its samples would count twice\n",
                         parts[j], parts[i]);
                 return EXIT_BAD_INPUT;

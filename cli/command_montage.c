@@ -4,17 +4,15 @@
  * writer's sRGB encoding gives PNG tiles back as they were. Exit codes: 0 ok, 1 runtime
  * failure (write failed, out of memory), 2 bad input (usage, unreadable or mismatched
  * images, -o naming an input). */
-#include <errno.h>
 #include <getopt.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 #include "commands.h"
 #include "image_io.h"
+#include "paths.h"
 #include "postprocess.h"
 
 #define DEFAULT_GAP 2
@@ -43,37 +41,11 @@ static void print_help(FILE *stream)
             DEFAULT_GAP);
 }
 
-/* True when the two paths name the same existing file. */
-static bool same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-}
-
-/* Returns path's extension including the dot, or "" when its last component has none. */
-static const char *extension_of(const char *path)
-{
-    const char *dot = strrchr(path, '.');
-    return dot != NULL && strchr(dot, '/') == NULL ? dot : "";
-}
-
-/* True for the formats image_write knows, so a bad -o is refused before any image is read. */
-static bool known_output(const char *path)
-{
-    static const char *const extensions[] = {".exr", ".hdr", ".png", ".jpg", ".jpeg", ".tif", ".tiff"};
-    for (size_t i = 0; i < sizeof extensions / sizeof extensions[0]; i++)
-        if (strcasecmp(extension_of(path), extensions[i]) == 0)
-            return true;
-    return false;
-}
-
 /* Parses text as a whole number in [0, maximum] into *value. Returns false when it is not. */
 static bool parse_count(const char *text, int maximum, int *value)
 {
-    char *end;
-    errno = 0;
-    long parsed = strtol(text, &end, 10);
-    if (errno != 0 || end == text || *end != '\0' || parsed < 0 || parsed > maximum)
+    long long parsed;
+    if (command_parse_integer(text, 0, maximum, &parsed) != 0)
         return false;
     *value = (int)parsed;
     return true;
@@ -113,15 +85,14 @@ int command_montage(int argc, char **argv)
             }
             break;
         case 'q': quiet = true; break;
-        case 'h': print_help(stdout); return EXIT_OK;
-        default: print_help(stderr); return EXIT_BAD_INPUT;
+        default: return command_help_exit(option, print_help);
         }
     }
     if (output == NULL) {
         fprintf(stderr, "rtspheres montage: no output; give -o SHEET.png\n");
         return EXIT_BAD_INPUT;
     }
-    if (!known_output(output)) {
+    if (image_format_of(output) == IMAGE_FORMAT_UNKNOWN) {
         fprintf(stderr, "rtspheres montage: cannot tell the format of '%s'; use .png, .jpg, .tif, .exr or .hdr\n",
                 output);
         return EXIT_BAD_INPUT;
@@ -133,7 +104,7 @@ int command_montage(int argc, char **argv)
     char **paths = argv + optind;
     int count = argc - optind;
     for (int i = 0; i < count; i++)
-        if (strcmp(paths[i], output) == 0 || same_file(paths[i], output)) {
+        if (strcmp(paths[i], output) == 0 || path_same_file(paths[i], output)) {
             fprintf(stderr, "rtspheres montage: the output '%s' is one of the inputs; refusing to overwrite it\n",
                     output);
             return EXIT_BAD_INPUT;

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "image_io.h"
+#include "metadata_keys.h"
 
 static void print_help(FILE *stream)
 {
@@ -19,11 +20,7 @@ static void print_help(FILE *stream)
                     "rtspheres:* metadata of the file, one 'metadata NAME: VALUE' line each.\n");
 }
 
-static const char *const metadata_names[] = {
-    "rtspheres:version", "rtspheres:scene", "rtspheres:scene_hash", "rtspheres:frame", "rtspheres:spp", "rtspheres:seed", "rtspheres:max_depth",
-    "rtspheres:sample_start", "rtspheres:samples_finished", "rtspheres:path_segments", "rtspheres:complete",
-    "rtspheres:render_seconds", "rtspheres:merged_parts",
-};
+static const char *const metadata_names[METADATA_KEY_COUNT] = METADATA_KEYS_IN_STATS_ORDER;
 
 int command_stats(int argc, char **argv)
 {
@@ -47,12 +44,8 @@ int command_stats(int argc, char **argv)
             cropped = true;
             break;
         }
-        case 'h':
-            print_help(stdout);
-            return EXIT_OK;
         default:
-            print_help(stderr);
-            return EXIT_BAD_INPUT;
+            return command_help_exit(option, print_help);
         }
     }
     if (optind + 1 != argc) {

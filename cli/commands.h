@@ -8,6 +8,8 @@
 #ifndef RT_COMMANDS_H
 #define RT_COMMANDS_H
 
+#include <stdio.h>
+
 int command_render(int argc, char **argv);
 int command_diff(int argc, char **argv);
 int command_info(int argc, char **argv);
@@ -20,7 +22,18 @@ int command_montage(int argc, char **argv);
 #define EXIT_RUNTIME 1
 #define EXIT_BAD_INPUT 2
 
+/* Helpers every command uses (cli/command_support.c). */
+
 /* Maps a core status to the exit code above. */
 int exit_code_for_status(int status);
+
+/* Parses all of text as a decimal whole number in [minimum, maximum] into *value.
+ * Returns 0, or -1 (and leaves *value) when it is not one. */
+int command_parse_integer(const char *text, long long minimum, long long maximum, long long *value);
+
+/* What a command does with -h/--help (option 'h': the help on stdout, exit 0) and with an
+ * unknown option (any other: the help on stderr after getopt's message, exit 2). Returns
+ * the exit code. */
+int command_help_exit(int option, void (*print_help)(FILE *stream));
 
 #endif

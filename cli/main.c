@@ -4,7 +4,6 @@
 #include <string.h>
 
 #include "commands.h"
-#include "status.h"
 #include "version.h"
 
 static void print_usage(FILE *stream)
@@ -24,17 +23,14 @@ static void print_usage(FILE *stream)
             "Run 'rtspheres COMMAND --help' for a command's options.\n");
 }
 
-int exit_code_for_status(int status)
-{
-    switch ((rt_status)status) {
-    case RT_OK: return EXIT_OK;
-    case RT_ERROR_INPUT: return EXIT_BAD_INPUT;
-    case RT_ERROR_RUNTIME:
-    case RT_ERROR_NO_DEVICE:
-    case RT_ERROR_INTERRUPTED: return EXIT_RUNTIME;
-    }
-    return EXIT_RUNTIME;
-}
+/* The subcommands by name. */
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+} commands[] = {
+    {"render", command_render}, {"diff", command_diff},   {"info", command_info},
+    {"stats", command_stats},   {"merge", command_merge}, {"montage", command_montage},
+};
 
 int main(int argc, char **argv)
 {
@@ -43,18 +39,9 @@ int main(int argc, char **argv)
         return EXIT_BAD_INPUT;
     }
     const char *command = argv[1];
-    if (strcmp(command, "render") == 0)
-        return command_render(argc - 1, argv + 1);
-    if (strcmp(command, "diff") == 0)
-        return command_diff(argc - 1, argv + 1);
-    if (strcmp(command, "info") == 0)
-        return command_info(argc - 1, argv + 1);
-    if (strcmp(command, "stats") == 0)
-        return command_stats(argc - 1, argv + 1);
-    if (strcmp(command, "merge") == 0)
-        return command_merge(argc - 1, argv + 1);
-    if (strcmp(command, "montage") == 0)
-        return command_montage(argc - 1, argv + 1);
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(command, commands[i].name) == 0)
+            return commands[i].run(argc - 1, argv + 1);
     if (strcmp(command, "--help") == 0 || strcmp(command, "-h") == 0 || strcmp(command, "help") == 0) {
         print_usage(stdout);
         return EXIT_OK;

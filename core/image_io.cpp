@@ -608,6 +608,23 @@ image_write_options image_write_options_defaults(void)
     return options;
 }
 
+image_format image_format_of(const char *path)
+{
+    file_kind kind = file_kind::unknown;
+    try {
+        kind = kind_of_extension(extension_of(path != nullptr ? path : ""));
+    } catch (...) {
+        /* Only an allocation can fail here; a name that cannot be examined has no format. */
+    }
+    switch (kind) {
+    case file_kind::exr: return IMAGE_FORMAT_EXR;
+    case file_kind::hdr: return IMAGE_FORMAT_HDR;
+    case file_kind::eight_bit: return IMAGE_FORMAT_EIGHT_BIT;
+    case file_kind::unknown: break;
+    }
+    return IMAGE_FORMAT_UNKNOWN;
+}
+
 rt_status image_create(rt_image *image, int width, int height, int channels, rt_error *error)
 {
     memset(image, 0, sizeof *image);

@@ -48,7 +48,8 @@ typedef enum image_attribute_type {
     IMAGE_ATTRIBUTE_FLOAT,
 } image_attribute_type;
 
-/* One metadata entry, e.g. {"rtspheres:spp", IMAGE_ATTRIBUTE_INT, .int_value = 64}. */
+/* One metadata entry, e.g. {METADATA_KEY_SPP, IMAGE_ATTRIBUTE_INT, .int_value = 64} (the
+ * rtspheres keys are in metadata_keys.h). */
 typedef struct image_attribute {
     const char *name;
     image_attribute_type type;
@@ -63,8 +64,20 @@ typedef struct image_write_options {
     int attribute_count;
 } image_write_options;
 
+/* The formats image_write() writes, as listed above. */
+typedef enum image_format {
+    IMAGE_FORMAT_UNKNOWN = 0,    /* an extension image_write() refuses, or none */
+    IMAGE_FORMAT_EXR,            /* .exr */
+    IMAGE_FORMAT_HDR,            /* .hdr */
+    IMAGE_FORMAT_EIGHT_BIT,      /* .png .jpg .jpeg .tif .tiff */
+} image_format;
+
 /* Returns options with every field at its default (all zero). */
 image_write_options image_write_options_defaults(void);
+
+/* Returns the format image_write() picks for path by its extension (case-insensitive, of
+ * the last path component), so callers can refuse an output before they work for it. */
+image_format image_format_of(const char *path);
 
 /* Allocates a width x height x channels image filled with zeros, with default channel
  * names. Returns RT_ERROR_RUNTIME when memory runs out. Free with image_free(). */

@@ -2,6 +2,7 @@
 #include "merge.h"
 
 #include "array.h"
+#include "metadata_keys.h"
 
 #include <errno.h>
 #include <math.h>
@@ -183,8 +184,8 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
                             "MERGE: '%s' has no 'samples' channel, so its pixels cannot be weighted; merge EXR "
                             "parts written by rtspheres render", name);
     if (metadata->spp <= 0)
-        return rt_error_set(error, RT_ERROR_INPUT, "MERGE: '%s' has rtspheres:spp %lld; it must be at least 1",
-                            name, metadata->spp);
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "MERGE: '%s' has " METADATA_KEY_SPP " %lld; it must be at least 1", name, metadata->spp);
 
     /* full_width 0 means the image is the full image. */
     int full_width = image->full_width > 0 ? image->full_width : image->width;
@@ -517,33 +518,33 @@ rt_status merge_read_part(const char *path, rt_image *image, merge_metadata *met
     long long number;
     unsigned long long whole;
     /* scene_hash first: when it is absent the file is no rtspheres part at all. */
-    if ((status = read_text(path, "rtspheres:scene_hash", true, metadata->scene_hash, MERGE_TEXT_MAX, error))
+    if ((status = read_text(path, METADATA_KEY_SCENE_HASH, true, metadata->scene_hash, MERGE_TEXT_MAX, error))
             != RT_OK
-        || (status = read_text(path, "rtspheres:scene", false, metadata->scene, MERGE_TEXT_MAX, error)) != RT_OK
-        || (status = read_text(path, "rtspheres:seed", true, text, sizeof text, error)) != RT_OK
-        || (status = parse_whole(path, "rtspheres:seed", text, 0, UINT32_MAX, &metadata->seed, NULL, error))
+        || (status = read_text(path, METADATA_KEY_SCENE, false, metadata->scene, MERGE_TEXT_MAX, error)) != RT_OK
+        || (status = read_text(path, METADATA_KEY_SEED, true, text, sizeof text, error)) != RT_OK
+        || (status = parse_whole(path, METADATA_KEY_SEED, text, 0, UINT32_MAX, &metadata->seed, NULL, error))
                != RT_OK
-        || (status = read_text(path, "rtspheres:max_depth", true, text, sizeof text, error)) != RT_OK
-        || (status = parse_whole(path, "rtspheres:max_depth", text, 1, INT32_MAX, NULL, &number, error)) != RT_OK)
+        || (status = read_text(path, METADATA_KEY_MAX_DEPTH, true, text, sizeof text, error)) != RT_OK
+        || (status = parse_whole(path, METADATA_KEY_MAX_DEPTH, text, 1, INT32_MAX, NULL, &number, error)) != RT_OK)
         goto failed;
     metadata->max_depth = (int)number;
-    if ((status = read_text(path, "rtspheres:frame", true, text, sizeof text, error)) != RT_OK
-        || (status = parse_whole(path, "rtspheres:frame", text, -1, INT32_MAX, NULL, &number, error)) != RT_OK)
+    if ((status = read_text(path, METADATA_KEY_FRAME, true, text, sizeof text, error)) != RT_OK
+        || (status = parse_whole(path, METADATA_KEY_FRAME, text, -1, INT32_MAX, NULL, &number, error)) != RT_OK)
         goto failed;
     metadata->frame = (int)number;
-    if ((status = read_text(path, "rtspheres:sample_start", true, text, sizeof text, error)) != RT_OK
-        || (status = parse_whole(path, "rtspheres:sample_start", text, 0, UINT32_MAX, &metadata->sample_start,
+    if ((status = read_text(path, METADATA_KEY_SAMPLE_START, true, text, sizeof text, error)) != RT_OK
+        || (status = parse_whole(path, METADATA_KEY_SAMPLE_START, text, 0, UINT32_MAX, &metadata->sample_start,
                                  NULL, error)) != RT_OK
-        || (status = read_text(path, "rtspheres:spp", true, text, sizeof text, error)) != RT_OK
-        || (status = parse_whole(path, "rtspheres:spp", text, 1, UINT32_MAX, NULL, &metadata->spp, error)) != RT_OK
-        || (status = read_text(path, "rtspheres:complete", true, text, sizeof text, error)) != RT_OK
-        || (status = parse_whole(path, "rtspheres:complete", text, 0, 1, &whole, NULL, error)) != RT_OK)
+        || (status = read_text(path, METADATA_KEY_SPP, true, text, sizeof text, error)) != RT_OK
+        || (status = parse_whole(path, METADATA_KEY_SPP, text, 1, UINT32_MAX, NULL, &metadata->spp, error)) != RT_OK
+        || (status = read_text(path, METADATA_KEY_COMPLETE, true, text, sizeof text, error)) != RT_OK
+        || (status = parse_whole(path, METADATA_KEY_COMPLETE, text, 0, 1, &whole, NULL, error)) != RT_OK)
         goto failed;
     metadata->complete = whole == 1;
     /* Only carried into the merged file's totals; a part without them still merges. */
-    read_text(path, "rtspheres:render_seconds", false, text, sizeof text, NULL);
+    read_text(path, METADATA_KEY_RENDER_SECONDS, false, text, sizeof text, NULL);
     metadata->render_seconds = text[0] ? strtod(text, NULL) : 0;
-    read_text(path, "rtspheres:path_segments", false, text, sizeof text, NULL);
+    read_text(path, METADATA_KEY_PATH_SEGMENTS, false, text, sizeof text, NULL);
     metadata->path_segments = text[0] ? strtod(text, NULL) : 0;
     return RT_OK;
 

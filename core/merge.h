@@ -39,7 +39,8 @@
 #define MERGE_MAX_WARNINGS 8
 #define MERGE_WARNING_MAX 512
 
-/* The rtspheres:* metadata of one part that the merge checks or carries over. */
+/* The rtspheres:* metadata of one part that the merge checks or carries over (the keys
+ * and what they hold: metadata_keys.h). */
 typedef struct merge_metadata {
     char scene[MERGE_TEXT_MAX];          /* rtspheres:scene, the scene file's path */
     char scene_hash[MERGE_TEXT_MAX];     /* rtspheres:scene_hash */

@@ -1,0 +1,35 @@
+/* render_arguments.h: the options of `rtspheres render` turned into a render job
+ * (core/render_job.h) plus what only the command uses (quiet, verbose, the device). The
+ * rules between options that are the job's (crop with tile, shards, ...) are checked by
+ * render_job_check(); here only what the command line itself can get wrong: a value's
+ * syntax and range, the scene and output being there.
+ */
+#ifndef RT_RENDER_ARGUMENTS_H
+#define RT_RENDER_ARGUMENTS_H
+
+#include <stdbool.h>
+
+#include "batch.h"
+#include "render_job.h"
+
+#define RENDER_ARGUMENTS_MAX_DEFINES 256
+
+typedef struct render_arguments {
+    render_job job;              /* its frames and defines point into this struct */
+    bool quiet, verbose;
+    int device;                  /* --device N, or -1: let gpu.h choose */
+    frame_list frames;
+    scene_define defines[RENDER_ARGUMENTS_MAX_DEFINES];
+    char *define_copies[RENDER_ARGUMENTS_MAX_DEFINES];  /* NAME\0VALUE of each -D */
+} render_arguments;
+
+/* Parses argv (argv[0] is "render") into *arguments (initialised here; free with
+ * render_arguments_free() whatever the result). Returns EXIT_OK, or an exit code after
+ * printing why on stderr; *help_shown is set when --help printed the help (then nothing
+ * else is to be done). */
+int render_arguments_parse(int argc, char **argv, render_arguments *arguments, bool *help_shown);
+
+/* Frees what parsing allocated and zeroes *arguments. */
+void render_arguments_free(render_arguments *arguments);
+
+#endif

@@ -1,0 +1,52 @@
+/* metadata_keys.h: the names of the rtspheres:* metadata in the EXR files rtspheres writes,
+ * spelled once. The writer is core/render_output.c (for renders, their partial files and
+ * merges); the readers are core/merge.c (merge_read_part), core/render_output.c (resuming
+ * a partial) and cli/command_stats.c.
+ *
+ *   key               type      what it says
+ *   version           string    the rtspheres version that wrote the file
+ *   scene             string    the scene file's path, as given
+ *   scene_hash        string    render_result.scene_hash as 16 hex digits
+ *   spp               int       the samples per pixel asked for (a merge: the fewest any
+ *                               pixel has)
+ *   sample_start      text      the first sample index (decimal; may pass 2^31)
+ *   seed              text      the random seed (decimal)
+ *   max_depth         int       path segments per sample at most
+ *   frame             int       the frame number, -1 without --frames
+ *   samples_finished  text      samples finished over all pixels (decimal)
+ *   path_segments     text      rays traced (decimal)
+ *   complete          int       1 when every sample asked for ran, else 0
+ *   render_seconds    float     the render's time (a merge: summed over its parts)
+ *   merged_parts      int       only in a merge's output: how many parts it merged
+ * "text" values are whole numbers stored as decimal text, since an OpenEXR int attribute
+ * holds 32 bits only.
+ */
+#ifndef RT_METADATA_KEYS_H
+#define RT_METADATA_KEYS_H
+
+#define METADATA_KEY_VERSION "rtspheres:version"
+#define METADATA_KEY_SCENE "rtspheres:scene"
+#define METADATA_KEY_SCENE_HASH "rtspheres:scene_hash"
+#define METADATA_KEY_SPP "rtspheres:spp"
+#define METADATA_KEY_SAMPLE_START "rtspheres:sample_start"
+#define METADATA_KEY_SEED "rtspheres:seed"
+#define METADATA_KEY_MAX_DEPTH "rtspheres:max_depth"
+#define METADATA_KEY_FRAME "rtspheres:frame"
+#define METADATA_KEY_SAMPLES_FINISHED "rtspheres:samples_finished"
+#define METADATA_KEY_PATH_SEGMENTS "rtspheres:path_segments"
+#define METADATA_KEY_COMPLETE "rtspheres:complete"
+#define METADATA_KEY_RENDER_SECONDS "rtspheres:render_seconds"
+#define METADATA_KEY_MERGED_PARTS "rtspheres:merged_parts"
+
+/* Every key, in the order `rtspheres stats` prints them: an initializer for an array of
+ * METADATA_KEY_COUNT strings. */
+#define METADATA_KEY_COUNT 13
+#define METADATA_KEYS_IN_STATS_ORDER                                                                         \
+    {                                                                                                        \
+        METADATA_KEY_VERSION, METADATA_KEY_SCENE, METADATA_KEY_SCENE_HASH, METADATA_KEY_FRAME, METADATA_KEY_SPP, \
+            METADATA_KEY_SEED, METADATA_KEY_MAX_DEPTH, METADATA_KEY_SAMPLE_START, METADATA_KEY_SAMPLES_FINISHED, \
+            METADATA_KEY_PATH_SEGMENTS, METADATA_KEY_COMPLETE, METADATA_KEY_RENDER_SECONDS,                   \
+            METADATA_KEY_MERGED_PARTS,                                                                       \
+    }
+
+#endif

@@ -1,0 +1,364 @@
+/* render_job.c: the running half of render_job.h: each image's scene, render, post-processing
+ * and files. The planning half is render_job_plan.c, the files' format render_output.c. */
+#include "render_job.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "clock.h"
+#include "image_io.h"
+#include "paths.h"
+#include "render_output.h"
+#include "scene_assets.h"
+
+/* One run of a job: what every image needs. */
+typedef struct job_run {
+    gpu_context *context;
+    const render_job *job;
+    render_job_plan plan;
+    render_job_callbacks callbacks;      /* the caller's, or all NULL */
+    render_job_failure failure;          /* where the run stopped short */
+} job_run;
+
+/* One image being rendered: its scene (render settings after the job's overrides and
+ * plan) and its plan. */
+typedef struct job_image {
+    job_run *run;
+    scene scene;
+    render_job_image plan;
+} job_image;
+
+/* Loads the scene with the variables of frame (-1: none) and its assets into *s. On
+ * failure *s is freed, and run->failure says whether the scene's own message is the error. */
+static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
+{
+    const render_job *job = run->job;
+    scene_define *defines = malloc(((size_t)job->define_count + 2) * sizeof *defines);
+    if (defines == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory for the scene's variables");
+    run->failure = RENDER_JOB_FAILURE_SCENE;
+    render_job_frame_values values;
+    scene_parse_options parse_options = scene_parse_options_defaults();
+    parse_options.defines = defines;
+    parse_options.define_count = render_job_scene_defines(job, frame, defines, &values);
+    rt_status status = scene_load_file(job->scene_path, &parse_options, s, error);
+    free(defines);
+    if (status == RT_OK) {
+        status = scene_load_assets(s, error);
+        if (status != RT_OK)
+            scene_free(s);
+    }
+    return status;
+}
+
+/* Writes pixels (R, G, B means, samples, of the image's region) to path with the
+ * metadata of image; complete says whether every sample ran. result gives the AOV
+ * layers, region, path segments, scene hash and time. */
+static rt_status write_image(const job_image *image, const rt_image *pixels, const char *path, uint64_t samples,
+                             bool complete, const render_result *result, rt_error *error)
+{
+    const render_job *job = image->run->job;
+    const scene_render_settings *settings = &image->scene.render;
+    rt_image placed = *pixels;
+    placed.x = result->region[0];
+    placed.y = result->region[1];
+    placed.full_width = settings->width;
+    placed.full_height = settings->height;
+    char hash[24];
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)result->scene_hash);
+    render_output_metadata metadata = {
+        .scene = job->scene_path,
+        .scene_hash = hash,
+        .spp = settings->samples_per_pixel,
+        .sample_start = image->plan.sample_start,
+        .seed = settings->seed,
+        .max_depth = settings->max_depth,
+        .frame = image->plan.frame,
+        .samples_finished = samples,
+        .path_segments = result->path_segments,
+        .complete = complete,
+        .render_seconds = result->seconds,
+    };
+    /* With a tone-mapping operator the exposure was applied before it (postprocess). */
+    float exposure = job->tonemap != TONEMAP_CLAMP ? 0.0f : (float)job->exposure;
+    return render_output_write(path, &placed, &result->aovs, &metadata, exposure, error);
+}
+
+/* render_options.checkpoint: writes the image so far to the partial file. */
+static rt_status write_checkpoint(void *context, const rt_image *partial, uint64_t samples, uint64_t scene_hash,
+                                  rt_error *error)
+{
+    const job_image *image = context;
+    render_result result = {.scene_hash = scene_hash};
+    memcpy(result.region, image->plan.window, sizeof result.region);
+    rt_status status = write_image(image, partial, image->plan.partial, samples, false, &result, error);
+    const render_job_callbacks *callbacks = &image->run->callbacks;
+    if (status == RT_OK && callbacks->checkpoint_written != NULL)
+        callbacks->checkpoint_written(callbacks->user, &image->plan, samples);
+    return status;
+}
+
+/* Copies channels [first, first + count) of image into a new image (*out; the caller
+ * frees it). */
+static rt_status copy_channels(const rt_image *image, int first, int count, rt_image *out, rt_error *error)
+{
+    rt_status status = image_create(out, image->width, image->height, count, error);
+    if (status != RT_OK)
+        return status;
+    size_t pixels = (size_t)image->width * image->height;
+    for (size_t i = 0; i < pixels; i++)
+        for (int c = 0; c < count; c++)
+            out->pixels[i * count + c] = image->pixels[i * image->channels + first + c];
+    return RT_OK;
+}
+
+/* Denoises colour guided by the result's AOVs and adds the noisy colour to the AOVs as
+ * noisy.R/G/B, so an EXR keeps it. */
+static rt_status denoise(rt_image *colour, render_result *result, rt_error *error)
+{
+    rt_image albedo = {0}, normal = {0}, depth = {0}, noisy = {0}, joined = {0};
+    rt_status status = copy_channels(&result->image, 0, 3, &noisy, error);
+    if (status == RT_OK)
+        status = copy_channels(&result->aovs, 0, 3, &albedo, error);
+    if (status == RT_OK)
+        status = copy_channels(&result->aovs, 3, 3, &normal, error);
+    if (status == RT_OK)
+        status = copy_channels(&result->aovs, 6, 1, &depth, error);
+    if (status == RT_OK)
+        status = postprocess_denoise(colour, &albedo, &normal, &depth, NULL, error);
+    if (status == RT_OK) {
+        static const char *const names[3] = {"noisy.R", "noisy.G", "noisy.B"};
+        for (int c = 0; c < 3; c++)
+            snprintf(noisy.channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", names[c]);
+        status = image_append_channels(&result->aovs, &noisy, &joined, error);
+    }
+    if (status == RT_OK) {
+        image_free(&result->aovs);
+        result->aovs = joined;
+        joined = (rt_image){0};
+    }
+    image_free(&albedo);
+    image_free(&normal);
+    image_free(&depth);
+    image_free(&noisy);
+    image_free(&joined);
+    return status;
+}
+
+/* Applies denoise, blur and tone mapping (8-bit outputs only) to the result's colour, in
+ * that order. */
+static rt_status postprocess_result(const render_job *job, const char *output, render_result *result,
+                                    rt_error *error)
+{
+    bool tonemap = image_format_of(output) == IMAGE_FORMAT_EIGHT_BIT && job->tonemap != TONEMAP_CLAMP;
+    if (!job->denoise && job->blur_sigma <= 0 && !tonemap)
+        return RT_OK;
+    rt_image colour;
+    rt_status status = copy_channels(&result->image, 0, 3, &colour, error);
+    if (status == RT_OK && job->denoise)
+        status = denoise(&colour, result, error);
+    if (status == RT_OK && job->blur_sigma > 0)
+        status = postprocess_gaussian_blur(&colour, job->blur_sigma, job->blur_passes > 0 ? job->blur_passes : 1,
+                                           error);
+    /* The writer's exposure would apply a second time after tone mapping: done here. */
+    if (status == RT_OK && tonemap)
+        status = postprocess_tonemap(&colour, job->tonemap, (float)job->exposure, error);
+    if (status == RT_OK) {
+        size_t pixels = (size_t)colour.width * colour.height;
+        for (size_t i = 0; i < pixels; i++)
+            for (int c = 0; c < 3; c++)
+                result->image.pixels[4 * i + c] = colour.pixels[3 * i + c];
+    }
+    image_free(&colour);
+    return status;
+}
+
+/* After the passes: post-processes the result and writes it, to the output when the
+ * render finished, else (render_status RT_ERROR_INTERRUPTED) to the partial file, which
+ * the message then names. */
+static rt_status finish_image(job_image *image, render_result *result, rt_status render_status, rt_error *error)
+{
+    const render_job_image *plan = &image->plan;
+    rt_status status = postprocess_result(image->run->job, plan->output, result, error);
+    if (status != RT_OK)
+        return status;
+    if (render_status == RT_ERROR_INTERRUPTED) {
+        /* The partial goes next to the output, never over it: the user's last good image
+         * stays, and --resume continues from the partial. */
+        rt_error write_error = {{0}};
+        if (write_image(image, &result->image, plan->partial, result->samples, false, result, &write_error) != RT_OK)
+            return rt_error_set(error, RT_ERROR_INTERRUPTED, "interrupted, and the partial could not be written: %s",
+                                write_error.message);
+        return rt_error_set(error, RT_ERROR_INTERRUPTED,
+                            "interrupted: wrote the %llu samples finished so far to %s; continue with --resume %s",
+                            (unsigned long long)result->samples, plan->partial, plan->partial);
+    }
+    status = write_image(image, &result->image, plan->output, result->samples, true, result, error);
+    if (status != RT_OK)
+        return status;
+    /* The checkpoint is ours and now superseded by the complete image. */
+    unlink(plan->partial);
+    const render_job_callbacks *callbacks = &image->run->callbacks;
+    if (callbacks->image_written != NULL)
+        callbacks->image_written(callbacks->user, plan, result);
+    return RT_OK;
+}
+
+/* Fills *options for the image: the job's tracer settings with the image's samples and
+ * region, the progress and stop of the run, and the checkpoint writer. */
+static void image_render_options(job_image *image, render_options *options)
+{
+    const render_job *job = image->run->job;
+    const render_job_callbacks *callbacks = &image->run->callbacks;
+    *options = job->tracer;
+    options->sample_start = image->plan.sample_start;
+    memcpy(options->region, image->plan.region, sizeof options->region);
+    options->aovs = job->aovs || job->denoise;
+    options->progress = callbacks->progress;
+    options->progress_context = callbacks->user;
+    options->stop_requested = job->stop_requested;
+    options->resume = NULL;
+    options->resume_scene_hash = 0;
+    options->checkpoint_seconds = 0;
+    options->checkpoint = NULL;
+    options->checkpoint_context = NULL;
+    if (job->checkpoint_seconds > 0) {
+        options->checkpoint_seconds = job->checkpoint_seconds;
+        options->checkpoint = write_checkpoint;
+        options->checkpoint_context = image;
+    }
+}
+
+/* Renders the scene of image (loaded and planned) and finishes it. */
+static rt_status render_image(job_image *image, rt_error *error)
+{
+    job_run *run = image->run;
+    const render_job *job = run->job;
+    render_options options;
+    image_render_options(image, &options);
+    rt_image resume_image = {0};
+    if (job->resume_path != NULL) {
+        render_output_resume_check check = {.seed = image->scene.render.seed,
+                                            .sample_start = image->plan.sample_start,
+                                            .spp = image->scene.render.samples_per_pixel};
+        memcpy(check.region, image->plan.window, sizeof check.region);
+        rt_status status =
+            render_output_read_partial(job->resume_path, &check, &resume_image, &options.resume_scene_hash, error);
+        if (status != RT_OK)
+            return status;
+        options.resume = &resume_image;
+    }
+    if (run->callbacks.render_started != NULL)
+        run->callbacks.render_started(run->callbacks.user, &image->plan);
+    render_result result;
+    rt_status status = render_scene(run->context, &image->scene, &options, &result, error);
+    if (run->callbacks.render_finished != NULL)
+        run->callbacks.render_finished(run->callbacks.user, &image->plan, status);
+    if (status == RT_OK || status == RT_ERROR_INTERRUPTED) {
+        status = finish_image(image, &result, status, error);
+        image_free(&result.image);
+        image_free(&result.aovs);
+    }
+    image_free(&resume_image);
+    return status;
+}
+
+/* Renders one image of the job (frame -1: the job has no frames) to output. */
+static rt_status run_image(job_run *run, int frame, const char *output, rt_error *error)
+{
+    const render_job *job = run->job;
+    run->failure = RENDER_JOB_FAILURE_IMAGE;
+    job_image *image = calloc(1, sizeof *image);
+    if (image == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory");
+    image->run = run;
+    rt_status status = load_scene(run, frame, &image->scene, error);
+    if (status != RT_OK) {
+        free(image);
+        return status;
+    }
+    run->failure = RENDER_JOB_FAILURE_IMAGE;
+    scene *s = &image->scene;
+    /* Asset warnings (a missing MTL file, ...): once, with the first frame of the list. */
+    bool first_frame = frame < 0 || frame == job->frames[0];
+    for (int i = 0; i < s->warning_count && first_frame && run->callbacks.warning != NULL; i++)
+        run->callbacks.warning(run->callbacks.user, s->warnings[i].message);
+    render_job_apply_overrides(job, &s->render);
+    image->plan.output = output;
+    render_output_partial_path(output, image->plan.partial, sizeof image->plan.partial);
+    status = render_job_plan_image(job, &run->plan, &s->render, frame, &image->plan, error);
+    if (status == RT_OK) {
+        s->render.samples_per_pixel = image->plan.samples_per_pixel;
+        status = render_image(image, error);
+    }
+    if (status == RT_OK)
+        run->failure = RENDER_JOB_FAILURE_NONE;
+    scene_free(s);
+    free(image);
+    return status;
+}
+
+/* True when the caller asked the job to stop. */
+static bool stop_requested(const render_job *job)
+{
+    return job->stop_requested != NULL && *job->stop_requested;
+}
+
+/* Renders the job's frames in order, those of its shard only; stops at the first failure
+ * and at a stop request between frames. */
+static rt_status run_frames(job_run *run, render_job_summary *summary, rt_error *error)
+{
+    const render_job *job = run->job;
+    rt_status status = RT_OK;
+    for (int i = 0; i < job->frame_count && status == RT_OK && !stop_requested(job); i++) {
+        if (!render_job_includes_frame(job, &run->plan, i))
+            continue;
+        int frame = job->frames[i];
+        char name[RENDER_JOB_PATH_MAX];
+        run->failure = RENDER_JOB_FAILURE_IMAGE;
+        status = render_job_output_name(job, &run->plan, frame, name, sizeof name, error);
+        if (status != RT_OK)
+            break;
+        if (path_same_file(name, job->scene_path)) {
+            status = rt_error_set(error, RT_ERROR_INPUT,
+                                  "frame %d's output '%s' is the scene file; refusing to overwrite it", frame, name);
+            break;
+        }
+        summary->images_started++;
+        status = run_image(run, frame, name, error);
+    }
+    if (status == RT_OK && stop_requested(job)) {
+        run->failure = RENDER_JOB_FAILURE_STOPPED;
+        status = rt_error_set(error, RT_ERROR_INTERRUPTED, "interrupted between frames; every frame begun is written");
+    }
+    return status;
+}
+
+rt_status render_job_run(gpu_context *context, const render_job *job, const render_job_callbacks *callbacks,
+                         render_job_summary *summary, rt_error *error)
+{
+    render_job_summary ignored;
+    if (summary == NULL)
+        summary = &ignored;
+    memset(summary, 0, sizeof *summary);
+    job_run run = {.context = context, .job = job};
+    if (callbacks != NULL)
+        run.callbacks = *callbacks;
+    rt_status status = render_job_check(job, &run.plan, error);
+    if (status != RT_OK) {
+        summary->failure = RENDER_JOB_FAILURE_PLAN;
+        return status;
+    }
+    double start = clock_seconds();
+    if (job->frame_count == 0) {
+        summary->images_started = 1;
+        status = run_image(&run, -1, run.plan.first_output, error);
+    } else {
+        status = run_frames(&run, summary, error);
+    }
+    summary->seconds = clock_seconds() - start;
+    summary->failure = status == RT_OK ? RENDER_JOB_FAILURE_NONE : run.failure;
+    return status;
+}

@@ -1,0 +1,217 @@
+/* render_job_plan.c: the planning half of render_job.h: the rules between a job's fields,
+ * its output names, and each image's samples and region. No GPU; the only file-system
+ * look-ups are render_job_check()'s checks of the first output. */
+#include "render_job.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "batch.h"
+#include "image_io.h"
+#include "paths.h"
+
+render_job render_job_defaults(void)
+{
+    return (render_job){0};
+}
+
+const char *render_job_shard_kind_name(render_job_shard_kind kind)
+{
+    switch (kind) {
+    case RENDER_SHARD_AUTO: return "auto";
+    case RENDER_SHARD_FRAMES: return "frames";
+    case RENDER_SHARD_SAMPLES: return "samples";
+    case RENDER_SHARD_TILES: return "tiles";
+    }
+    return "auto";
+}
+
+/* True when the job names a crop (any of its numbers non-zero, as render.h's region). */
+static bool has_crop(const render_job *job)
+{
+    return job->crop[0] || job->crop[1] || job->crop[2] || job->crop[3];
+}
+
+/* Returns the value of the job's last define of name, or NULL. */
+static const char *last_define(const render_job *job, const char *name)
+{
+    const char *value = NULL;
+    for (int i = 0; i < job->define_count; i++)
+        if (strcmp(job->defines[i].name, name) == 0)
+            value = job->defines[i].value;
+    return value;
+}
+
+/* Finds the first output name into plan->first_output, checking what only frames or
+ * their absence decide. */
+static rt_status plan_first_output(const render_job *job, render_job_plan *plan, rt_error *error)
+{
+    const char *time_define = last_define(job, "time");
+    if (job->frame_count > 0 && (plan->frame_define != NULL || time_define != NULL)) {
+        const char *name = plan->frame_define != NULL ? "frame" : "time";
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "-D %s and --frames both set $%s (--frames sets $frame and $time); give one", name, name);
+    }
+    int first_frame = job->frame_count > 0 ? job->frames[0] : -1;
+    rt_status status =
+        render_job_output_name(job, plan, first_frame, plan->first_output, sizeof plan->first_output, error);
+    if (status != RT_OK)
+        return status;
+    if (job->frame_count > 1 && !output_pattern_has_frame(job->output))
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "%d frames would all write '%s'; put a frame number pattern in the output, e.g. "
+                            "frame-%%04d.png", job->frame_count, job->output);
+    return RT_OK;
+}
+
+/* Checks the first output name: a format image_write() knows, a directory to write in,
+ * and not the scene file. */
+static rt_status check_first_output(const render_job *job, const char *output, rt_error *error)
+{
+    if (image_format_of(output) == IMAGE_FORMAT_UNKNOWN)
+        return rt_error_set(error, RT_ERROR_INPUT, "cannot tell the format of '%s'; use .exr, .hdr, .png, .jpg or .tif",
+                            output);
+    if (!path_directory_writable(output))
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "cannot write '%s': its directory does not exist or is not writable", output);
+    if (path_same_file(output, job->scene_path))
+        return rt_error_set(error, RT_ERROR_INPUT, "the output '%s' is the scene file; refusing to overwrite it",
+                            output);
+    return RT_OK;
+}
+
+/* Resolves the shard (its kind, and for tiles the band) into plan and checks it against
+ * the other ways of choosing frames, samples and region. */
+static rt_status plan_shard(const render_job *job, render_job_plan *plan, rt_error *error)
+{
+    if (job->shard_by != RENDER_SHARD_AUTO && job->shard_count == 0)
+        return rt_error_set(error, RT_ERROR_INPUT, "--shard-by %s does nothing without --shard I/N",
+                            render_job_shard_kind_name(job->shard_by));
+    if (job->shard_count == 0)
+        return RT_OK;
+    render_job_shard_kind by = job->shard_by;
+    if (by == RENDER_SHARD_AUTO)
+        by = job->frame_count > 1 ? RENDER_SHARD_FRAMES : RENDER_SHARD_SAMPLES;
+    plan->shard_by = by;
+    if (by == RENDER_SHARD_FRAMES && job->frame_count == 0)
+        return rt_error_set(error, RT_ERROR_INPUT, "--shard-by frames needs --frames");
+    /* As with an empty sample shard or tile: a part with nothing to render is an error,
+     * not a silent success that writes nothing. */
+    if (by == RENDER_SHARD_FRAMES && job->shard_index >= job->frame_count)
+        return rt_error_set(error, RT_ERROR_INPUT, "shard %d/%d of %d frame%s is empty; use fewer shards",
+                            job->shard_index, job->shard_count, job->frame_count, job->frame_count == 1 ? "" : "s");
+    if (by == RENDER_SHARD_SAMPLES && job->sample_count > 0)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--shard by samples and --samples both choose the samples; give one");
+    if (by == RENDER_SHARD_TILES && (has_crop(job) || job->tile_count))
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--shard by tiles and --crop/--tile both choose the region; give one");
+    if (by == RENDER_SHARD_TILES) {
+        plan->tile_index = job->shard_index;
+        plan->tile_count = job->shard_count;
+    }
+    return RT_OK;
+}
+
+rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error)
+{
+    memset(plan, 0, sizeof *plan);
+    plan->frame_define = last_define(job, "frame");
+    plan->tile_index = job->tile_index;
+    plan->tile_count = job->tile_count;
+    if (job->scene_path == NULL || job->output == NULL)
+        return rt_error_set(error, RT_ERROR_INPUT, "a render job needs a scene file and an output name");
+    rt_status status = plan_first_output(job, plan, error);
+    if (status == RT_OK)
+        status = check_first_output(job, plan->first_output, error);
+    if (status != RT_OK)
+        return status;
+    if (has_crop(job) && job->tile_count)
+        return rt_error_set(error, RT_ERROR_INPUT, "--crop and --tile both choose the region; give one");
+    if (job->aovs && image_format_of(plan->first_output) != IMAGE_FORMAT_EXR)
+        return rt_error_set(error, RT_ERROR_INPUT, "--aovs writes extra layers, which only .exr keeps; not '%s'",
+                            plan->first_output);
+    if (job->resume_path != NULL && job->frame_count > 1)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--resume continues one image; render the frames one at a time");
+    return plan_shard(job, plan, error);
+}
+
+bool render_job_includes_frame(const render_job *job, const render_job_plan *plan, int index)
+{
+    return !(job->shard_count && plan->shard_by == RENDER_SHARD_FRAMES && index % job->shard_count != job->shard_index);
+}
+
+rt_status render_job_output_name(const render_job *job, const render_job_plan *plan, int frame, char *name,
+                                 size_t size, rt_error *error)
+{
+    if (frame >= 0)
+        return output_pattern_format(job->output, frame, name, size, error);
+    return output_name_without_frames(job->output, plan->frame_define, name, size, error);
+}
+
+int render_job_scene_defines(const render_job *job, int frame, scene_define *defines,
+                             render_job_frame_values *values)
+{
+    int count = job->define_count;
+    if (count > 0)
+        memcpy(defines, job->defines, (size_t)count * sizeof defines[0]);
+    if (frame >= 0) {
+        double fps = job->frames_per_second > 0 ? job->frames_per_second : RENDER_JOB_DEFAULT_FRAMES_PER_SECOND;
+        snprintf(values->frame, sizeof values->frame, "%d", frame);
+        snprintf(values->time, sizeof values->time, "%.17g", frame / fps);
+        defines[count++] = (scene_define){.name = "frame", .value = values->frame, .optional = true};
+        defines[count++] = (scene_define){.name = "time", .value = values->time, .optional = true};
+    }
+    return count;
+}
+
+void render_job_apply_overrides(const render_job *job, scene_render_settings *settings)
+{
+    if (job->samples_per_pixel)
+        settings->samples_per_pixel = job->samples_per_pixel;
+    if (job->width)
+        settings->width = job->width;
+    if (job->height)
+        settings->height = job->height;
+    if (job->max_depth)
+        settings->max_depth = job->max_depth;
+    if (job->seed_set)
+        settings->seed = job->seed;
+}
+
+rt_status render_job_plan_image(const render_job *job, const render_job_plan *plan,
+                                const scene_render_settings *settings, int frame, render_job_image *image,
+                                rt_error *error)
+{
+    image->frame = frame;
+    long long start = 0, count = settings->samples_per_pixel;
+    if (job->sample_count > 0) {
+        start = job->sample_start;
+        count = job->sample_count;
+    } else if (job->shard_count && plan->shard_by == RENDER_SHARD_SAMPLES) {
+        shard_range(job->shard_index, job->shard_count, settings->samples_per_pixel, &start, &count);
+        if (count == 0)
+            return rt_error_set(error, RT_ERROR_INPUT,
+                                "shard %d/%d of %d samples per pixel is empty; use fewer shards", job->shard_index,
+                                job->shard_count, settings->samples_per_pixel);
+    }
+    image->sample_start = (uint32_t)start;
+    image->samples_per_pixel = (int)count;
+
+    memset(image->region, 0, sizeof image->region);
+    if (has_crop(job)) {
+        memcpy(image->region, job->crop, sizeof image->region);
+    } else if (plan->tile_count) {
+        long long row, rows;
+        shard_range(plan->tile_index, plan->tile_count, settings->height, &row, &rows);
+        if (rows == 0)
+            return rt_error_set(error, RT_ERROR_INPUT, "tile %d/%d of a %d-row image is empty; use fewer tiles",
+                                plan->tile_index, plan->tile_count, settings->height);
+        int band[4] = {0, (int)row, settings->width, (int)(row + rows)};
+        memcpy(image->region, band, sizeof band);
+    }
+    int whole[4] = {0, 0, settings->width, settings->height};
+    memcpy(image->window, has_crop(job) || plan->tile_count ? image->region : whole, sizeof image->window);
+    return RT_OK;
+}
