@@ -157,6 +157,9 @@ scene_material scene_material_defaults(void)
     material.albedo_texture = -1;
     material.emission_texture = -1;
     material.normal_map = -1;
+    material.metallic_roughness_texture = -1;
+    material.alpha = 1.0f;
+    material.alpha_cutoff = 0.5f;
     return material;
 }
 

@@ -119,7 +119,27 @@ typedef struct scene_material {
     float specular[3];           /* Whitted/Phong specular colour; default (0.04, 0.04, 0.04)
                                   * for lambertian, the albedo for metal */
     bool specular_set;           /* false: use the default above */
+    /* pbr: the glTF 2.0 metallic-roughness model (docs/scene-format.md); albedo is its base
+     * colour, albedo_texture its base colour texture, index_of_refraction its ior (whoever
+     * makes a pbr material sets it: glTF's default is 1.5), emission / emission_texture /
+     * normal_map as above. */
+    float metallic;              /* pbr: 0..1 */
+    float roughness;             /* pbr: perceptual roughness 0..1 (GGX alpha = roughness^2) */
+    float transmission;          /* pbr: 0..1, the share of the dielectric part transmitted
+                                  * (KHR_materials_transmission) */
+    int metallic_roughness_texture;  /* pbr: -1, or index into scene.images: roughness in
+                                  * its G channel, metallic in B (as glTF packs them) */
+    int alpha_mode;              /* pbr: SCENE_ALPHA_OPAQUE or SCENE_ALPHA_MASK */
+    float alpha;                 /* pbr: base alpha (glTF baseColorFactor's a), 1 by default */
+    float alpha_cutoff;          /* pbr, mask: where alpha is below it there is no surface */
+    bool vertex_colors;          /* pbr: the base colour is multiplied by the mesh's vertex
+                                  * colours (PLY, glTF COLOR_0) */
+    bool one_sided;              /* emissive and pbr emission: only the front face emits (the
+                                  * side the geometric normal points to); default both sides */
 } scene_material;
+
+/* pbr alpha modes (glTF's OPAQUE and MASK; BLEND is imported as MASK). */
+enum { SCENE_ALPHA_OPAQUE = 0, SCENE_ALPHA_MASK = 1 };
 
 typedef struct scene_sphere {
     float center[3];
