@@ -81,7 +81,8 @@
 #define MATERIAL_METAL 1
 #define MATERIAL_DIELECTRIC 2
 #define MATERIAL_EMISSIVE 3
-#define MATERIAL_TYPE_COUNT 4
+#define MATERIAL_PBR 4               /* glTF metallic-roughness (scene.h scene_material "pbr") */
+#define MATERIAL_TYPE_COUNT 5
 
 /* ---- primitives: one texel each (a leaf's primitives are contiguous)
  *   sphere:         (centre.xyz, radius)
