@@ -254,3 +254,33 @@ quality_compare() {
     quality_fact "$label" adaptive_seconds_for_point_rmse "$adaptive_time"
     quality_fact "$label" adaptive_time_ratio "$(ratio "$adaptive_time" "$own_time")"
 }
+
+# Renders SCENE (spheres only) in POV-Ray as NAME at SIZE, the counterpart of rtspheres'
+# Whitted frame: the scene written by tests/bench/povray_scene.py (an 8x8 area light for
+# the light sphere), trace depth DEPTH, 2x2 supersampling of every pixel (+A0.0 +AM1
+# +R2: about 4 samples a pixel, as rtspheres' 4 spp). render s is POV-Ray's own trace
+# time (parsing, a few ms here, apart), wall s the whole process.
+bench_povray() {
+    name=$1 scene=$2 size=$3 depth=$4
+    log="$work/$name.log"
+    rm -f "$work/$name.png"
+    if ! python3 tests/bench/povray_scene.py "$scene" "$work/$name.pov" >"$log" 2>&1 ||
+        ! "$work/peak_rss" povray +I"$work/$name.pov" +O"$work/$name.png" +FN +W"${size%x*}" +H"${size#*x}" -D \
+            +WT"$peer_threads" +A0.0 +AM1 +R2 >>"$log" 2>&1 || [ ! -f "$work/$name.png" ]; then
+        echo "$name: POV-Ray FAILED (see $log:)"; tr '\r' '\n' <"$log" | grep -v '^Rendered' | tail -n 3
+        failures=$((failures + 1))
+        return 0
+    fi
+    stats=$(tr '\r' '\n' <"$log" | grep -v '^Rendered')
+    trace=$(field "$stats" 's/.*Trace Time:.*(\([0-9.]*\) seconds).*/\1/p')
+    samples=$(field "$stats" 's/.*Samples: *\([0-9]*\) .*/\1/p')
+    per_pixel=$(field "$stats" 's/.*Smpls\/Pxl: *\([0-9.]*\).*/\1/p')
+    rates=$(awk -v s="$trace" -v n="$samples" 'BEGIN {
+        if (s == "-" || n == "-" || s <= 0) print "- -"; else printf "%.3g %.4g\n", n / s, s / n }')
+    measured=$(grep "^peak_rss:" "$log" | tail -n 1)
+    rss=$(field "$measured" 's/^peak_rss: \([0-9]*\) KiB.*/\1/p')
+    rss=$(awk -v k="$rss" 'BEGIN { if (k == "-") print "-"; else printf "%.0f", k / 1024 }')
+    record "$name" "$size" 4 1 - "$(field "$measured" 's/.*, \([0-9.]*\) s wall.*/\1/p')" "$trace" "${rates% *}" - \
+        "${rates#* }" - - - "$rss" - "$(field "$measured" 's/.*, \([0-9.]*\) s CPU.*/\1/p')" \
+        "POV-Ray, trace time; Whitted, 8x8 area light, $per_pixel samples/pixel" povray -
+}

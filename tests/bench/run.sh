@@ -276,9 +276,12 @@ if peer_ready cycles; then
     bench_cycles cycles-weekend scenes/weekend.txt 1200x675 "$weekend_spp" "" --max-depth 50
 fi
 bench three-balls scenes/three-balls.txt 640x360 "$(scaled 16)" ""
-# The seed's quick-sweep mode: a Whitted frame with soft shadows (POV-Ray renders such a
-# frame with an 8x8 area light in about 1.6 s on two cores).
-bench three-balls-whitted scenes/three-balls.txt 640x360 4 "Whitted (POV-Ray: 1.6 s)" --integrator whitted
+# The seed's quick-sweep mode: a Whitted frame with soft shadows, and right after it the
+# same frame in POV-Ray with an 8x8 area light (tests/bench/peers.sh).
+bench three-balls-whitted scenes/three-balls.txt 640x360 4 "Whitted" --integrator whitted
+if peer_ready povray; then
+    bench_povray povray-three-balls scenes/three-balls.txt 640x360 16
+fi
 bench_animation three-balls-anim scenes/three-balls.txt 320x180 "$(scaled 4)" 24
 # The books' scenes at the books' sizes, except the Next Week scene at half its 800x800
 # (its fog makes every path scatter: 1 spp of the full frame takes ~40 s here).
@@ -330,6 +333,11 @@ if [ "$(value cycles-weekend 7)" != - ]; then
         "$(value cycles-weekend 7) s ($(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")x); whole processes" \
         "$(value weekend 6) s and $(value cycles-weekend 6) s ($(ratio "$(value weekend 6)" "$(value cycles-weekend 6)")x);" \
         "Cycles' mean colour ${cycles_mean:--}"
+fi
+if [ "$(value povray-three-balls 7)" != - ]; then
+    echo "three balls, Whitted, 640x360: rtspheres 4 spp render $(value three-balls-whitted 7) s (whole process" \
+        "$(value three-balls-whitted 6) s), POV-Ray trace $(value povray-three-balls 7) s (whole process" \
+        "$(value povray-three-balls 6) s): $(ratio "$(value three-balls-whitted 7)" "$(value povray-three-balls 7)")x"
 fi
 quality_compare cornell
 quality_compare three-balls
