@@ -55,12 +55,15 @@ peer_notes=                    # why peer rows were skipped, for the summary
 # Succeeds when peer NAME (cycles or povray) is asked for and its program is there;
 # otherwise fails and adds the reason to the notes (once), which the summary prints.
 peer_ready() {
-    case " $peers " in *" $1 "*) ;; *) return 1 ;; esac
     case $1 in cycles) command=blender ;; *) command=povray ;; esac
-    command -v "$command" >/dev/null 2>&1 && return 0
-    case $peer_notes in *"'$command'"*) ;; *)
-        echo "  $1 rows skipped: '$command' is not installed (make bench installs .ci/bench-packages)"
-        peer_notes="${peer_notes}  $1 rows skipped: '$command' is not installed (make bench installs .ci/bench-packages)
+    case " $peers " in
+        *" $1 "*) command -v "$command" >/dev/null 2>&1 && return 0
+                  reason="'$command' is not installed (make bench installs .ci/bench-packages)" ;;
+        *) reason="not in BENCH_PEERS" ;;
+    esac
+    case $peer_notes in *"$1 rows skipped"*) ;; *)
+        echo "  $1 rows skipped: $reason"
+        peer_notes="${peer_notes}  $1 rows skipped: $reason
 " ;;
     esac
     return 1
@@ -81,6 +84,13 @@ image_rmse() {
     echo "${found:--}"
 }
 
+# Runs tests/bench/cycles/render.py in Blender under the peak-RSS wrapper with the
+# arguments given (SCENE -o OUT ...) and the peers' thread count.
+run_cycles() {
+    "$work/peak_rss" blender -b --factory-startup -noaudio --python-exit-code 1 -P tests/bench/cycles/render.py \
+        -- "$@" --threads "$peer_threads"
+}
+
 # Renders SCENE in Cycles as NAME (SIZE, SPP; the arguments after NOTE go to
 # tests/bench/cycles/render.py, e.g. --max-depth 50) and records its row: render s is
 # Cycles' render call, wall s the whole Blender process (its start-up included).
@@ -89,9 +99,7 @@ bench_cycles() {
     shift 5
     out="$work/$name.exr" log="$work/$name.log"
     rm -f "$out"
-    if ! "$work/peak_rss" blender -b --factory-startup -noaudio --python-exit-code 1 -P tests/bench/cycles/render.py \
-        -- "$scene" -o "$out" --size "$size" --spp "$spp" --threads "$peer_threads" "$@" >"$log" 2>&1 ||
-        [ ! -f "$out" ]; then
+    if ! run_cycles "$scene" -o "$out" --size "$size" --spp "$spp" "$@" >"$log" 2>&1 || [ ! -f "$out" ]; then
         echo "$name: Cycles FAILED (see $log:)"; grep -v '^Fra:' "$log" | tail -n 3
         failures=$((failures + 1))
         return 0
@@ -132,9 +140,8 @@ quality_reference() {
         "$work/peak_rss" "$program" render "$scene" -o "$partial" --size "$size" --spp "$quality_reference_spp" \
             --max-depth "$depth" --seed 2 --quiet >"$log" 2>&1 || status=$?
     else
-        "$work/peak_rss" blender -b --factory-startup -noaudio --python-exit-code 1 -P tests/bench/cycles/render.py \
-            -- "$scene" -o "$partial" --size "$size" --spp "$quality_reference_spp" --max-depth "$depth" \
-            --seed 2 --threads "$peer_threads" >"$log" 2>&1 || status=$?
+        run_cycles "$scene" -o "$partial" --size "$size" --spp "$quality_reference_spp" --max-depth "$depth" \
+            --seed 2 >"$log" 2>&1 || status=$?
     fi
     if [ "$status" = 0 ] && [ -f "$partial" ]; then
         mv "$partial" "$reference_image"
