@@ -167,7 +167,7 @@ loglog_at() {
 }
 
 # Prints "TIME RMSE" of this run's ladder rows named PREFIX then a number of spp (column
-# $2 the time: 7 render s, 6 wall s), one point a line.
+# $2 the time: 7 render s, 6 wall s, 16 CPU s), one point a line.
 ladder_points() {
     awk -F '\t' -v prefix="$1" -v column="$2" 'index($1, prefix) == 1 && substr($1, length(prefix) + 1) ~ /^[0-9]+$/ &&
         $column != "-" && $19 != "-" { print $column, $19 }' "$rows"
@@ -223,7 +223,8 @@ quality_scene() {
 # Compares the ladders of LABEL (quality_scene) and prints and records the results:
 # Cycles' RMSE and time at $quality_point spp; rtspheres' RMSE at that time and the time
 # it needs for that RMSE (log-log interpolation between its ladder points), as ratios to
-# Cycles'; the adaptive ladder's time for rtspheres' own RMSE at $quality_point spp.
+# Cycles' (by render s, wall s and CPU s); the adaptive ladder's time for rtspheres' own
+# RMSE at $quality_point spp.
 quality_compare() {
     label=$1
     means=$(awk -F '\t' -v l="$label" '$1 == l && $2 ~ /_reference_mean$/ { sub(/_reference_mean/, "", $2)
@@ -239,14 +240,16 @@ quality_compare() {
     quality_fact "$label" rtspheres_point_seconds "$own_time"
     quality_fact "$label" rtspheres_point_rmse "$own_rmse"
     if [ "$(value "cycles:$label@$quality_point" 7)" != - ]; then
-        for column in 7 6; do
-            what=render; [ "$column" = 7 ] || what=wall
+        quality_fact "$label" cycles_point_rmse "$(value "cycles:$label@$quality_point" 19)"
+        # render s (the headline), whole-process wall s, and whole-process CPU s (all threads,
+        # start-up in it): the last is the least moved by other work on the machine.
+        for column in 7 6 16; do
+            case $column in 7) what=render ;; 6) what=wall ;; *) what=cpu ;; esac
             cycles_time=$(value "cycles:$label@$quality_point" "$column")
             cycles_rmse=$(value "cycles:$label@$quality_point" 19)
             at_time=$(ladder_points "$label@" "$column" | loglog_at "$cycles_time")
             for_rmse=$(ladder_points "$label@" "$column" | awk '{ print $2, $1 }' | loglog_at "$cycles_rmse")
             quality_fact "$label" "cycles_point_${what}_seconds" "$cycles_time"
-            quality_fact "$label" cycles_point_rmse "$cycles_rmse"
             quality_fact "$label" "rtspheres_rmse_at_cycles_${what}_time" "$at_time"
             quality_fact "$label" "rmse_ratio_equal_${what}_time" "$(ratio "$at_time" "$cycles_rmse")"
             quality_fact "$label" "rtspheres_${what}_seconds_for_cycles_rmse" "$for_rmse"

@@ -332,7 +332,8 @@ if [ "$(value cycles-weekend 7)" != - ]; then
     echo "weekend at $weekend_spp spp: rtspheres render $(value weekend 7) s, Cycles render call" \
         "$(value cycles-weekend 7) s ($(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")x); whole processes" \
         "$(value weekend 6) s and $(value cycles-weekend 6) s ($(ratio "$(value weekend 6)" "$(value cycles-weekend 6)")x);" \
-        "Cycles' mean colour ${cycles_mean:--}"
+        "their CPU s (all threads; less moved by other work) $(value weekend 16) and $(value cycles-weekend 16)" \
+        "($(ratio "$(value weekend 16)" "$(value cycles-weekend 16)")x); Cycles' mean colour ${cycles_mean:--}"
 fi
 if [ "$(value povray-three-balls 7)" != - ]; then
     echo "three balls, Whitted, 640x360: rtspheres 4 spp render $(value three-balls-whitted 7) s (whole process" \
