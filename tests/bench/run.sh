@@ -404,6 +404,11 @@ echo "  (path segments per CPU-second instead: $(awk -v a="$(value weekend 9)" -
             print "unknown"
         else printf "rtspheres %.3g, reference %.3g, ratio %.3g", a * ar / ac, b * br / bc,
                     (a * ar / ac) / (b * br / bc) }'))"
+# The same for the peers' targets: other work moves wall seconds more than CPU seconds.
+echo "  (by whole-process CPU seconds instead: weekend rtspheres / Cycles" \
+    "$(ratio "$(value weekend 16)" "$(value cycles-weekend 16)"), Cornell RMSE at equal CPU time" \
+    "$(quality_value cornell rmse_ratio_equal_cpu_time), time for Cycles' RMSE" \
+    "$(quality_value cornell time_ratio_equal_rmse_cpu))"
 echo "  (first pass with Mesa's shader cache: $(value startup-cached 13) s;" \
     "weekend's own, a full 1200x675 pass: $(value weekend 13) s)"
 echo "load average at the end $load_end"
