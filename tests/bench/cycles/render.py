@@ -21,9 +21,9 @@ The same scene, as near as two renderers allow (what differs is said where it is
 - Coordinates: rtspheres' y is up, Blender's z: (x, y, z) -> (x, -z, y), a rotation.
 - Spheres are Cycles point-cloud points, which Cycles intersects as analytic spheres:
   one point cloud per material type (Mesh to Points in geometry nodes), each sphere's
-  colour, fuzz and IOR as point attributes read by the shader, since Cycles gives every
-  point of a cloud its first material. Quads and boxes are one mesh of quads with a
-  material per face.
+  colour, metal roughness and IOR as point attributes read by the shader, since Cycles
+  gives every point of a cloud its first material. Quads and boxes are one mesh of
+  quads with a material per face.
 - lambertian -> Diffuse BSDF (roughness 0, Lambert); metal -> Glossy BSDF, GGX (see
   metal_roughness: the lobes differ); dielectric -> Glass BSDF, sharp (exact Fresnel
   where rtspheres uses Schlick's approximation); emissive surfaces -> Emission (Cycles'
@@ -172,7 +172,7 @@ def world(scene, sky):
 
 def material_of(name, kind, albedo=None, fuzz=0.0, ior=1.5, emission=None, from_attributes=False):
     """A Cycles material for an rtspheres material type. With FROM_ATTRIBUTES its colour,
-    roughness and IOR come from the point attributes bench_albedo, bench_fuzz and
+    roughness and IOR come from the point attributes bench_albedo, bench_roughness and
     bench_ior (the point clouds), else from the values given (the meshes)."""
     material = bpy.data.materials.new(name)
     material.use_nodes = True
@@ -210,15 +210,7 @@ def material_of(name, kind, albedo=None, fuzz=0.0, ior=1.5, emission=None, from_
             shader.inputs["Color"].default_value = (*albedo, 1.0)
     if kind == "metal":
         if from_attributes:
-            # roughness = sqrt(fuzz / sqrt(10)) per point (metal_roughness)
-            scale = nodes.new("ShaderNodeMath")
-            scale.operation = "MULTIPLY"
-            scale.inputs[1].default_value = 1.0 / math.sqrt(10.0)
-            root = nodes.new("ShaderNodeMath")
-            root.operation = "SQRT"
-            links.new(attribute("bench_fuzz", "Fac"), scale.inputs[0])
-            links.new(scale.outputs["Value"], root.inputs[0])
-            links.new(root.outputs["Value"], shader.inputs["Roughness"])
+            links.new(attribute("bench_roughness", "Fac"), shader.inputs["Roughness"])
         else:
             shader.inputs["Roughness"].default_value = metal_roughness(fuzz)
     if kind == "dielectric":
@@ -231,14 +223,15 @@ def material_of(name, kind, albedo=None, fuzz=0.0, ior=1.5, emission=None, from_
 
 
 def point_cloud(name, spheres, material):
-    """An object of analytic spheres: a mesh of their centres with radius, albedo, fuzz
-    and IOR per vertex, turned into points by a geometry-nodes modifier (Mesh to Points,
-    radius from the attribute) that also sets MATERIAL."""
+    """An object of analytic spheres: a mesh of their centres with radius, albedo, metal
+    roughness (metal_roughness of the fuzz) and IOR per vertex, turned into points by a
+    geometry-nodes modifier (Mesh to Points, radius from the attribute) that also sets
+    MATERIAL."""
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata([to_blender(centre) for centre, _, _ in spheres], [], [])
     values = {"bench_radius": ("FLOAT", [radius for _, radius, _ in spheres]),
               "bench_albedo": ("FLOAT_VECTOR", [m.get("albedo", (1.0, 1.0, 1.0)) for _, _, m in spheres]),
-              "bench_fuzz": ("FLOAT", [m.get("fuzz", 0.0) for _, _, m in spheres]),
+              "bench_roughness": ("FLOAT", [metal_roughness(m.get("fuzz", 0.0)) for _, _, m in spheres]),
               "bench_ior": ("FLOAT", [m.get("ior", 1.5) for _, _, m in spheres])}
     for attribute_name, (data_type, data) in values.items():
         attribute = mesh.attributes.new(attribute_name, data_type, "POINT")
