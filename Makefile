@@ -6,11 +6,14 @@
 #   test     install missing packages, build, run every test (unit, render, analytic),
 #            or just the tests TESTS names (make test TESTS="test-frames test_pack")
 #   bench    build with release flags and time the benchmark scenes against a plain C
-#            reference built in the same run (not a test): a table with the targets as
-#            ratios, build/bench.csv (appended), build/bench.json, build/bench-plot.png
+#            reference and the peers (Blender Cycles, POV-Ray) in the same run (not a
+#            test): a table with the targets as ratios, build/bench.csv (appended),
+#            build/bench.json, build/bench-plot.png; installs the peers first
+#            (bench-deps)
 #   golden   re-render the golden images in golden/ (never run by the tests; say why in
 #            the commit when you commit new ones)
 #   deps     install the Debian packages listed in .ci/debian-packages that are missing
+#   bench-deps  the same for .ci/bench-packages, the bench's peers (never the tests')
 #   fuzz     build the libFuzzer harnesses (tests/fuzz/) with clang into build-fuzz/ and
 #            fuzz each for FUZZ_SECONDS; the corpus found grows in build-fuzz/corpus/
 #   fuzz-smoke  the fuzzing check the tests run: regressions, then 10 s per harness
@@ -27,11 +30,12 @@
 #   FUZZ_SECONDS  how long `make fuzz` runs each harness (default 60)
 #   FUZZ_CC, FUZZ_CXX  the compilers of the fuzz harnesses; must have libFuzzer
 #              (default clang, clang++)
-#   BENCH_SPP, BENCH_REFERENCE_SPP, BENCH_SCALE, BENCH_MESH_LEVELS  the sizes of `make
-#              bench` (environment; tests/bench/run.sh says what each does)
+#   BENCH_SPP, BENCH_REFERENCE_SPP, BENCH_SCALE, BENCH_MESH_LEVELS, BENCH_PEERS,
+#   BENCH_QUALITY_*, ...  the sizes of `make bench` (environment; tests/bench/run.sh and
+#              tests/bench/peers.sh say what each does)
 
 all: rtspheres
-.PHONY: all demo test bench golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
+.PHONY: all demo test bench bench-deps golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
 
 CC ?= cc
 CXX ?= c++
@@ -112,18 +116,26 @@ $(BUILD)/tests/%: tests/unit/%.c $(LIBRARY)
 
 unit-tests: $(UNIT_TESTS)
 
-# Installs what .ci/debian-packages lists and dpkg says is missing (sudo when not root).
+# Installs what the list $(1) names and dpkg says is missing (sudo when not root); $(2)
+# is the target, for the message. deps: what rtspheres and its tests need; bench-deps:
+# the bench's peers.
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
-deps:
-	@missing=$$(grep -v '^\s*#' .ci/debian-packages | while read -r p; do \
+define install_missing
+	@missing=$$(grep -v '^\s*#' $(1) | while read -r p; do \
 		[ -n "$$p" ] || continue; \
 		dpkg-query -W -f='$${Status}\n' "$$p" 2>/dev/null | grep -q 'install ok installed' || echo "$$p"; \
 	done | tr '\n' ' '); \
 	if [ -n "$$missing" ]; then \
-		echo "deps: installing missing Debian packages: $$missing"; \
+		echo "$(2): installing missing Debian packages: $$missing"; \
 		$(SUDO) apt-get update -q && \
 		$(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends $$missing; \
 	fi
+endef
+deps:
+	$(call install_missing,.ci/debian-packages,deps)
+
+bench-deps:
+	$(call install_missing,.ci/bench-packages,bench-deps)
 
 demo: deps
 	$(Q)$(MAKE) --no-print-directory all
@@ -163,13 +175,16 @@ test: deps
 		$(BUILD) ./$(PROGRAM) $(TESTS)
 
 # The bench compiles its own tools (the reference with -O3 -march=native -fopenmp and none
-# of your CFLAGS, since it is the yardstick; the peak-RSS wrapper; the chart) into
-# build/bench/, so `sh tests/bench/run.sh ./rtspheres` also works alone. A sanitizer
-# build would time the sanitizers, so SAN=1 is refused.
+# of your CFLAGS, since it is the yardstick; the peak-RSS wrapper; the chart; the image
+# error) into build/bench/, so `sh tests/bench/run.sh ./rtspheres` also works alone. A
+# sanitizer build would time the sanitizers, so SAN=1 is refused. Peers that cannot be
+# installed (no network) only lose their rows: run.sh skips them with a note.
 bench: deps
 ifeq ($(SAN),1)
 	@echo "bench: times the release build; run it without SAN=1" >&2; exit 2
 endif
+	$(Q)$(MAKE) --no-print-directory bench-deps || \
+		echo "bench: the peers of .ci/bench-packages could not be installed; their rows are skipped"
 	$(Q)$(MAKE) --no-print-directory all
 	$(Q)CC="$(CC)" CXX="$(CXX)" V="$(V)" sh tests/bench/run.sh ./$(PROGRAM)
 

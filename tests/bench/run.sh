@@ -69,7 +69,7 @@ mkdir -p "$work"
 run_id=$(date -u +%Y-%m-%dT%H:%M:%SZ)
 failures=0
 
-header="date,run,scene,size,spp,frames,triangles,wall_seconds,render_seconds,samples_per_second,segments_per_second,seconds_per_sample,bvh_build_seconds,bytes_per_triangle,first_pass_seconds,peak_rss_mib,frames_per_second,cpu_seconds"
+header="date,run,scene,size,spp,frames,triangles,wall_seconds,render_seconds,samples_per_second,segments_per_second,seconds_per_sample,bvh_build_seconds,bytes_per_triangle,first_pass_seconds,peak_rss_mib,frames_per_second,cpu_seconds,renderer,rmse"
 if [ -f "$csv" ] && [ "$(head -n 1 "$csv")" != "$header" ]; then
     old="build/bench-old-$(date -u +%Y%m%dT%H%M%SZ).csv"
     mv "$csv" "$old"
@@ -109,23 +109,28 @@ field() { found=$(printf '%s\n' "$1" | sed -n "$2" | head -n 1); echo "${found:-
 # Appends one row to the run's rows and the CSV and prints it in the table. Arguments
 # (their column numbers in the rows): 1 name, 2 size, 3 spp, 4 frames, 5 triangles,
 # 6 wall s, 7 render s, 8 samples/s, 9 segments/s, 10 s/sample, 11 BVH s, 12 B/tri,
-# 13 first pass s, 14 RSS MiB, 15 frames/s, 16 CPU s, 17 note; "-" when unknown.
+# 13 first pass s, 14 RSS MiB, 15 frames/s, 16 CPU s, 17 note, 18 renderer (rtspheres when
+# left out), 19 RMSE against the row's quality reference (tests/bench/peers.sh); "-" when
+# unknown.
 record() {
     printf '%s\t' "$@" | sed 's/\t$//' >>"$rows"
+    [ $# -ge 18 ] || printf '\trtspheres' >>"$rows"
+    [ $# -ge 19 ] || printf '\t-' >>"$rows"
     echo >>"$rows"
-    printf '%-19s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s  %s\n' \
+    printf '%-22s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s  %s\n' \
         "$1" "$2" "$3" "$5" "$6" "$(awk -v c="${16}" -v w="$6" 'BEGIN {
             if (c == "-" || w == "-" || w <= 0) print "-"; else printf "%.2f", c / w }')" "$7" "$8" "$9" \
         "$(awk -v s="${10}" 'BEGIN { if (s == "-") print "-"; else printf "%.3g", s * 1e6 }')" \
         "${11}" "${12}" "${13}" "${14}" "${17}"
     # The CSV leaves unknown values empty rather than "-", and has no note.
-    echo "$(date -u +%Y-%m-%dT%H:%M:%SZ),$run_id,$1,$2,$3,$4,$5,$6,$7,$8,$9,${10},${11},${12},${13},${14},${15},${16}" |
+    echo "$(date -u +%Y-%m-%dT%H:%M:%SZ),$run_id,$1,$2,$3,$4,$5,$6,$7,$8,$9,${10},${11},${12},${13},${14},${15},${16},${18:-rtspheres},${19:--}" |
         awk -F ',' 'BEGIN { OFS = "," } { for (i = 1; i <= NF; i++) if ($i == "-") $i = ""; print }' >>"$csv"
 }
 
 # Renders SCENE as NAME under the peak-RSS wrapper and records its row with NOTE; the
 # arguments after NOTE go to rtspheres. $render_environment (NAME=VALUE words, usually
-# empty) is added to rtspheres' environment.
+# empty) is added to rtspheres' environment. With $quality_reference set (an image of
+# the same size, tests/bench/peers.sh), the row also gets the RMSE against it.
 render_environment=
 bench() {
     name=$1 scene=$2 size=$3 spp=$4 note=$5
@@ -161,8 +166,10 @@ bench() {
         split(size, wh, "x"); if (b == "-") b = 0; split(steady, st, " ")
         if (steady != "-" && st[2] > 0) printf "%.4g", st[1] / st[2]
         else if (s == "-") print "-"; else printf "%.4g", (s - b) / (wh[1] * wh[2] * spp) }')
+    rmse=$(image_rmse "$out")
+    [ "$rmse" = - ] || note="${note:+$note; }RMSE $rmse"
     record "$name" "$size" "$spp" 1 "$triangles" "$wall" "$render_seconds" "$samples" "$segments" "$per_sample" \
-        "$build" "$per_triangle" "$first" "$rss" - "$cpu" "$note"
+        "$build" "$per_triangle" "$first" "$rss" - "$cpu" "$note" rtspheres "$rmse"
 }
 
 # Renders the three-ball animation (frames 0 .. FRAMES-1 on one GPU context) as NAME and
@@ -225,10 +232,20 @@ bench_reference() {
         "$(field "$measured" 's/.*, \([0-9.]*\) s CPU.*/\1/p')" "plain C, brute force, OpenMP $threads threads"
 }
 
+# Prints the value of KEY ($2) in this run's time-to-quality results of LABEL ($1), or "-".
+quality_value() {
+    awk -F '\t' -v label="$1" -v key="$2" '$1 == label && $2 == key { v = $3 } END { print v == "" ? "-" : v }' \
+        "$quality"
+}
+
 # Prints column $2 of the row named $1 of this run, or "-".
 value() {
     awk -F '\t' -v name="$1" -v column="$2" '$1 == name { v = $column } END { print v == "" ? "-" : v }' "$rows"
 }
+
+# The peers' rows (Blender Cycles, POV-Ray) and time to quality: tests/bench/peers.sh.
+# shellcheck source=tests/bench/peers.sh
+. tests/bench/peers.sh
 
 # ---- the run --------------------------------------------------------------------------
 renderer=$("$program" info 2>/dev/null | sed -n 's/^GL renderer: *//p')
@@ -238,9 +255,9 @@ load_start=$(cut -d ' ' -f 1-3 /proc/loadavg 2>/dev/null || echo "-")
 echo "bench: $run_id, $cpu_model, $cores cores, renderer $renderer"
 echo "bench: load average at the start $load_start (other work on the machine slows both renderers alike" \
     "only when it stays steady)"
-printf '%-19s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s  %s\n' \
+printf '%-22s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s  %s\n' \
     scene size spp triangles "wall s" cores "render s" samples/s segments/s us/sample "BVH s" B/tri "first" "RSS" note
-printf '%-19s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s\n' \
+printf '%-22s %-8s %3s %9s %7s %5s %8s %9s %10s %8s %6s %6s %6s %5s\n' \
     "" "" "" "" "" "" "" "" "" "" "" "" "pass s" "MiB"
 
 # The start-up probe: with Mesa's on-disk shader cache off, every run compiles the tracer
@@ -254,16 +271,29 @@ bench startup-cached scenes/weekend.txt 64x36 1 "start-up probe: Mesa shader cac
 # The headline pair back to back, so that the same load weighs on both.
 bench weekend scenes/weekend.txt 1200x675 "$weekend_spp" "" --max-depth 50
 bench_reference 1200x675 "$reference_spp"
+# The peer at equal spp, right after them (issue 13: rtspheres at most half its time).
+if peer_ready cycles; then
+    bench_cycles cycles-weekend scenes/weekend.txt 1200x675 "$weekend_spp" "" --max-depth 50
+fi
 bench three-balls scenes/three-balls.txt 640x360 "$(scaled 16)" ""
-# The seed's quick-sweep mode: a Whitted frame with soft shadows (POV-Ray renders such a
-# frame with an 8x8 area light in about 1.6 s on two cores).
-bench three-balls-whitted scenes/three-balls.txt 640x360 4 "Whitted (POV-Ray: 1.6 s)" --integrator whitted
+# The seed's quick-sweep mode: a Whitted frame with soft shadows, and right after it the
+# same frame in POV-Ray with an 8x8 area light (tests/bench/peers.sh).
+bench three-balls-whitted scenes/three-balls.txt 640x360 4 "Whitted" --integrator whitted
+if peer_ready povray; then
+    bench_povray povray-three-balls scenes/three-balls.txt 640x360 16
+fi
 bench_animation three-balls-anim scenes/three-balls.txt 320x180 "$(scaled 4)" 24
 # The books' scenes at the books' sizes, except the Next Week scene at half its 800x800
 # (its fog makes every path scatter: 1 spp of the full frame takes ~40 s here).
 bench cornell scenes/cornell.txt 600x600 "$(scaled 4)" ""
 bench next-week scenes/next-week.txt 400x400 "$(scaled 2)" ""
 bench crystal-ball scenes/crystal-ball.txt 640x480 "$(scaled 4)" ""
+
+# Time to quality against Cycles (tests/bench/peers.sh): ladders of spp, RMSE against
+# each renderer's own cached high-spp reference. The issue's sizes: the Cornell box at
+# 200x200 with depth 50, three balls at 320x180 with the scene's depth 16.
+quality_scene cornell scenes/cornell.txt 200x200 50
+quality_scene three-balls scenes/three-balls.txt 320x180 16
 
 # Meshes of growing size, the same small frame each: time per sample should grow about
 # like log n. Generated at run time (the largest OBJ is 138 MB), never committed.
@@ -295,6 +325,25 @@ echo
 echo "weekend mean colour: rtspheres ${rtspheres_mean:--}, reference ${reference_mean:--}" \
     "(largest difference ${mean_difference}%; same scene when within about 1%)"
 
+# ---- the peers (issue 13): equal spp, time to quality ------------------------------------
+echo
+if [ "$(value cycles-weekend 7)" != - ]; then
+    cycles_mean=$("$work/image_error" "$work/cycles-weekend.exr" 2>/dev/null | sed -n 's/^mean //p')
+    echo "weekend at $weekend_spp spp: rtspheres render $(value weekend 7) s, Cycles render call" \
+        "$(value cycles-weekend 7) s ($(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")x); whole processes" \
+        "$(value weekend 6) s and $(value cycles-weekend 6) s ($(ratio "$(value weekend 6)" "$(value cycles-weekend 6)")x);" \
+        "their CPU s (all threads; less moved by other work) $(value weekend 16) and $(value cycles-weekend 16)" \
+        "($(ratio "$(value weekend 16)" "$(value cycles-weekend 16)")x); Cycles' mean colour ${cycles_mean:--}"
+fi
+if [ "$(value povray-three-balls 7)" != - ]; then
+    echo "three balls, Whitted, 640x360: rtspheres 4 spp render $(value three-balls-whitted 7) s (whole process" \
+        "$(value three-balls-whitted 6) s), POV-Ray trace $(value povray-three-balls 7) s (whole process" \
+        "$(value povray-three-balls 6) s): $(ratio "$(value three-balls-whitted 7)" "$(value povray-three-balls 7)")x"
+fi
+quality_compare cornell
+quality_compare three-balls
+printf '%s' "$peer_notes"
+
 # ---- the chart --------------------------------------------------------------------------
 plot_data=$work/plot-data.txt
 echo "# triangles seconds_per_sample name (make bench, $run_id)" >"$plot_data"
@@ -324,13 +373,23 @@ targets=$work/targets.tsv
         "$(value startup 13)"
     printf 'packed_bytes_per_triangle\t%s\t<=\t100\tB\tpacked bytes per triangle, mesh-%s\n' \
         "$(value "mesh-$last_level" 12)" "$last_level"
+    # issue 13, against Blender Cycles (tests/bench/peers.sh)
+    printf 'weekend_time_ratio_cycles\t%s\t<=\t0.5\tx\tweekend at equal spp, render s rtspheres / Cycles\n' \
+        "$(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")"
+    printf 'cornell_rmse_ratio_equal_time\t%s\t<=\t1\tx\tCornell RMSE at equal time (Cycles %s spp), rtspheres / Cycles\n' \
+        "$(quality_value cornell rmse_ratio_equal_render_time)" "$quality_point"
+    for label in cornell three-balls; do
+        printf '%s_adaptive_time_ratio\t%s\t<=\t0.5\tx\t%s\n' "$(echo "$label" | tr - _)" \
+            "$(quality_value "$label" adaptive_time_ratio)" \
+            "$label: time for the RMSE of $quality_point spp, --noise-threshold / fixed spp"
+    done
 } | awk -F '\t' 'BEGIN { OFS = "\t" } {
     reached = ($3 == ">=" && $2 >= $4) || ($3 == "<=" && $2 <= $4) || ($3 == "<" && $2 < $4)
     met = $2 == "-" ? "unknown" : reached ? "met" : "missed"
     print $1, $2, $3, $4, $5, $6, met }' >"$targets"
 echo
 echo "targets (ratios measured in this run):"
-awk -F '\t' '{ printf "  %-74s %7s %-2s %-3s %-2s %s\n", $6, $2, $3, $4, $5, $7 }' "$targets"
+awk -F '\t' '{ printf "  %-80s %7s %-2s %-3s %-2s %s\n", $6, $2, $3, $4, $5, $7 }' "$targets"
 # Counting the set-up in (the one-off costs the growth target leaves to their own columns):
 echo "  (time per sample with BVH build, packing, upload and compile in it: mesh-$last_level / mesh-$first_level = $(awk -F '\t' \
     -v a="mesh-$last_level" -v b="mesh-$first_level" '$1 == a || $1 == b {
@@ -345,6 +404,11 @@ echo "  (path segments per CPU-second instead: $(awk -v a="$(value weekend 9)" -
             print "unknown"
         else printf "rtspheres %.3g, reference %.3g, ratio %.3g", a * ar / ac, b * br / bc,
                     (a * ar / ac) / (b * br / bc) }'))"
+# The same for the peers' targets: other work moves wall seconds more than CPU seconds.
+echo "  (by whole-process CPU seconds instead: weekend rtspheres / Cycles" \
+    "$(ratio "$(value weekend 16)" "$(value cycles-weekend 16)"), Cornell RMSE at equal CPU time" \
+    "$(quality_value cornell rmse_ratio_equal_cpu_time), time for Cycles' RMSE" \
+    "$(quality_value cornell time_ratio_equal_rmse_cpu))"
 echo "  (first pass with Mesa's shader cache: $(value startup-cached 13) s;" \
     "weekend's own, a full 1200x675 pass: $(value weekend 13) s)"
 echo "load average at the end $load_end"
@@ -357,22 +421,38 @@ json_string() { printf '"%s"' "$(printf '%s' "$1" | sed 's/\\/\\\\/g; s/"/\\"/g'
     printf '  "machine": {"cpu": %s, "cores": %s, "renderer": %s, "load_average_start": %s, "load_average_end": %s},\n' \
         "$(json_string "$cpu_model")" "$(echo "$cores" | sed 's/^-$/null/')" "$(json_string "$renderer")" \
         "$(json_string "$load_start")" "$(json_string "$load_end")"
-    printf '  "knobs": {"BENCH_SPP": %s, "BENCH_REFERENCE_SPP": %s, "BENCH_SCALE": %s, "BENCH_MESH_LEVELS": %s},\n' \
+    printf '  "knobs": {"BENCH_SPP": %s, "BENCH_REFERENCE_SPP": %s, "BENCH_SCALE": %s, "BENCH_MESH_LEVELS": %s, ' \
         "$weekend_spp" "$reference_spp" "$scale" "$(json_string "$mesh_levels")"
+    printf '"BENCH_PEERS": %s, "quality_spp": %s, "quality_point": %s, "quality_reference_spp": %s, ' \
+        "$(json_string "$peers")" "$(json_string "$quality_spp")" "$quality_point" "$quality_reference_spp"
+    printf '"noise_thresholds": %s, "peer_threads": %s},\n' "$(json_string "$noise_thresholds")" "$peer_threads"
     printf '  "scenes": [\n'
     awk -F '\t' 'function number(v) { return v == "-" || v == "" ? "null" : v }
         { printf "%s    {\"name\": \"%s\", \"size\": \"%s\", \"spp\": %s, \"frames\": %s, \"triangles\": %s, " \
               "\"wall_seconds\": %s, \"render_seconds\": %s, \"samples_per_second\": %s, " \
               "\"segments_per_second\": %s, \"seconds_per_sample\": %s, \"bvh_build_seconds\": %s, " \
               "\"bytes_per_triangle\": %s, \"first_pass_seconds\": %s, \"peak_rss_mib\": %s, " \
-              "\"frames_per_second\": %s, \"cpu_seconds\": %s, \"note\": \"%s\"}", (NR > 1 ? ",\n" : ""), $1, $2,
+              "\"frames_per_second\": %s, \"cpu_seconds\": %s, \"note\": \"%s\", \"renderer\": \"%s\", " \
+              "\"rmse\": %s}", (NR > 1 ? ",\n" : ""), $1, $2,
               number($3), number($4), number($5), number($6), number($7), number($8), number($9), number($10),
-              number($11), number($12), number($13), number($14), number($15), number($16), $17 }
+              number($11), number($12), number($13), number($14), number($15), number($16), $17, $18, number($19) }
         END { print "" }' "$rows"
     printf '  ],\n'
     printf '  "weekend_mean": {"rtspheres": [%s], "reference": [%s], "largest_difference_percent": %s},\n' \
         "$(echo "${rtspheres_mean:-}" | sed 's/ /, /g')" "$(echo "${reference_mean:-}" | sed 's/ /, /g')" \
         "$(echo "$mean_difference" | sed 's/^-$/null/')"
+    # Time to quality: per scene its facts; "R G B" means become arrays, "-" null.
+    printf '  "quality": {'
+    sort -s -t "$(printf '\t')" -k 1,1 "$quality" | awk -F '\t' 'function json(v) {
+            if (v == "-" || v == "") return "null"
+            if (v ~ /^-?[0-9.]+(e[+-]?[0-9]+)?$/) return v
+            if (v ~ /^[0-9.e+-]+ [0-9.e+-]+ [0-9.e+-]+$/) { gsub(/ /, ", ", v); return "[" v "]" }
+            gsub(/"/, "\\\"", v); return "\"" v "\"" }
+        NF < 3 { next }
+        $1 != label { printf "%s\n    \"%s\": {", label == "" ? "" : "},", $1; label = $1; n = 0 }
+        { printf "%s\"%s\": %s", n++ ? ", " : "", $2, json($3) }
+        END { print label == "" ? "}," : "}\n  }," }'
+    printf '  "peer_notes": %s,\n' "$(json_string "$(printf '%s' "$peer_notes" | sed 's/^ *//' | tr '\n' ';')")"
     printf '  "targets": [\n'
     awk -F '\t' '{ printf "%s    {\"name\": \"%s\", \"value\": %s, \"comparison\": \"%s\", \"limit\": %s, " \
                       "\"unit\": \"%s\", \"what\": \"%s\", \"status\": \"%s\"}", (NR > 1 ? ",\n" : ""), $1,
