@@ -333,18 +333,31 @@ static double shape_hit(const scene_shape *shape, double time, const double o[3]
     return inside ? t : INFINITY;
 }
 
-/* Brute force over the whole scene in double: world spheres, and every instance's shapes
- * and mesh triangles in object coordinates. Returns the nearest t (INFINITY: none). */
-static double brute_force(const scene *s, double time, const double o[3], const double d[3])
+/* What brute_force_of() looks at. */
+typedef enum brute_force_set {
+    ALL_SHAPES,       /* everything */
+    BLOCKERS,         /* all but one world sphere (a shadow ray's light) and volume instances */
+    VOLUME_SHAPES,    /* the shapes of volume instances */
+} brute_force_set;
+
+/* Brute force over the scene in double: world spheres, and every instance's shapes and
+ * mesh triangles in object coordinates, of the set (skip_sphere: the world sphere that
+ * BLOCKERS leaves out). Returns the nearest t (INFINITY: none). */
+static double brute_force_of(const scene *s, double time, const double o[3], const double d[3], brute_force_set set,
+                             int skip_sphere)
 {
     double best = INFINITY;
-    for (int i = 0; i < s->sphere_count; i++) {
+    for (int i = 0; i < s->sphere_count && set != VOLUME_SHAPES; i++) {
+        if (set == BLOCKERS && i == skip_sphere)
+            continue;
         scene_shape shape = {.type = SHAPE_SPHERE, .radius = s->spheres[i].radius};
         memcpy(shape.points[0], s->spheres[i].center, sizeof shape.points[0]);
         best = fmin(best, shape_hit(&shape, time, o, d));
     }
     for (int i = 0; i < s->instance_count; i++) {
         const scene_instance *instance = &s->instances[i];
+        if ((set == BLOCKERS && instance->volume) || (set == VOLUME_SHAPES && !instance->volume))
+            continue;
         /* Invert the affine placement in double. */
         const float (*m)[4] = instance->object_to_world;
         double a[3][3], inverse[3][3];
@@ -381,6 +394,12 @@ static double brute_force(const scene *s, double time, const double o[3], const 
             best = fmin(best, shape_hit(&s->shapes[object->first_shape + k], time, object_origin, object_direction));
     }
     return best;
+}
+
+/* The nearest t of anything in the scene (INFINITY: none). */
+static double brute_force(const scene *s, double time, const double o[3], const double d[3])
+{
+    return brute_force_of(s, time, o, d, ALL_SHAPES, -1);
 }
 
 /* A random shape within a few units of the origin. */
@@ -492,6 +511,91 @@ static void instanced_traversal_matches_brute_force(void **state)
     }
 }
 
+/* The shader's shadow rays (packed_shadow_blocked, mirrored from glsl/traverse.glsl)
+ * against brute force on instanced scenes with a volume instance: towards a world sphere
+ * (the light, passable) or nothing, up to a random t_max. With the volume passable too,
+ * whatever passes nearest is P and the nearest blocker B: B before P must block; when
+ * the ray is not blocked, its hit is P (none when P is beyond t_max). As a plain shadow
+ * ray (volumes not passable), it is blocked exactly when a blocker or volume comes before
+ * the light and t_max. Near-ties within float precision are skipped. */
+static void shadow_rays_match_brute_force(void **state)
+{
+    (void)state;
+    for (uint64_t seed = 40; seed < 43; seed++) {
+        scene s;
+        instanced_scene(&s, seed);
+        s.instances[1].volume = true;   /* one of object 1's transformed placements */
+        s.instances[1].density = 0.5f;
+        packed_scene packed;
+        assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+        int blocked_count = 0, through = 0, to_volume = 0;
+        for (int r = 0; r < 3000; r++) {
+            double o[3], d[3], length = 0;
+            for (int i = 0; i < 3; i++) {
+                o[i] = random_unit() * 30 - 15;
+                d[i] = random_unit() * 2 - 1;
+                length += d[i] * d[i];
+            }
+            length = sqrt(length);
+            float of[3], df[3];
+            for (int i = 0; i < 3; i++) {
+                of[i] = (float)o[i];
+                df[i] = (float)(d[i] / length);
+                o[i] = of[i];
+                d[i] = df[i];
+            }
+            float t_max = (float)(random_unit() * 40);
+            /* The light: a world sphere (world primitives keep the scene's order first). */
+            int light = r % 2 ? (int)(random_unit() * s.sphere_count) : -1;
+            uint32_t light_slot = PACKED_NONE;
+            for (uint32_t slot = 0; light >= 0 && slot < packed.primitive_count; slot++) {
+                packed_primitive primitive = packed_primitive_at(&packed, slot);
+                if (primitive.type == PRIMITIVE_SPHERE && primitive.data[0][3] == s.spheres[light].radius
+                    && memcmp(primitive.data[0], s.spheres[light].center, sizeof s.spheres[light].center) == 0)
+                    light_slot = slot;
+            }
+            if (light >= 0)
+                assert_int_not_equal(light_slot, PACKED_NONE);
+            double t_light = INFINITY;
+            if (light >= 0) {
+                scene_shape shape = {.type = SHAPE_SPHERE, .radius = s.spheres[light].radius};
+                memcpy(shape.points[0], s.spheres[light].center, sizeof shape.points[0]);
+                t_light = shape_hit(&shape, 0, o, d);
+            }
+            double blocker = brute_force_of(&s, 0, o, d, BLOCKERS, light);
+            double volume = brute_force_of(&s, 0, o, d, VOLUME_SHAPES, -1);
+            double passable = fmin(t_light, volume);
+            double tolerance = 2e-4 * (1 + fmin(fmin(blocker, passable), t_max));
+            if (fabs(blocker - passable) < tolerance || fabs(blocker - t_max) < tolerance
+                || fabs(passable - t_max) < tolerance || fabs(t_light - volume) < tolerance)
+                continue;
+            packed_hit hit;
+            bool blocked = packed_shadow_blocked(&packed, of, df, 0, t_max, light_slot, true, &hit);
+            if (blocker < passable && blocker < t_max && !blocked)
+                fail_msg("seed %llu ray %d: a blocker at %g before %g, not blocked", (unsigned long long)seed, r,
+                         blocker, fmin(passable, (double)t_max));
+            if (blocked) {
+                assert_true(blocker < t_max);
+                blocked_count++;
+            } else if (passable < t_max) {
+                assert_true(fabs(hit.t - passable) <= tolerance);
+                assert_true(hit.instance != PACKED_NONE || hit.primitive == light_slot);
+                to_volume += hit.instance != PACKED_NONE;
+            } else {
+                assert_true(hit.t == t_max && hit.primitive == PACKED_NONE);
+                through++;
+            }
+            /* A plain shadow ray: anything but the light blocks. */
+            double first = fmin(blocker, volume);
+            bool plain = packed_shadow_blocked(&packed, of, df, 0, t_max, light_slot, false, &hit);
+            assert_int_equal(plain, first < t_light && first < t_max);
+        }
+        assert_true(blocked_count > 200 && through > 200 && to_volume > 20);
+        packed_scene_free(&packed);
+        scene_free(&s);
+    }
+}
+
 /* A mesh with degenerate triangles (a repeated corner, three collinear corners) and
  * duplicated ones (the same three vertices twice, or in another order), placed with the
  * identity and with a transform: the packed traversal finds the brute-force nearest hit
@@ -595,7 +699,15 @@ static void instance_records_and_materials(void **state)
         if (instance->object == 0)
             continue;
         uint32_t base = packed.instance_offset + (uint32_t)packed_index++ * PACKED_INSTANCE_STRIDE;
-        assert_true(packed_uint(&packed, base, 0) < packed.node_count);
+        /* texel 0 holds the (first, count) of the object's root node record */
+        uint32_t first = packed_uint(&packed, base, 0), count = packed_uint(&packed, base, 3);
+        bool root_found = false;
+        for (uint32_t n = 0; n < packed.node_count && !root_found; n++) {
+            uint32_t node = packed.node_offset + n * PACKED_NODE_STRIDE;
+            root_found = packed_uint(&packed, node, 3) == first && packed_uint(&packed, node + 1, 3) == count;
+        }
+        assert_true(root_found);
+        assert_true(count == 0 ? first + 1 < packed.node_count : first + count <= packed.primitive_count);
         assert_int_equal(packed_uint(&packed, base, 1),
                          instance->material >= 0 ? (uint32_t)instance->material : PACKED_NONE);
         for (int r = 0; r < 3; r++)
@@ -867,6 +979,7 @@ int main(void)
         cmocka_unit_test(packed_traversal_matches_brute_force),
         cmocka_unit_test(empty_scene_packs_and_misses),
         cmocka_unit_test(instanced_traversal_matches_brute_force),
+        cmocka_unit_test(shadow_rays_match_brute_force),
         cmocka_unit_test(instance_records_and_materials),
         cmocka_unit_test(singular_instance_is_an_error),
         cmocka_unit_test(emissive_spheres_become_lights),
