@@ -18,7 +18,7 @@
  * pack_internal.h.
  *
  * Defaults of pack_options (all zero): BVHs built with bvh_build_config defaults, a bake
- * budget of PACK_DEFAULT_BAKE_BUDGET (65,536) primitives, placements baked by the rule.
+ * budget of PACK_DEFAULT_BAKE_BUDGET (262,144) primitives, placements baked by the rule.
  */
 #ifndef RT_PACK_H
 #define RT_PACK_H
@@ -31,7 +31,7 @@
 #include "status.h"
 
 /* The default of pack_options.bake_budget. */
-#define PACK_DEFAULT_BAKE_BUDGET 65536
+#define PACK_DEFAULT_BAKE_BUDGET 262144
 
 typedef struct pack_options {
     const bvh_build_config *bvh_config;  /* NULL: defaults */

@@ -8,7 +8,7 @@
 #
 # Each scene is rendered as it is (its placements baked, "0 instances") and with copies
 # of its groups hidden where no ray goes (under the floor, which closes the view), so
-# many that the copies beyond the first pass the bake budget (65,536 primitives) and the
+# many that the copies beyond the first pass the bake budget (262,144 primitives) and the
 # visible placements stay instances too.
 #   usage: sh tests/render/test-baked-placements.sh PROGRAM SCRATCH_DIR
 set -u
@@ -73,8 +73,8 @@ cp scenes/cornell.txt "$scratch/cornell.txt"
 {
     sed 's/^group tall_block/group blocks {\ngroup tall_block/' scenes/cornell.txt
     echo "}"
-    # 10,923 copies of six quads beyond the first: 65,538 primitives, over the budget.
-    hidden_copies blocks 10923 0 -2000 0
+    # 43,691 copies of six quads beyond the first: 262,146 primitives, over the budget.
+    hidden_copies blocks 43691 0 -2000 0
 } >"$scratch/cornell-instanced.txt"
 compare cornell "$scratch/cornell.txt" "--size 64x64 --spp 64" "20,30,32,56 33,43,48,60 20,10,44,26"
 
@@ -113,8 +113,8 @@ group shapes {
 SCENE
 {
     cat "$scratch/shapes.txt"
-    # 10,923 copies of 11 shapes and of a 40-triangle mesh beyond the first: over the budget.
-    hidden_copies shapes 10923 0 -50 0
+    # 43,691 copies of 11 shapes and of a 40-triangle mesh beyond the first: over the budget.
+    hidden_copies shapes 43691 0 -50 0
 } >"$scratch/shapes-instanced.txt"
 compare shapes "$scratch/shapes.txt" "" "16,20,32,34 60,12,74,26 34,12,50,30 46,28,74,42 0,44,96,54"
 

@@ -266,8 +266,8 @@ static void add_placed_mesh(scene *s, int triangle_count, int placements)
     }
 }
 
-/* The default budget, 65,536 primitives beyond the first copy: a mesh of 32,768
- * triangles placed three times bakes (exactly at the budget), one of 32,769 stays
+/* The default budget, 262,144 primitives beyond the first copy: a mesh of 131,072
+ * triangles placed three times bakes (exactly at the budget), one of 131,073 stays
  * instanced; a mesh placed once bakes however large. */
 static void the_default_budget(void **state)
 {
@@ -276,9 +276,9 @@ static void the_default_budget(void **state)
         int triangles, placements;
         uint32_t instances, stored_triangles;
     } cases[] = {
-        {32768, 3, 0, 3 * 32768},
-        {32769, 3, 3, 32769},
-        {70000, 1, 0, 70000},
+        {PACK_DEFAULT_BAKE_BUDGET / 2, 3, 0, 3 * (PACK_DEFAULT_BAKE_BUDGET / 2)},
+        {PACK_DEFAULT_BAKE_BUDGET / 2 + 1, 3, 3, PACK_DEFAULT_BAKE_BUDGET / 2 + 1},
+        {PACK_DEFAULT_BAKE_BUDGET + 1000, 1, 0, PACK_DEFAULT_BAKE_BUDGET + 1000},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         scene s;
