@@ -85,6 +85,12 @@ typedef struct summary_case {
 
 #define GREY "material grey lambertian 0.5 0.5 0.5\n"
 #define LAMP "material lamp emissive 1 1 1 strength 4\n"
+/* A quad and a triangle in a group turned, and placed again moved. */
+#define PANELS                                                                                                         \
+    GREY "sphere 0 -10 0 1 grey\n"                                                                                     \
+         "group panel material grey {\n    rotate 0 1 0 30\n    quad 0 0 0  1 0 0  0 1 0\n"                            \
+         "    triangle 0 0 1  1 0 1  0 1 1\n}\n"                                                                       \
+         "instance panel {\n    translate 3 0 0\n}\n"
 
 static const summary_case cases[] = {
     {.what = "spheres only",
@@ -97,18 +103,12 @@ static const summary_case cases[] = {
     /* The quad and the triangle are only in the group's own BVH, placed twice with a
      * rotation and kept instanced: they count. */
     {.what = "kinds inside instances",
-     .body = GREY "sphere 0 -10 0 1 grey\n"
-                  "group panel material grey {\n    rotate 0 1 0 30\n    quad 0 0 0  1 0 0  0 1 0\n"
-                  "    triangle 0 0 1  1 0 1  0 1 1\n}\n"
-                  "instance panel {\n    translate 3 0 0\n}\n",
+     .body = PANELS,
      .keep_instances = true,
      .primitive_types = BIT(PRIMITIVE_SPHERE) | BIT(PRIMITIVE_TRIANGLE) | BIT(PRIMITIVE_QUAD) | BIT(PRIMITIVE_INSTANCE)},
     /* By default both placements are baked (core/pack_collect.c): one level. */
     {.what = "placements baked",
-     .body = GREY "sphere 0 -10 0 1 grey\n"
-                  "group panel material grey {\n    rotate 0 1 0 30\n    quad 0 0 0  1 0 0  0 1 0\n"
-                  "    triangle 0 0 1  1 0 1  0 1 1\n}\n"
-                  "instance panel {\n    translate 3 0 0\n}\n",
+     .body = PANELS,
      .primitive_types = BIT(PRIMITIVE_SPHERE) | BIT(PRIMITIVE_TRIANGLE) | BIT(PRIMITIVE_QUAD)},
     /* The Cornell box's blocks: boxes turned and moved by groups, no instances left, so
      * the tracer variant leaves the instance code out. */
