@@ -424,8 +424,8 @@ bool pack_is_emissive(const scene *s, uint32_t material)
  *     (pack_options.bake_budget, 262,144 primitives by default). An object placed once
  *     always bakes: one copy either way. Baking was faster in every case measured (1.3x
  *     to 1.8x in time per sample, up to 64 copies of a 5,120-triangle mesh); what it
- *     costs is about 70 packed bytes, 80 bytes of peak memory and 1 us of BVH build per
- *     extra triangle, which the budget bounds at about 18 MB and 0.25 s
+ *     costs is about 70 packed bytes, 80 bytes of peak memory and 0.7 us of BVH build per
+ *     extra triangle, which the budget bounds at about 18 MB and 0.2 s
  *     (docs/performance.md, "Placements baked into the world"). A mesh of 1M triangles
  *     placed 3 times stays instanced, one of 82k placed 3 times bakes; so do the Cornell
  *     box's blocks (six quads, placed once each) and the orchard of
