@@ -459,7 +459,6 @@ typedef struct placement_needs {
     bool spheres_oriented;/* one of them reads uv or has a normal map: no rotation either */
     bool shading_frame;   /* vertex normals or a normal map on a triangle or quad: a similarity */
     bool dielectric;      /* a dielectric material: instanced for now (see above) */
-    uint64_t primitives;  /* the object's shapes or mesh triangles */
 } placement_needs;
 
 /* Whether texture (an index of s->textures, or -1) reads the surface's uv: an image, or
@@ -502,7 +501,6 @@ static placement_needs placement_needs_of(const scene *s, const scene_instance *
     bool reads_uv;
     if (object->mesh >= 0) {
         const scene_mesh *mesh = &s->meshes[object->mesh];
-        needs.primitives = (uint64_t)mesh->triangle_count;
         needs.shading_frame = mesh->normals != NULL;
         for (int t = 0; t < mesh->triangle_count && !(needs.emits && needs.shading_frame && needs.dielectric); t++) {
             int own = mesh->triangle_materials ? mesh->triangle_materials[t] : -1;
@@ -513,7 +511,6 @@ static placement_needs placement_needs_of(const scene *s, const scene_instance *
         }
         return needs;
     }
-    needs.primitives = (uint64_t)object->shape_count;
     for (int k = 0; k < object->shape_count; k++) {
         const scene_shape *shape = &s->shapes[object->first_shape + k];
         uint32_t material = resolve_material(shape->material, instance->material);
