@@ -10,6 +10,7 @@
  *   splitmix64_next(&state)                        reproducible 64-bit test data
  *   scratch: make_scratch / remove_scratch (a cmocka setup/teardown pair), in_scratch,
  *            write_file, scratch_write             a fresh directory per test
+ *   scratch_test(test)                             a test table entry with that pair
  *
  * The assertions fail the running test at the caller's file and line, as cmocka's own
  * assert_* do; the value printed is the expression as written in the test. */
@@ -140,6 +141,9 @@ static inline int remove_scratch(void **state)
     free(s);
     return result == 0 ? 0 : -1;
 }
+
+/* An entry of a cmocka test table: test, run in a scratch directory of its own. */
+#define scratch_test(test) cmocka_unit_test_setup_teardown(test, make_scratch, remove_scratch)
 
 /* Returns directory/name in the scratch's path buffer (overwritten by the next call). */
 static inline const char *in_scratch(scratch *s, const char *name)

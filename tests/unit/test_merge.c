@@ -492,7 +492,7 @@ int main(void)
         cmocka_unit_test(test_missing_pieces_described),
         cmocka_unit_test(test_mismatched_parts),
         cmocka_unit_test(test_malformed_parts),
-        cmocka_unit_test_setup_teardown(test_read_part, make_scratch, remove_scratch),
+        scratch_test(test_read_part),
     };
     return cmocka_run_group_tests_name("merge", tests, NULL, NULL);
 }

@@ -1059,7 +1059,7 @@ static void test_sky_box_unreadable_face_is_named(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-#define T(name) cmocka_unit_test_setup_teardown(name, make_scratch, remove_scratch)
+#define T(name) scratch_test(name)
         T(test_quad_becomes_two_triangles),
         T(test_ngons_are_triangulated),
         T(test_negative_indices),
