@@ -81,6 +81,30 @@ fi
 if [ ! -f "$scratch/out.partial.exr" ]; then pass "the partial is removed when the render completes"
 else fail "the partial is removed when the render completes" "it is still there"; fi
 
+# An interrupted render whose output is post-processed (here blurred, to a PNG) still
+# writes the raw means and sample counts to its partial, as a checkpoint does: --resume
+# adds samples to them, so processed colour there would be processed twice.
+code=$(interrupt_running INT "$scratch/blur.png" --blur 2)
+if [ "$code" = 1 ] && [ "$(metadata "$scratch/blur.partial.exr" complete)" = 0 ]; then
+    pass "SIGINT during a --blur render to a PNG writes its partial"
+else fail "SIGINT during a --blur render to a PNG writes its partial" "exit $code; $(cat "$scratch/interrupt.err")"; fi
+# Its pixels are the raw means: resumed without post-processing, they give the plain
+# render (reference.exr above), as a checkpoint's partial does.
+# shellcheck disable=SC2086
+if "$program" render $scene -o "$scratch/blur-raw.exr" $options --resume "$scratch/blur.partial.exr" --quiet &&
+   "$program" diff "$scratch/blur-raw.exr" "$scratch/reference.exr" --fail 1e-5 --failpercent 0 >"$scratch/diff.txt"; then
+    pass "the partial of a --blur render holds the raw means, not the blurred colour"
+else fail "the partial of a --blur render holds the raw means" "$(tr '\n' ' ' <"$scratch/diff.txt")"; fi
+# Resumed with the same options it gives the uninterrupted blurred PNG, but for 8-bit
+# rounding (the colours before the blur agree within 1e-5; one level is 1/255).
+# shellcheck disable=SC2086
+"$program" render $scene -o "$scratch/blur-reference.png" $options --blur 2 --quiet
+# shellcheck disable=SC2086
+if "$program" render $scene -o "$scratch/blur.png" $options --blur 2 --resume "$scratch/blur.partial.exr" --quiet &&
+   "$program" diff "$scratch/blur.png" "$scratch/blur-reference.png" --fail 0.004 --failpercent 0 >"$scratch/diff.txt"; then
+    pass "a resumed --blur render to a PNG equals the uninterrupted one"
+else fail "a resumed --blur render to a PNG equals the uninterrupted one" "$(tr '\n' ' ' <"$scratch/diff.txt")"; fi
+
 # A partial of another render is refused: different seed, different size.
 code=$(interrupt_running INT "$scratch/other.exr")
 # shellcheck disable=SC2086
