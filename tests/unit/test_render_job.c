@@ -423,15 +423,11 @@ static void metadata_round_trip(void **state)
     /* The merge reads back what was written, and the layers follow the four channels. */
     merge_metadata back;
     assert_int_equal(merge_read_part(path, &read, &back, NULL), RT_OK);
-    assert_string_equal(back.scene, "scenes/x.txt");
-    assert_string_equal(back.scene_hash, "00000000deadbeef");
-    assert_int_equal(back.spp, 4);
-    assert_true(back.sample_start == 3000000000ULL);
-    assert_true(back.seed == 4294967295ULL);
-    assert_int_equal(back.max_depth, 8);
-    assert_int_equal(back.frame, 12);
-    assert_true(back.complete);
-    assert_true(back.path_segments == 1e10);
+    assert_merge_metadata_equal(&back, (&(merge_metadata){
+                                           .scene = "scenes/x.txt", .scene_hash = "00000000deadbeef", .spp = 4,
+                                           .sample_start = 3000000000ULL, .seed = 4294967295ULL, .max_depth = 8,
+                                           .frame = 12, .complete = true, .render_seconds = 1.5,
+                                           .path_segments = 1e10}));
     assert_int_equal(read.channels, 5);
     assert_string_equal(read.channel_names[4], "depth.Z");
     assert_int_equal(read.x, 1);
