@@ -1,4 +1,4 @@
-/* render.c: see render.h. Plain C: the GL work is gpu.c's. */
+/* render.c: see render.h. Plain C: the GL work is the GPU module's (core/gpu.c, gpu_tracer.c). */
 #include "render.h"
 
 #include <math.h>
@@ -16,9 +16,8 @@
 #define MINIMUM_ADAPTIVE_BUDGET 16
 #define MAXIMUM_ADAPTIVE_BUDGET 16384
 /* Passes of about a second on a CPU rasteriser, a quarter on a GPU (under any watchdog):
- * on llvmpipe every pass costs a share of its time whatever it does (the weekend scene
- * at 1200x675 traced 4.3e6 segments/s with 0.25 s passes, 5.5e6 with 0.5 s and 5.7e6
- * with 1 s), and nothing kills a long draw there. */
+ * on llvmpipe every pass costs a share of its time whatever it does (docs/performance.md,
+ * the log: longer passes), and nothing kills a long draw there. */
 #define DEFAULT_TARGET_PASS_SECONDS 0.25
 #define SOFTWARE_TARGET_PASS_SECONDS 1.0
 #define DEFAULT_RUSSIAN_ROULETTE_DEPTH 4

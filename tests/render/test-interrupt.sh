@@ -6,8 +6,8 @@
 #   usage: sh tests/render/test-interrupt.sh PROGRAM SCRATCH_DIR
 . "$(dirname "$0")/lib.sh"
 scene=scenes/materials/lambertian.txt
-# About 2.7 million samples: seconds on llvmpipe; the tests wait for the first checkpoint
-# before signalling, so a fast device is fine too.
+# About 2.7 million samples (docs/performance.md has how long they take on llvmpipe); the
+# tests wait for the first checkpoint before signalling, so a fast device is fine too.
 options="--size 48x27 --spp 2048 --seed 3"
 
 # wait_for_file FILE: waits (at most 60 s) until FILE exists; false on time-out.
@@ -120,8 +120,8 @@ if [ "$code" = 2 ]; then pass "resume refuses another size"
 else fail "resume refuses another size" "exit $code: $(cat "$scratch/err")"; fi
 
 # --checkpoint writes the partial while the render runs. A render that cannot finish
-# before it is killed (with $options it took about 0.9 s, and it once finished and removed
-# its partial between the file's appearance and the checks below).
+# before it is killed (one with $options once finished and removed its partial between
+# the file's appearance and the checks below; docs/performance.md has its time).
 "$program" render $scene -o "$scratch/cp.exr" --size 48x27 --spp 1000000 --seed 3 --checkpoint 0.3 --quiet &
 pid=$!
 if wait_for_file "$scratch/cp.partial.exr" && kill -0 "$pid" 2>/dev/null &&
