@@ -60,6 +60,7 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
         *faces[face] = s->sky.faces[face] >= 0 ? (uint32_t)s->sky.faces[face] : 0;
     p->sky_environment = s->sky.environment >= 0 ? (uint32_t)s->sky.environment : 0;
     p->seed = s->render.seed;
+    p->sampler = options->sampler;
     p->sample_start = options->sample_start;
     p->samples_per_pixel = (uint32_t)s->render.samples_per_pixel;
     p->max_depth = (uint32_t)s->render.max_depth;
@@ -102,6 +103,10 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_INSTANCES;
     if (!contents->emitters)
         omitted |= GPU_OMIT_EMITTERS;
+    if (packed->light_count <= 1 || packed->light_count > LIGHT_LOCAL_CHOICE_MAX)
+        omitted |= GPU_OMIT_LIGHT_CHOICE;
+    if (!(contents->light_types & 1u << LIGHT_QUAD))
+        omitted |= GPU_OMIT_RECTANGLE_LIGHTS;
     return omitted;
 }
 
@@ -122,8 +127,8 @@ static uint64_t scene_hash(const scene *s, const packed_scene *packed, const cam
     hash = hash_bytes(hash, &s->camera.shutter_open, sizeof s->camera.shutter_open);
     hash = hash_bytes(hash, &s->camera.shutter_close, sizeof s->camera.shutter_close);
     hash = hash_bytes(hash, s->ambient, sizeof s->ambient);
-    int shape[5] = {s->render.width, s->render.height, s->render.max_depth, options->no_light_sampling,
-                    (int)options->integrator};
+    int shape[6] = {s->render.width, s->render.height, s->render.max_depth, options->no_light_sampling,
+                    (int)options->integrator, options->sampler};
     return hash_bytes(hash, shape, sizeof shape);
 }
 
