@@ -133,7 +133,7 @@ static float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direc
     return INFINITY;
 }
 
-/* glsl/intersect.glsl intersect_flat (Moller-Trumbore), and quads by their plane. */
+/* glsl/intersect.glsl intersect_flat: Moller-Trumbore for triangles, quads by their plane. */
 static float intersect_flat(packed_primitive *primitive, vec3 origin, vec3 direction, float t_max)
 {
     float *corner = primitive->data[0], *edge1 = primitive->data[1], *edge2 = primitive->data[2];
@@ -168,7 +168,7 @@ static void ray_set(moving_ray *ray, vec3 origin, vec3 direction)
     glm_vec3_div(GLM_VEC3_ONE, direction, ray->inverse_direction);
 }
 
-/* glsl/intersect.glsl intersect_box: where the ray enters the box (texels lo, hi) within
+/* glsl/intersect.glsl intersect_box, the slab test: where the ray enters the box (texels lo, hi) within
  * (0, t_max), or INFINITY when it misses. */
 static float intersect_box(const packed_scene *packed, uint32_t lo, uint32_t hi, const moving_ray *ray, float t_max)
 {

@@ -25,7 +25,7 @@
     .balign 16
     .global shader_modules
 shader_modules:
-    module "core/tracer_interface.h", SHADER_PROGRAM_TRACER         /* ids, the parameter list */
+    module "core/tracer_interface.h", SHADER_PROGRAM_TRACER|SHADER_PROGRAM_RANDOM_TEST /* ids, parameters */
     module "core/packed_layout.h", SHADER_PROGRAM_TRACER            /* the packed scene's records */
     module "glsl/random.glsl", SHADER_PROGRAM_TRACER|SHADER_PROGRAM_RANDOM_TEST
     module "glsl/random_test.frag", SHADER_PROGRAM_RANDOM_TEST

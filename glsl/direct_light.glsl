@@ -26,8 +26,8 @@ struct LightQuery {
     Material material;   // surfaces: what scatters (in a medium only albedo is read: 1)
     vec3 weight;         // the path's throughput at the point
     // Set by begin_direct_light:
-    uint next_light;     // the next of the light_total samples to take
-    uint light_total;
+    uint next_light;     // the next of the light_samples samples to take
+    uint light_samples;
     vec3 view;           // the reverse of the incoming ray
     uint bounce;         // the segment's bounce (its random numbers)
     float time;          // the path's
@@ -62,7 +62,7 @@ LightQuery no_light_query()
     q.material.texel2 = uvec4(0u);
     q.weight = vec3(0.0);
     q.next_light = 0u;
-    q.light_total = 0u;
+    q.light_samples = 0u;
     q.view = vec3(0.0);
     q.bounce = 0u;
     q.time = 0.0;
@@ -99,7 +99,7 @@ PendingShadow no_pending_shadow()
 }
 
 // Whether the query has lights left to sample.
-bool direct_light_pending(LightQuery query) { return query.next_light < query.light_total; }
+bool direct_light_pending(LightQuery query) { return query.next_light < query.light_samples; }
 
 // Starts gathering the light the query's point sends towards view (the reverse of the
 // incoming ray): Whitted's ambient term goes to radiance at once, and the lights to
@@ -111,7 +111,7 @@ void begin_direct_light(inout LightQuery query, vec3 view, uint media, float tim
         radiance += query.weight * (ambient * query.material.albedo);
     bool choose = !phong_model || light_count > WHITTED_ALL_LIGHTS;
     query.next_light = 0u;
-    query.light_total = light_count == 0u ? 0u : choose ? 1u : light_count;
+    query.light_samples = light_count == 0u ? 0u : choose ? 1u : light_count;
     query.view = view;
     query.media = media;
     query.time = time;
@@ -120,8 +120,10 @@ void begin_direct_light(inout LightQuery query, vec3 view, uint media, float tim
 
 // Samples the query's next light: the shadow ray towards it and what it adds to the
 // path's radiance if nothing is in the way (pending false when the light gives nothing:
-// chosen with probability 0, out of reach, or below the surface).
-PendingShadow next_shadow_ray(inout LightQuery query)
+// chosen with probability 0, out of reach, or below the surface). light_total receives
+// what MIS at the path's next emitter hit needs of the light choice here
+// (glsl/lights.glsl).
+PendingShadow next_shadow_ray(inout LightQuery query, inout float light_total)
 {
     PendingShadow shadow = no_pending_shadow();
     uint k = query.next_light;
@@ -130,12 +132,19 @@ PendingShadow next_shadow_ray(inout LightQuery query)
     bool choose = !phong_model || light_count > WHITTED_ALL_LIGHTS;
     vec4 u = !phong_model ? random4(query.bounce, 5u)
                           : fract(random4(query.bounce, 6u + (k & 1u)) + float(k >> 1u) * 0.6180339887);
-    uint light = choose ? choose_light(u.x) : k;
-    float choice = choose ? light_probability(light) : 1.0;
+    float choice = 1.0;
+    uint light = k;
+    if (!phong_model)
+        light = choose_light_at(u.x, query.position, choice, light_total);
+    else if (choose) {
+        light = choose_light(u.x);
+        choice = light_power_probability(light);
+    }
     if (choice <= 0.0)
         return shadow;
     LightSample light_sample;
-    if (!sample_light_from(light, query.position, u.yz, light_sample))
+    // u.x chooses the light; the point on it is the stratified pair (z, w).
+    if (!sample_light_from(light, query.position, u.zw, light_sample))
         return shadow;
     vec3 to_light = light_sample.direction;
     vec3 value;

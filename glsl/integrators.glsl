@@ -175,7 +175,7 @@ void integrate(inout PixelState s)
         if (HAS_DIRECT_LIGHT && shade && query.wanted)
             begin_direct_light(query, -incoming, s.media, time, segment_bounce, s.radiance);
         if (HAS_DIRECT_LIGHT && !shadow.pending && direct_light_pending(query))
-            shadow = next_shadow_ray(query);
+            shadow = next_shadow_ray(query, s.light_total);
         if (path_done) {
             s.bounce = 0u;
             if (HAS_DIRECT_LIGHT && (shadow.pending || direct_light_pending(query))) {
