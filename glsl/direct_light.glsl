@@ -182,3 +182,40 @@ PendingShadow next_shadow_ray(inout LightQuery query, inout float light_total)
     shadow.transit = shadow_transit(light_sample.distance, query.media);
     return shadow;
 }
+
+// Whether the segment loop gathers a point's direct light in place, each shadow ray
+// walked at once by a traversal of its own (direct_light_in_place), instead of in the
+// next iteration's walk with the path's next segment (glsl/integrators.glsl). Whitted
+// samples up to WHITTED_ALL_LIGHTS lights at a point: an iteration of the segment loop
+// per light (and per volume boundary its shadow ray crosses) runs the loop's whole body
+// each time (docs/performance.md), which costs more than a light loop of its own, and
+// since the pass state keeps no pending shadow ray, all of them would have to fit in what
+// a pass may run past its budget (glsl/work.glsl): 16 lights behind a few boundaries did
+// not. So Whitted variants keep the second traversal; path tracing takes one light sample
+// a point and has none.
+bool gathers_in_place() { return tracer_integrator() == INTEGRATOR_WHITTED; }
+
+// Takes all the query's light samples (begin_direct_light counted them), walking each
+// shadow ray to its light through the volume boundaries on its way, and adds what gets
+// through to radiance.
+void direct_light_in_place(inout LightQuery query, inout float light_total, inout vec3 radiance)
+{
+    while (direct_light_pending(query)) {
+        work++;
+        PendingShadow shadow = next_shadow_ray(query, light_total);
+        while (shadow.pending) {
+            work++;
+            bool blocked;
+            Hit hit, no_path_hit;
+            trace_rays(true, shadow.ray, false, shadow.ray.origin, shadow.ray.direction, shadow.ray.time, 0.0, blocked,
+                       hit, no_path_hit);
+            if (shadow_at_boundary(shadow.ray, blocked, hit)) {
+                Surface surface = surface_at(hit, shadow.ray.origin, shadow.ray.direction, shadow.ray.time);
+                shadow.pending = shadow_cross(shadow.ray, shadow.transit, hit, surface);
+            } else {
+                radiance += shadow_arrived(shadow.transit, shadow.ray, blocked, hit) * shadow.contribution;
+                shadow.pending = false;
+            }
+        }
+    }
+}

@@ -91,7 +91,7 @@ void integrate(inout PixelState s)
         float time = ray_time();
         bool blocked;
         Hit shadow_hit, path_hit;
-        trace_rays(HAS_DIRECT_LIGHT && shadow.pending, shadow.ray, trace_path, s.origin, s.direction, time, INFINITY,
+        trace_rays(HAS_DIRECT_LIGHT && !gathers_in_place() && shadow.pending, shadow.ray, trace_path, s.origin, s.direction, time, INFINITY,
                    blocked, shadow_hit, path_hit);
         if (trace_path)
             s.statistics.x += 1.0;
@@ -172,9 +172,12 @@ void integrate(inout PixelState s)
                 }
             }
         }
-        if (HAS_DIRECT_LIGHT && shade && query.wanted)
+        if (HAS_DIRECT_LIGHT && shade && query.wanted) {
             begin_direct_light(query, -incoming, s.media, time, segment_bounce, s.radiance);
-        if (HAS_DIRECT_LIGHT && !shadow.pending && direct_light_pending(query))
+            if (gathers_in_place())
+                direct_light_in_place(query, s.light_total, s.radiance);
+        }
+        if (HAS_DIRECT_LIGHT && !gathers_in_place() && !shadow.pending && direct_light_pending(query))
             shadow = next_shadow_ray(query, s.light_total);
         if (path_done) {
             s.bounce = 0u;
