@@ -1,8 +1,9 @@
 // direct_light.glsl: the light that reaches a scattering point straight from the lights
 // (next-event estimation), one shadow ray at a time: this file samples a light and makes
-// the shadow ray, and the segment loop (glsl/integrators.glsl) traces it in the same
-// traversal loop as its next path ray (glsl/traverse.glsl): GLSL inlines every call, and
-// each extra copy of the BVH traversal costs llvmpipe dearly (docs/performance.md).
+// the shadow ray, and for path tracing the segment loop (glsl/integrators.glsl) traces it
+// in the same traversal loop as its next path ray (glsl/traverse.glsl): GLSL inlines
+// every call, and each extra copy of the BVH traversal costs llvmpipe dearly
+// (docs/performance.md). Whitted walks its shadow rays here (gathers_in_place).
 
 // How the light is gathered (LightQuery.model):
 //   DIRECT_MIS (path tracing): one light chosen by power, one point on it, weighted

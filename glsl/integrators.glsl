@@ -66,33 +66,33 @@ bool integrator_survives(inout PixelState s)
 // pending (both start at the same vertex); the shadow ray's light is added when it
 // returns. So a path's shadow rays ride along with its segments, and the last one of a
 // sample with the next sample's camera ray. When the shadow ray is not done after one
-// trace (it stopped at a volume boundary, glsl/media.glsl) or more lights are to be
-// sampled for one point (Whitted with several lights), the path's hit is held and shaded
-// in a later iteration; a sample whose path ended is finished when its last shadow ray
+// trace (it stopped at a volume boundary, glsl/media.glsl), the path's hit is held and
+// shaded in a later iteration; a sample whose path ended is finished when its shadow ray
 // returns. None of that is kept between passes: a pass ends only when nothing is
-// pending, and once the budget is spent no new segment is traced.
+// pending, and once the budget is spent no new segment is traced. Whitted, which samples
+// every light at a point, gathers its direct light in place instead
+// (glsl/direct_light.glsl gathers_in_place).
 void integrate(inout PixelState s)
 {
     if (!HAS_DIRECT_LIGHT || !integrator_samples_lights())
         light_count = 0u;       // nothing to sample
     PendingShadow shadow = no_pending_shadow();
-    LightQuery query = no_light_query();   // direct_light_pending: lights left to sample
+    LightQuery query = no_light_query();
     Hit held_hit = no_hit(INFINITY);
     bool holding = false;                  // held_hit is a segment still to be shaded
-    bool finishing = false;                // a sample whose path ended waits for its shadow rays
+    bool finishing = false;                // a sample whose path ended waits for its shadow ray
     vec3 finishing_radiance = vec3(0.0);
     for (;;) {
-        bool lights_pending = HAS_DIRECT_LIGHT && direct_light_pending(query);
-        bool busy = shadow.pending || lights_pending || holding;
+        bool busy = shadow.pending || holding;
         bool trace_path;
-        if (!begin_segment(s, busy, !lights_pending && !holding, trace_path))
+        if (!begin_segment(s, busy, !holding, trace_path))
             break;
         trace_path = trace_path && !holding;
         float time = ray_time();
         bool blocked;
         Hit shadow_hit, path_hit;
-        trace_rays(HAS_DIRECT_LIGHT && !gathers_in_place() && shadow.pending, shadow.ray, trace_path, s.origin, s.direction, time, INFINITY,
-                   blocked, shadow_hit, path_hit);
+        trace_rays(HAS_DIRECT_LIGHT && !gathers_in_place() && shadow.pending, shadow.ray, trace_path, s.origin,
+                   s.direction, time, INFINITY, blocked, shadow_hit, path_hit);
         if (trace_path)
             s.statistics.x += 1.0;
         if (holding)
@@ -106,11 +106,8 @@ void integrate(inout PixelState s)
                 vec3 light = shadow_arrived(shadow.transit, shadow.ray, blocked, shadow_hit) * shadow.contribution;
                 shadow.pending = false;
                 if (finishing) {
-                    finishing_radiance += light;
-                    if (!direct_light_pending(query)) {
-                        finish_sample(s, finishing_radiance);
-                        finishing = false;
-                    }
+                    finish_sample(s, finishing_radiance + light);
+                    finishing = false;
                 } else {
                     s.radiance += light;
                 }
@@ -118,7 +115,7 @@ void integrate(inout PixelState s)
         }
 
         // The path's segment, once nothing of its last vertex is pending.
-        bool shade = (trace_path || holding) && !shadow.pending && !(HAS_DIRECT_LIGHT && direct_light_pending(query));
+        bool shade = (trace_path || holding) && !shadow.pending;
         holding = (trace_path || holding) && !shade;
         held_hit = path_hit;
         bool path_done = false;
@@ -176,21 +173,20 @@ void integrate(inout PixelState s)
             begin_direct_light(query, -incoming, s.media, time, segment_bounce, s.radiance);
             if (gathers_in_place())
                 direct_light_in_place(query, s.light_total, s.radiance);
+            else if (direct_light_pending(query))   // one light sample: the shadow ray for the next iteration
+                shadow = next_shadow_ray(query, s.light_total);
         }
-        if (HAS_DIRECT_LIGHT && !gathers_in_place() && !shadow.pending && direct_light_pending(query))
-            shadow = next_shadow_ray(query, s.light_total);
         if (path_done) {
             s.bounce = 0u;
-            if (HAS_DIRECT_LIGHT && (shadow.pending || direct_light_pending(query))) {
+            if (HAS_DIRECT_LIGHT && shadow.pending) {
                 finishing = true;
                 finishing_radiance = s.radiance;
             } else {
                 finish_sample(s, s.radiance);
             }
         }
-        // The ended path's last light sample gave no shadow ray, or its shadow ray passed
-        // one volume boundary too many: nothing more comes.
-        if (finishing && !shadow.pending && !direct_light_pending(query)) {
+        // The ended path's shadow ray passed one volume boundary too many: nothing comes.
+        if (finishing && !shadow.pending) {
             finish_sample(s, finishing_radiance);
             finishing = false;
         }

@@ -28,9 +28,9 @@ struct PixelState {
 // Prepares the next iteration of the segment loop: starts a sample (its camera ray) when
 // no path is in flight and may_start, and counts the iteration's work. trace_path is set
 // when the path's next segment is to be traced now. False when the pixel stops for this
-// pass: no samples left or its work budget spent, and nothing busy (a shadow ray or
-// light samples still to take, a hit to shade) that must end in this pass, since the pass
-// state keeps none of them.
+// pass: no samples left or its work budget spent, and nothing busy (a shadow ray still
+// to trace, a hit to shade) that must end in this pass, since the pass state keeps
+// neither.
 bool begin_segment(inout PixelState s, bool busy, bool may_start, out bool trace_path)
 {
     bool budget_left = work < pass_work_budget;
