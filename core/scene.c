@@ -37,6 +37,7 @@ void scene_free(scene *s)
         free(s->meshes[i].positions);
         free(s->meshes[i].normals);
         free(s->meshes[i].uvs);
+        free(s->meshes[i].colors);
         free(s->meshes[i].indices);
         free(s->meshes[i].triangle_materials);
     }

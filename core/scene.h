@@ -195,6 +195,9 @@ typedef struct scene_mesh {
     float *positions;            /* 3 per vertex */
     float *normals;              /* 3 per vertex, or NULL: flat shading */
     float *uvs;                  /* 2 per vertex, or NULL; v points up (v = 1: image top row) */
+    float *colors;               /* 3 per vertex (linear RGB, 0..1), or NULL: none; a pbr
+                                  * material with vertex_colors multiplies its base colour
+                                  * by them (PLY, glTF COLOR_0) */
     uint32_t *indices;           /* 3 per triangle, into the vertex arrays */
     int *triangle_materials;     /* per triangle: index into scene.materials or -1 */
     int vertex_count, triangle_count;
