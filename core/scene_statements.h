@@ -43,7 +43,7 @@ typedef bool (*statement_parser)(scene_parser *p, source_line *line, const token
 typedef bool (*clause_reader)(scene_parser *p, source_line *line, int clause, void *target);
 
 /* A statement takes at most this many kinds of clause. */
-#define MAX_CLAUSES 8
+#define MAX_CLAUSES 16
 
 /* Reads the clauses of a statement to the end of its line, in any order, each at most
  * once: names (count of them) are the clause words, statement names the statement in
