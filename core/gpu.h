@@ -106,6 +106,9 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_INSTANCES       no instance record: one BVH level
  *   GPU_OMIT_EMITTERS        no emissive material
  *   GPU_OMIT_QUADS           no quad
+ *   GPU_OMIT_PBR             no pbr material
+ *   GPU_OMIT_ALPHA_MASK      no alpha-masked material (the traversal's alpha test)
+ *   GPU_OMIT_VERTEX_COLORS   no vertex colour section
  *   GPU_FIX_UNIFORMS         the integrator and the sky type compiled in as constants
  *                            (the values in the parameters), not read from the
  *                            parameter block
@@ -120,7 +123,10 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_EMITTERS (1u << 7)
 #define GPU_OMIT_QUADS (1u << 8)
 #define GPU_FIX_UNIFORMS (1u << 9)
-#define GPU_VARIANT_BITS 10
+#define GPU_OMIT_PBR (1u << 10)
+#define GPU_OMIT_ALPHA_MASK (1u << 11)
+#define GPU_OMIT_VERTEX_COLORS (1u << 12)
+#define GPU_VARIANT_BITS 13
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct

@@ -193,6 +193,9 @@ static void variant_defines(uint32_t omitted, int integrator, int sky_type, char
         {GPU_OMIT_INSTANCES, "RTSPHERES_OMIT_INSTANCES"},
         {GPU_OMIT_EMITTERS, "RTSPHERES_OMIT_EMITTERS"},
         {GPU_OMIT_QUADS, "RTSPHERES_OMIT_QUADS"},
+        {GPU_OMIT_PBR, "RTSPHERES_OMIT_PBR"},
+        {GPU_OMIT_ALPHA_MASK, "RTSPHERES_OMIT_ALPHA_MASK"},
+        {GPU_OMIT_VERTEX_COLORS, "RTSPHERES_OMIT_VERTEX_COLORS"},
         {GPU_FIX_UNIFORMS, "RTSPHERES_FIX_UNIFORMS"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;

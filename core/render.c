@@ -76,8 +76,9 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
  * GPU_FIX_UNIFORMS, from what the packed scene holds (pack.h, pack_summary): no light
  * sampling in path tracing without lights (or with it switched off), no volumes when there
  * is none and the camera is in none, no textures when there is none and no material has a
- * normal map; primitive types and emitters as the packed records (every BVH level) hold
- * them. The --full-tracer option asks for 0: everything, read from uniforms. */
+ * normal map; primitive types, emitters, the pbr material, alpha masks and vertex colours
+ * as the packed records (every BVH level) hold them. The --full-tracer option asks for 0:
+ * everything, read from uniforms. */
 static uint32_t omitted_features(const packed_scene *packed, const render_options *options, uint32_t camera_media)
 {
     if (options->full_tracer)
@@ -103,6 +104,12 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_INSTANCES;
     if (!contents->emitters)
         omitted |= GPU_OMIT_EMITTERS;
+    if (!contents->pbr)
+        omitted |= GPU_OMIT_PBR;
+    if (!contents->alpha_mask)
+        omitted |= GPU_OMIT_ALPHA_MASK;
+    if (!contents->vertex_colors)
+        omitted |= GPU_OMIT_VERTEX_COLORS;
     return omitted;
 }
 

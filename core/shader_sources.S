@@ -35,9 +35,9 @@ shader_modules:
     module "glsl/sampling.glsl", SHADER_PROGRAM_TRACER
     module "glsl/camera.glsl", SHADER_PROGRAM_TRACER
     module "glsl/scene_access.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/textures.glsl", SHADER_PROGRAM_TRACER              /* before intersect: alpha masks */
     module "glsl/intersect.glsl", SHADER_PROGRAM_TRACER
     module "glsl/traverse.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/textures.glsl", SHADER_PROGRAM_TRACER
     module "glsl/sky.glsl", SHADER_PROGRAM_TRACER
     module "glsl/surface.glsl", SHADER_PROGRAM_TRACER
     module "glsl/media.glsl", SHADER_PROGRAM_TRACER
@@ -46,6 +46,8 @@ shader_modules:
     module "glsl/material_metal.glsl", SHADER_PROGRAM_TRACER
     module "glsl/material_dielectric.glsl", SHADER_PROGRAM_TRACER
     module "glsl/material_emissive.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/microfacet.glsl", SHADER_PROGRAM_TRACER            /* GGX, for pbr */
+    module "glsl/material_pbr.glsl", SHADER_PROGRAM_TRACER
     module "glsl/material_phong.glsl", SHADER_PROGRAM_TRACER        /* Whitted's shading model */
     module "glsl/material_table.glsl", SHADER_PROGRAM_TRACER        /* the table of materials */
     module "glsl/lights.glsl", SHADER_PROGRAM_TRACER

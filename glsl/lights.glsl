@@ -128,7 +128,7 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
             return false;
     }
     Material material = material_record(primitive_info(head.y) & uint(PRIMITIVE_INFO_MATERIAL_MASK));
-    emitted = emissive_emitted(material, x, uv);
+    emitted = emissive_emitted(material, x, uv) * emitted_side(material, direction, n);
     return true;
 }
 

@@ -103,7 +103,8 @@ void cross_volume_boundary(inout PixelState s, Surface surface, bool front_face,
 }
 
 // The path hit an emitter (surface): its radiance joins the path's, weighted by MIS when
-// light sampling could have found it too. The caller ends the path.
+// light sampling could have found it too. The material's sample then ends the path or,
+// for a pbr emitter, sends it on.
 void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material)
 {
     // MIS wants the path's last scattering vertex, origin - since_vertex * direction. But

@@ -1,30 +1,33 @@
 // textures.glsl: images (bilinear, wrapping), procedural noise, and the texture records
 // of the packed scene (core/packed_layout.h "textures", "images").
 
-// Bilinear lookup of image (index) at uv, wrapping. Texture coordinates follow OBJ and
-// the Ray Tracing books: u to the right, v UP, so v = 1 is the image's top row (images are
-// stored top row first).
-vec3 image_lookup(uint image, vec2 uv)
+// Bilinear lookup of image (index) at uv, wrapping: its RGBA. Texture coordinates follow
+// OBJ and the Ray Tracing books: u to the right, v UP, so v = 1 is the image's top row
+// (images are stored top row first).
+vec4 image_lookup_rgba(uint image, vec2 uv)
 {
     uvec4 record = packed_texel(image_offset + image * uint(PACKED_IMAGE_STRIDE));
     uint first = record.x;
     int width = int(record.y), height = int(record.z);
     if (width == 0 || height == 0)
-        return vec3(1.0, 0.0, 1.0);
+        return vec4(1.0, 0.0, 1.0, 1.0);
     vec2 position = vec2(fract(uv.x), 1.0 - fract(uv.y)) * vec2(width, height) - 0.5;
     ivec2 corner = ivec2(floor(position));
     vec2 weight = position - vec2(corner);
-    vec3 colour = vec3(0.0);
+    vec4 colour = vec4(0.0);
     for (int k = 0; k < 4; k++) {
         work++;
         ivec2 texel = corner + ivec2(k & 1, k >> 1);
         texel.x = (texel.x % width + width) % width;
         texel.y = clamp(texel.y, 0, height - 1);
         float w = ((k & 1) != 0 ? weight.x : 1.0 - weight.x) * ((k >> 1) != 0 ? weight.y : 1.0 - weight.y);
-        colour += w * packed_vec4(first + uint(texel.y * width + texel.x)).rgb;
+        colour += w * packed_vec4(first + uint(texel.y * width + texel.x));
     }
     return colour;
 }
+
+// The same, its colour.
+vec3 image_lookup(uint image, vec2 uv) { return image_lookup_rgba(image, uv).rgb; }
 
 // Gradient noise in [-1, 1] with hashed gradients (Perlin's construction, hash instead
 // of a permutation table so that no table needs uploading).
