@@ -229,6 +229,44 @@ void gpu_tracer_destroy(gpu_tracer *tracer);
 rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32_t sample_index, uint32_t seed,
                              uint32_t dimension, float *rgba, rt_error *error);
 
+/* One query of the material test: a ray along direction meets a surface (normal: the
+ * geometric normal facing the ray, shading: the shading normal, front_face: whether the
+ * ray met the primitive's front) whose material is the packed scene's material number
+ * material; u are the four uniform numbers its sample function draws from, to_light a
+ * direction at which its evaluate and pdf functions are read as well. All directions
+ * unit, in the world. */
+typedef struct gpu_material_query {
+    float direction[3];
+    float normal[3];
+    float shading[3];
+    bool front_face;
+    float u[4];
+    float to_light[3];
+    uint32_t material;
+} gpu_material_query;
+
+/* What the material functions of glsl/material_table.glsl return for one query
+ * (view = -direction). */
+typedef struct gpu_material_result {
+    float direction[3];          /* material_sample: where the path goes on */
+    float pdf;                   /* its BsdfSample.pdf (the density MIS is given) */
+    float weight[3];             /* its f cos / pdf */
+    bool absorbed, light_sampled;
+    float evaluate[3];           /* material_evaluate(view, to_light): f cos */
+    float evaluate_pdf;          /* material_pdf(view, to_light) */
+    float sampled_evaluate[3];   /* the same at the sampled direction */
+    float sampled_pdf;
+} gpu_material_result;
+
+/* Runs the tracer's material functions (the whole tracer's: no part left out) on the
+ * device for count queries against a packed scene (texels as gpu_tracer_create takes
+ * them; only its header, materials, textures and images are read), filling results[0 ..
+ * count - 1]. For testing a material's sampling, density and evaluation where they run
+ * (tests/unit/test_material_pbr.c). The caller owns both arrays. */
+rt_status gpu_material_test(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
+                            const gpu_material_query *queries, int count, gpu_material_result *results,
+                            rt_error *error);
+
 /* Compiles the whole tracer (no part left out) and reads where the GL placed the members
  * of its parameter block: offsets[i] receives the byte offset of the member called
  * names[i] (-1 when the program has none of that name), *block_size the block's size

@@ -50,6 +50,13 @@
 #define TRACER_AOV_NORMAL 1
 #define TRACER_AOV_COUNT 2
 
+/* ---- the material test program (gpu.h gpu_material_test, glsl/material_test.frag): its
+ * queries, MATERIAL_TEST_QUERY_TEXELS RGBA32F texels each in a buffer texture on unit
+ * MATERIAL_TEST_QUERY_UNIT, and its MATERIAL_TEST_OUTPUTS RGBA32F outputs (locations 0 on) */
+#define MATERIAL_TEST_QUERY_UNIT 0
+#define MATERIAL_TEST_QUERY_TEXELS 5
+#define MATERIAL_TEST_OUTPUTS 4
+
 /* ---- bindings: texture unit of the packed scene, uniform buffer of the parameter block,
  * atomic counter buffer (unfinished pixels at offset 0, finished samples at offset 4) */
 #define TRACER_PACKED_SCENE_UNIT 7
