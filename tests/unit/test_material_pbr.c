@@ -2,10 +2,11 @@
  * (gpu.h gpu_material_test): its sampling against its density by a chi-square test as
  * Mitsuba's BSDF tests do it, the density MIS is given against the sampled one, weights
  * against evaluate / pdf, white furnaces against single-scattering GGX integrated here in
- * double precision, reciprocity, and the roughness-0 limit against the metal and
- * dielectric materials. */
+ * double precision, reciprocity, the roughness-0 limit against the metal and dielectric
+ * materials, and vertex colours in a render. */
 #include "gpu.h"
 #include "pack.h"
+#include "render.h"
 #include "scene.h"
 
 #include "support.h"
@@ -606,6 +607,88 @@ static void roughness_zero_is_the_metal_and_the_dielectric(void **state)
     free(queries);
 }
 
+/* ---- vertex colours ------------------------------------------------------------------ */
+
+/* A scene of one triangle mesh in front of the camera under a white sky: a pbr material
+ * whose base colour is base, times the vertex colours (each vertex colour) when given. */
+static void coloured_triangle(scene *s, const float base[3], const float (*colors)[3])
+{
+    scene_defaults(s);
+    s->render.width = s->render.height = 16;
+    s->render.samples_per_pixel = 16;
+    s->render.max_depth = 4;
+    s->sky.type = SKY_CONSTANT;
+    s->sky.bottom[0] = s->sky.bottom[1] = s->sky.bottom[2] = 1;
+    s->camera.look_from[2] = 3;
+    s->camera.vertical_fov_degrees = 30;
+    scene_material m = scene_material_defaults();
+    m.type = MATERIAL_PBR;
+    memcpy(m.albedo, base, sizeof m.albedo);
+    m.roughness = 0.6f;
+    m.index_of_refraction = 1.5f;
+    m.vertex_colors = colors != NULL;
+    assert_true(scene_add_material(s, &m) == 0);
+    scene_mesh mesh = {.default_material = 0, .vertex_count = 3, .triangle_count = 1};
+    const float positions[9] = {-2, -2, 0, 2, -2, 0, 0, 2, 0};
+    const uint32_t indices[3] = {0, 1, 2};
+    mesh.positions = malloc(sizeof positions);
+    mesh.indices = malloc(sizeof indices);
+    memcpy(mesh.positions, positions, sizeof positions);
+    memcpy(mesh.indices, indices, sizeof indices);
+    if (colors != NULL) {
+        mesh.colors = malloc(9 * sizeof(float));
+        memcpy(mesh.colors, colors, 9 * sizeof(float));
+    }
+    scene_object object = {.mesh = scene_add_mesh(s, &mesh)};
+    assert_true(scene_add_object(s, &object) >= 0);
+    scene_instance here = {.object = 0, .material = 0};
+    scene_identity_transform(here.object_to_world);
+    assert_true(scene_add_instance(s, &here) >= 0);
+}
+
+/* Renders s; the caller frees the image. */
+static rt_image render_image(const scene *s)
+{
+    render_result result;
+    rt_error error;
+    if (render_scene(context, s, NULL, &result, &error) != RT_OK)
+        fail_msg("%s", error.message);
+    image_free(&result.aovs);
+    return result.image;
+}
+
+/* Vertex colours multiply the base colour: a mesh whose vertices are all one colour
+ * renders as the base colour times it (to the unsigned 16-bit fractions they are stored
+ * as), and colours that differ per vertex are interpolated. */
+static void vertex_colours_multiply_the_base_colour(void **state)
+{
+    (void)state;
+    const float white[3] = {1, 1, 1}, colour[3] = {0.2f, 0.6f, 0.9f};
+    const float same[3][3] = {{0.2f, 0.6f, 0.9f}, {0.2f, 0.6f, 0.9f}, {0.2f, 0.6f, 0.9f}};
+    const float corners[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    scene plain, coloured, mixed;
+    coloured_triangle(&plain, colour, NULL);
+    coloured_triangle(&coloured, white, same);
+    coloured_triangle(&mixed, white, corners);
+    rt_image a = render_image(&plain), b = render_image(&coloured), c = render_image(&mixed);
+    double largest = 0;
+    for (size_t i = 0; i < 16 * 16 * 4; i++)
+        largest = fmax(largest, fabs(a.pixels[i] - b.pixels[i]));
+    assert_true(largest < 1e-4);
+    const float *centre = &a.pixels[(8 * 16 + 8) * 4];
+    assert_true(centre[0] < 0.5f * centre[2]);        /* the triangle's colour, not the sky's */
+    /* Towards the red corner (bottom left) red leads, towards the blue one (top) blue. */
+    const float *low = &c.pixels[(13 * 16 + 3) * 4], *high = &c.pixels[(1 * 16 + 8) * 4];
+    assert_true(low[0] > 1.5 * low[1] && low[0] > 1.1 * low[2]);
+    assert_true(high[2] > 1.5 * high[0] && high[2] > 1.5 * high[1]);
+    image_free(&a);
+    image_free(&b);
+    image_free(&c);
+    scene_free(&plain);
+    scene_free(&coloured);
+    scene_free(&mixed);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -617,6 +700,7 @@ int main(void)
         cmocka_unit_test(rough_glass_furnace_loses_what_single_scattering_loses),
         cmocka_unit_test(evaluate_is_reciprocal),
         cmocka_unit_test(roughness_zero_is_the_metal_and_the_dielectric),
+        cmocka_unit_test(vertex_colours_multiply_the_base_colour),
     };
     return cmocka_run_group_tests(tests, set_up, tear_down);
 }
