@@ -106,7 +106,8 @@ vec3 pbr_evaluate_pdf(PbrView p, vec3 to_light, out float pdf)
     vec3 value = vec3(0.0);
     if (l.z > 0.0) {
         vec3 h = normalize(v + l);
-        float vh = max(dot(v, h), 0.0);
+        // Clamped: v.h may round above 1, and pow of a negative base is undefined.
+        float vh = clamp(dot(v, h), 0.0, 1.0);
         float dielectric = pbr_dielectric_fresnel(vh, p.eta_ratio);
         value = (1.0 - p.metallic) * (1.0 - p.transmission) * (1.0 - dielectric) * p.base * (l.z / PI);
         pdf = p.p_diffuse * l.z / PI;
@@ -126,7 +127,7 @@ vec3 pbr_evaluate_pdf(PbrView p, vec3 to_light, out float pdf)
             float denominator = p.eta_ratio * vh + lh;
             float jacobian = abs(lh) / (denominator * denominator);   // d(omega_h) / d(omega_l)
             float d = ggx_distribution(h, p.alpha);
-            float transmitted = 1.0 - pbr_dielectric_fresnel(vh, p.eta_ratio);
+            float transmitted = 1.0 - pbr_dielectric_fresnel(min(vh, 1.0), p.eta_ratio);
             value = (1.0 - p.metallic) * p.transmission * transmitted * p.base
                     * (d * vh * jacobian / (v.z * (1.0 + lambda_v + lambda_l)));
             pdf = (1.0 - p.p_specular - p.p_diffuse) * d * vh * jacobian / (v.z * (1.0 + lambda_v));

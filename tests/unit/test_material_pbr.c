@@ -384,6 +384,44 @@ static void samples_carry_their_density_and_weight(void **state)
     }
 }
 
+/* Where v.h rounds above 1 (light straight back along the view, views at the normal)
+ * every value is a number: Schlick's (1 - v.h)^5 of a negative base is undefined in GLSL
+ * (a chart render once had two NaN pixels from it). */
+static void values_at_the_mirror_direction_are_numbers(void **state)
+{
+    (void)state;
+    enum { COUNT = 1 << 14 };
+    gpu_material_query *queries = malloc(COUNT * sizeof *queries);
+    assert_non_null(queries);
+    const int materials[] = {METAL_03, METAL_10, DIELECTRIC_05, MIXED_04, GLASS_05, HALF_GLASS_07};
+    uint64_t seed = 800;
+    for (int i = 0; i < COUNT; i++) {
+        vec n = normalized(make_vec(uniform(&seed) - 0.5, uniform(&seed) - 0.5, uniform(&seed) - 0.5));
+        frame f = frame_around(n);
+        /* Views at or within a few float steps of the normal; the light straight back. */
+        vec view = i % 2 ? n : normalized(to_world(&f, make_vec(1e-4 * (uniform(&seed) - 0.5), 0, 1)));
+        queries[i] = (gpu_material_query){.front_face = i % 4 < 2, .material = (uint32_t)materials[i % 6]};
+        store(queries[i].direction, scale(view, -1));
+        store(queries[i].normal, n);
+        store(queries[i].shading, n);
+        store(queries[i].to_light, view);
+        for (int k = 0; k < 4; k++)
+            queries[i].u[k] = uniform(&seed);
+    }
+    gpu_material_result *r = run(queries, COUNT);
+    for (int i = 0; i < COUNT; i++) {
+        assert_true(isfinite(r[i].pdf) && isfinite(r[i].evaluate_pdf) && isfinite(r[i].sampled_pdf));
+        for (int c = 0; c < 3; c++)
+            if (!(isfinite(r[i].weight[c]) && isfinite(r[i].evaluate[c]) && isfinite(r[i].sampled_evaluate[c])
+                  && isfinite(r[i].direction[c])))
+                fail_msg("query %d (material %u, front %d): weight %g, evaluate %g, at the sample %g, direction %g",
+                         i, queries[i].material, queries[i].front_face, r[i].weight[c], r[i].evaluate[c],
+                         r[i].sampled_evaluate[c], r[i].direction[c]);
+    }
+    free(r);
+    free(queries);
+}
+
 /* ---- white furnaces ------------------------------------------------------------------ */
 
 static double lambda(vec w, double alpha)
@@ -696,6 +734,7 @@ int main(void)
         cmocka_unit_test(dielectric_sampling_follows_its_density),
         cmocka_unit_test(transmission_sampling_follows_its_density),
         cmocka_unit_test(samples_carry_their_density_and_weight),
+        cmocka_unit_test(values_at_the_mirror_direction_are_numbers),
         cmocka_unit_test(metal_furnace_loses_what_single_scattering_loses),
         cmocka_unit_test(rough_glass_furnace_loses_what_single_scattering_loses),
         cmocka_unit_test(evaluate_is_reciprocal),
