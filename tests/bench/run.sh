@@ -20,6 +20,8 @@
 #   three-balls-anim  24 frames (--frames 0-23) at 320x180, 4 spp, one GPU context
 #   cornell        600x600, 4 spp; next-week 400x400 (half the book's), 2 spp;
 #   crystal-ball   640x480, 4 spp
+#   pbr-chart      scenes/pbr-chart.txt 640x360, 16 spp: the pbr material, every
+#                  roughness and metallic (issue 14)
 #   mesh-L         icospheres of level L (3 5 6 8: 1,280 / 20,480 / 81,920 / 1,310,720
 #                  triangles, the nearest levels to the issue's 1k/10k/100k/1M), 320x240,
 #                  16 spp, depth 8
@@ -288,6 +290,8 @@ bench_animation three-balls-anim scenes/three-balls.txt 320x180 "$(scaled 4)" 24
 bench cornell scenes/cornell.txt 600x600 "$(scaled 4)" ""
 bench next-week scenes/next-week.txt 400x400 "$(scaled 2)" ""
 bench crystal-ball scenes/crystal-ball.txt 640x480 "$(scaled 4)" ""
+# The pbr material (issue 14): a chart of roughness by metallic under a sphere light.
+bench pbr-chart scenes/pbr-chart.txt 640x360 "$(scaled 16)" ""
 
 # Time to quality against Cycles (tests/bench/peers.sh): ladders of spp, RMSE against
 # each renderer's own cached high-spp reference. The issue's sizes: the Cornell box at
