@@ -92,7 +92,17 @@ static void print_result(const image_diff_result *result, double fail_threshold,
     }
 }
 
-int command_diff(int argc, char **argv)
+/* What the command line asks for. */
+typedef struct diff_arguments {
+    double fail_threshold, fail_percent, hard_fail, scale;
+    bool hard_fail_set, diff_always, quiet;
+    const char *diff_out;  /* NULL: no difference image */
+    const char *path_a, *path_b;
+} diff_arguments;
+
+/* Reads the options and the two paths into *arguments; returns true to go on, or false
+ * with the command's exit code in *exit_code (after --help, or a message on stderr). */
+static bool parse_arguments(int argc, char **argv, diff_arguments *arguments, int *exit_code)
 {
     enum { OPTION_FAIL = 256, OPTION_FAIL_PERCENT, OPTION_HARD_FAIL, OPTION_DIFF_OUT,
            OPTION_DIFF_ALWAYS, OPTION_SCALE };
@@ -107,10 +117,8 @@ int command_diff(int argc, char **argv)
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
-    double fail_threshold = DEFAULT_FAIL, fail_percent = DEFAULT_FAIL_PERCENT;
-    double hard_fail = 0.0, scale = DEFAULT_SCALE;
-    const char *diff_out = NULL;
-    bool hard_fail_set = false, diff_always = false, quiet = false;
+    *arguments = (diff_arguments){
+        .fail_threshold = DEFAULT_FAIL, .fail_percent = DEFAULT_FAIL_PERCENT, .scale = DEFAULT_SCALE};
 
     /* Our own messages instead of getopt's, which would say "diff: ..." */
     opterr = 0;
@@ -119,66 +127,88 @@ int command_diff(int argc, char **argv)
     while ((option = getopt_long(argc, argv, ":qh", long_options, NULL)) != -1) {
         switch (option) {
         case OPTION_FAIL:
-            if (!parse_number(optarg, 0.0, HUGE_VAL, &fail_threshold)) {
+            if (!parse_number(optarg, 0.0, HUGE_VAL, &arguments->fail_threshold)) {
                 fprintf(stderr, "rtspheres diff: --fail wants an error of 0 or more, e.g. 0.016, "
                                 "not '%s'\n", optarg);
-                return EXIT_BAD_INPUT;
+                *exit_code = EXIT_BAD_INPUT;
+                return false;
             }
             break;
         case OPTION_FAIL_PERCENT:
-            if (!parse_number(optarg, 0.0, 100.0, &fail_percent)) {
+            if (!parse_number(optarg, 0.0, 100.0, &arguments->fail_percent)) {
                 fprintf(stderr, "rtspheres diff: --failpercent wants a percentage from 0 to 100, "
                                 "not '%s'\n", optarg);
-                return EXIT_BAD_INPUT;
+                *exit_code = EXIT_BAD_INPUT;
+                return false;
             }
             break;
         case OPTION_HARD_FAIL:
-            if (!parse_number(optarg, 0.0, HUGE_VAL, &hard_fail)) {
+            if (!parse_number(optarg, 0.0, HUGE_VAL, &arguments->hard_fail)) {
                 fprintf(stderr, "rtspheres diff: --hardfail wants an error of 0 or more, "
                                 "not '%s'\n", optarg);
-                return EXIT_BAD_INPUT;
+                *exit_code = EXIT_BAD_INPUT;
+                return false;
             }
-            hard_fail_set = true;
+            arguments->hard_fail_set = true;
             break;
         case OPTION_DIFF_OUT:
-            diff_out = optarg;
+            arguments->diff_out = optarg;
             break;
         case OPTION_DIFF_ALWAYS:
-            diff_always = true;
+            arguments->diff_always = true;
             break;
         case OPTION_SCALE:
-            if (!parse_number(optarg, 0.0, HUGE_VAL, &scale) || scale == 0.0) {
+            if (!parse_number(optarg, 0.0, HUGE_VAL, &arguments->scale) || arguments->scale == 0.0) {
                 fprintf(stderr, "rtspheres diff: --scale wants a factor above 0, e.g. 16, "
                                 "not '%s'\n", optarg);
-                return EXIT_BAD_INPUT;
+                *exit_code = EXIT_BAD_INPUT;
+                return false;
             }
             break;
         case 'q':
-            quiet = true;
+            arguments->quiet = true;
             break;
         case 'h':
             print_help(stdout);
-            return EXIT_OK;
+            *exit_code = EXIT_OK;
+            return false;
         case ':':
             fprintf(stderr, "rtspheres diff: %s needs a value (see 'rtspheres diff --help')\n",
                     argv[optind - 1]);
-            return EXIT_BAD_INPUT;
+            *exit_code = EXIT_BAD_INPUT;
+            return false;
         default:
             fprintf(stderr, "rtspheres diff: unknown option '%s' (see 'rtspheres diff --help')\n",
                     argv[optind - 1]);
-            return EXIT_BAD_INPUT;
+            *exit_code = EXIT_BAD_INPUT;
+            return false;
         }
     }
     if (argc - optind != 2) {
         fprintf(stderr, "rtspheres diff: expected two images, got %d; usage: rtspheres diff A B "
                         "[options]\n", argc - optind);
-        return EXIT_BAD_INPUT;
+        *exit_code = EXIT_BAD_INPUT;
+        return false;
     }
-    if (diff_always && diff_out == NULL) {
+    if (arguments->diff_always && arguments->diff_out == NULL) {
         fprintf(stderr, "rtspheres diff: --diff-always needs --diff-out FILE\n");
-        return EXIT_BAD_INPUT;
+        *exit_code = EXIT_BAD_INPUT;
+        return false;
     }
-    const char *path_a = argv[optind], *path_b = argv[optind + 1];
+    arguments->path_a = argv[optind];
+    arguments->path_b = argv[optind + 1];
+    return true;
+}
+
+/* Compares the two images of arguments and prints the verdict (and writes the difference
+ * image); returns the command's exit code. */
+static int compare_images(const diff_arguments *arguments)
+{
+    const char *path_a = arguments->path_a, *path_b = arguments->path_b;
+    const char *diff_out = arguments->diff_out;
+    double fail_threshold = arguments->fail_threshold, fail_percent = arguments->fail_percent;
+    double hard_fail = arguments->hard_fail;
+    bool hard_fail_set = arguments->hard_fail_set;
 
     rt_error error;
     rt_image a, b;
@@ -207,7 +237,7 @@ int command_diff(int argc, char **argv)
     options.fail_percent = zero_as_smallest(fail_percent);
     /* --hardfail 0 means "no difference at all", not image_diff's "off". */
     options.hard_fail = hard_fail_set ? zero_as_smallest(hard_fail) : 0.0;
-    options.diff_scale = scale;
+    options.diff_scale = arguments->scale;
     image_diff_result result;
     rt_image difference = {0};
     rt_status status = image_diff(&a, &b, &options, &result, diff_out ? &difference : NULL,
@@ -221,13 +251,13 @@ int command_diff(int argc, char **argv)
         exit_code = EXIT_BAD_INPUT;
     } else {
         /* --quiet silences a match only: a failure's numbers are what one looks at next. */
-        bool show = !quiet || !result.passed;
+        bool show = !arguments->quiet || !result.passed;
         if (show) {
             print_metrics(&result, &a, compared, fail_threshold);
             print_result(&result, fail_threshold, fail_percent, hard_fail_set, hard_fail);
         }
         exit_code = result.passed ? EXIT_OK : EXIT_RUNTIME;
-        if (diff_out != NULL && (diff_always || !result.passed)) {
+        if (diff_out != NULL && (arguments->diff_always || !result.passed)) {
             /* An unwritable difference image is an error, not a verdict about the images. */
             if (image_write(diff_out, &difference, NULL, &error) != RT_OK) {
                 fprintf(stderr, "rtspheres diff: %s\n", error.message);
@@ -241,4 +271,13 @@ int command_diff(int argc, char **argv)
     image_free(&a);
     image_free(&b);
     return exit_code;
+}
+
+int command_diff(int argc, char **argv)
+{
+    diff_arguments arguments;
+    int exit_code;
+    if (!parse_arguments(argc, argv, &arguments, &exit_code))
+        return exit_code;
+    return compare_images(&arguments);
 }

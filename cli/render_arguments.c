@@ -56,6 +56,9 @@ static void print_help(FILE *stream)
             "      --tonemap OP       for 8-bit outputs: clamp (default), reinhard or aces\n"
             "      --light-sampling on|off  sample lights at diffuse hits (next-event\n"
             "                         estimation with MIS; default on): less noise, same image\n"
+            "      --sampler KIND     sobol (default: stratified, Owen-scrambled Sobol points) or\n"
+            "                         independent (hashed random numbers): the same image,\n"
+            "                         more noise; for comparisons\n"
             "      --roulette-depth N paths may end at random (Russian roulette, unbiased)\n"
             "                         after N segments (default 4)\n"
             "      --full-tracer      compile the whole tracer, also the code this scene cannot\n"
@@ -73,7 +76,7 @@ enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
-    OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER,
+    OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -164,6 +167,7 @@ static const char *take_value(int option, const char *value, render_job *job)
     static const choice tonemaps[] = {{"clamp", TONEMAP_CLAMP}, {"reinhard", TONEMAP_REINHARD}, {"aces", TONEMAP_ACES}};
     static const choice integrators[] = {{"path", INTEGRATOR_PATH}, {"whitted", INTEGRATOR_WHITTED}};
     static const choice switches[] = {{"on", 0}, {"off", 1}};
+    static const choice samplers[] = {{"sobol", SAMPLER_SOBOL}, {"independent", SAMPLER_INDEPENDENT}};
     static const choice shard_kinds[] = {
         {"frames", RENDER_SHARD_FRAMES}, {"samples", RENDER_SHARD_SAMPLES}, {"tiles", RENDER_SHARD_TILES}};
     long long a = 0, b = 0;
@@ -229,6 +233,11 @@ static const char *take_value(int option, const char *value, render_job *job)
         if (!parse_choice(value, switches, 2, &word))
             return "--light-sampling wants on or off";
         job->tracer.no_light_sampling = word == 1;
+        return NULL;
+    case OPTION_SAMPLER:
+        if (!parse_choice(value, samplers, 2, &word))
+            return "--sampler wants sobol or independent";
+        job->tracer.sampler = word;
         return NULL;
     case OPTION_SHARD_BY:
         if (!parse_choice(value, shard_kinds, 3, &word))
@@ -364,6 +373,7 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
         {"checkpoint", required_argument, NULL, OPTION_CHECKPOINT},
         {"resume", required_argument, NULL, OPTION_RESUME},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
+        {"sampler", required_argument, NULL, OPTION_SAMPLER},
         {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
         {"aovs", no_argument, NULL, OPTION_AOVS},

@@ -106,10 +106,14 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_INSTANCES       no instance record: one BVH level
  *   GPU_OMIT_EMITTERS        no emissive material
  *   GPU_OMIT_QUADS           no quad
+ *   GPU_OMIT_LIGHT_CHOICE    lights are chosen by power alone (1 light, or more than
+ *                            LIGHT_LOCAL_CHOICE_MAX of core/tracer_interface.h), never by
+ *                            their estimated irradiance at the point (glsl/lights.glsl)
+ *   GPU_OMIT_RECTANGLE_LIGHTS  no quad light, so no sampling by spherical rectangles
  *   GPU_OMIT_PBR             no pbr material
  *   GPU_OMIT_ALPHA_MASK      no alpha-masked material (the traversal's alpha test)
  *   GPU_OMIT_VERTEX_COLORS   no vertex colour section
- *   GPU_FIX_UNIFORMS         the integrator and the sky type compiled in as constants
+ *   GPU_FIX_UNIFORMS         the integrator, the sky type and the sampler compiled in as constants
  *                            (the values in the parameters), not read from the
  *                            parameter block
  * glsl/variant.glsl turns them into the constants HAS_* the tracer tests. */
@@ -123,10 +127,12 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_EMITTERS (1u << 7)
 #define GPU_OMIT_QUADS (1u << 8)
 #define GPU_FIX_UNIFORMS (1u << 9)
-#define GPU_OMIT_PBR (1u << 10)
-#define GPU_OMIT_ALPHA_MASK (1u << 11)
-#define GPU_OMIT_VERTEX_COLORS (1u << 12)
-#define GPU_VARIANT_BITS 13
+#define GPU_OMIT_LIGHT_CHOICE (1u << 10)
+#define GPU_OMIT_RECTANGLE_LIGHTS (1u << 11)
+#define GPU_OMIT_PBR (1u << 12)
+#define GPU_OMIT_ALPHA_MASK (1u << 13)
+#define GPU_OMIT_VERTEX_COLORS (1u << 14)
+#define GPU_VARIANT_BITS 15
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct
@@ -222,12 +228,23 @@ void gpu_tracer_destroy(gpu_tracer *tracer);
 
 /* ---- tests ------------------------------------------------------------------------ */
 
-/* Draws the tracer's random numbers (glsl/random.glsl) for one (sample index, seed,
- * dimension) on the device: rgba receives width*height*4 floats, rows top to bottom, and
- * pixel (x, y) gets the four numbers the tracer draws for that pixel. For testing the
- * generator where it runs. */
-rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32_t sample_index, uint32_t seed,
-                             uint32_t dimension, float *rgba, rt_error *error);
+/* What gpu_random_numbers() draws. Zero is a default for every field but width/height:
+ * sampler SAMPLER_SOBOL (tracer_interface.h), per-pixel layout. */
+typedef struct gpu_random_request {
+    int width, height;           /* the output image, >= 1 */
+    uint32_t sample_index, seed, dimension;
+    int sampler;                 /* SAMPLER_* of tracer_interface.h */
+    bool over_samples;           /* false: pixel (x, y) gets its own values for sample_index;
+                                  * true: every output pixel shows pixel fixed_pixel, output
+                                  * pixel (x, y) holding sample sample_index + y * width + x */
+    int fixed_pixel[2];          /* with over_samples: the image pixel (x, y), row 0 at the top */
+} gpu_random_request;
+
+/* Draws the tracer's sample values (glsl/random.glsl) on the device, as the request says:
+ * rgba receives width*height*4 floats, rows top to bottom, the four numbers of one
+ * dimension per output pixel. For testing the sampler where it runs. */
+rt_status gpu_random_numbers(gpu_context *context, const gpu_random_request *request, float *rgba,
+                             rt_error *error);
 
 /* One query of the material test: a ray along direction meets a surface (normal: the
  * geometric normal facing the ray, shading: the shading normal, front_face: whether the

@@ -176,9 +176,10 @@ static GLuint build_fragment_program(uintptr_t program, const char *defines, rt_
 
 /* Writes the #defines of a tracer variant into defines (size bytes): every
  * RTSPHERES_OMIT_* as 1 when its GPU_OMIT_* bit is in omitted, else 0 (glsl/variant.glsl
- * reads them), and RTSPHERES_FIX_UNIFORMS with the integrator and sky type it compiles in
- * (0 when not fixed, so the source does not vary with the parameters). */
-static void variant_defines(uint32_t omitted, int integrator, int sky_type, char *defines, size_t size)
+ * reads them), and RTSPHERES_FIX_UNIFORMS with the integrator, sky type and sampler of
+ * settings it compiles in (0 when not fixed, so the source does not vary with the
+ * parameters; settings may then be NULL). */
+static void variant_defines(uint32_t omitted, const tracer_parameter_block *settings, char *defines, size_t size)
 {
     static const struct {
         uint32_t bit;
@@ -197,6 +198,8 @@ static void variant_defines(uint32_t omitted, int integrator, int sky_type, char
         {GPU_OMIT_ALPHA_MASK, "RTSPHERES_OMIT_ALPHA_MASK"},
         {GPU_OMIT_VERTEX_COLORS, "RTSPHERES_OMIT_VERTEX_COLORS"},
         {GPU_FIX_UNIFORMS, "RTSPHERES_FIX_UNIFORMS"},
+        {GPU_OMIT_LIGHT_CHOICE, "RTSPHERES_OMIT_LIGHT_CHOICE"},
+        {GPU_OMIT_RECTANGLE_LIGHTS, "RTSPHERES_OMIT_RECTANGLE_LIGHTS"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;
@@ -205,36 +208,37 @@ static void variant_defines(uint32_t omitted, int integrator, int sky_type, char
         used += (size_t)snprintf(defines + used, size - used, "#define %s %d\n", features[i].name,
                                  (omitted & features[i].bit) != 0);
     if (used < size)
-        snprintf(defines + used, size - used, "#define RTSPHERES_INTEGRATOR %d\n#define RTSPHERES_SKY_TYPE %d\n",
-                 fixed ? integrator : 0, fixed ? sky_type : 0);
+        snprintf(defines + used, size - used,
+                 "#define RTSPHERES_INTEGRATOR %d\n#define RTSPHERES_SKY_TYPE %d\n#define RTSPHERES_SAMPLER %d\n",
+                 fixed ? settings->integrator : 0, fixed ? settings->sky_type : 0, fixed ? settings->sampler : 0);
 }
 
 /* The key of a variant in the context's program cache: the bits, and the constants
  * compiled in with GPU_FIX_UNIFORMS. */
-static uint32_t variant_key(uint32_t omitted, int integrator, int sky_type)
+static uint32_t variant_key(uint32_t omitted, const tracer_parameter_block *settings)
 {
     omitted &= (1u << GPU_VARIANT_BITS) - 1u;
     if (omitted & GPU_FIX_UNIFORMS)
-        return omitted | (uint32_t)(integrator & 3) << 16 | (uint32_t)(sky_type & 15) << 20;
+        return omitted | (uint32_t)(settings->integrator & 3) << 16 | (uint32_t)(settings->sky_type & 15) << 20
+               | (uint32_t)(settings->sampler & 3) << 24;
     return omitted;
 }
 
 /* The context's tracer program for the variant of the parameters (omitted_features,
- * integrator, sky type), compiled on first use and kept (the oldest goes when the cache
+ * integrator, sky type, sampler), compiled on first use and kept (the oldest goes when the cache
  * is full; a render holding it still has it, since only the next render asks again). */
 static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *parameters, rt_error *error)
 {
     gpu_context *context = tracer->context;
     uint32_t omitted = parameters->omitted_features;
-    int integrator = parameters->shader.integrator, sky_type = parameters->shader.sky_type;
-    uint32_t key = variant_key(omitted, integrator, sky_type);
+    uint32_t key = variant_key(omitted, &parameters->shader);
     for (int i = 0; i < context->tracer_program_count; i++)
         if (context->tracer_programs[i].key == key) {
             tracer->program = context->tracer_programs[i].program;
             return RT_OK;
         }
     char defines[1024];
-    variant_defines(omitted, integrator, sky_type, defines, sizeof defines);
+    variant_defines(omitted, &parameters->shader, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
@@ -548,7 +552,7 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
     /* The render's variant: the AOV pass reaches no more of the tracer than the render. */
     char defines[1024];
     const gpu_tracer_parameters *p = &tracer->parameters;
-    variant_defines(p->omitted_features, p->shader.integrator, p->shader.sky_type, defines, sizeof defines);
+    variant_defines(p->omitted_features, &p->shader, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_AOV, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
@@ -624,10 +628,11 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
     free(tracer);
 }
 
-rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32_t sample_index, uint32_t seed,
-                             uint32_t dimension, float *rgba, rt_error *error)
+rt_status gpu_random_numbers(gpu_context *context, const gpu_random_request *request, float *rgba,
+                             rt_error *error)
 {
     (void)context;
+    int width = request->width, height = request->height;
     GLuint program = build_fragment_program(SHADER_PROGRAM_RANDOM_TEST, "", error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
@@ -644,10 +649,14 @@ rt_status gpu_random_numbers(gpu_context *context, int width, int height, uint32
     glBindVertexArray(vertex_array);
     glViewport(0, 0, width, height);
     glUseProgram(program);
-    glUniform1ui(glGetUniformLocation(program, "sample_index"), sample_index);
-    glUniform1ui(glGetUniformLocation(program, "seed"), seed);
-    glUniform1ui(glGetUniformLocation(program, "dimension"), dimension);
+    glUniform1ui(glGetUniformLocation(program, "sample_index"), request->sample_index);
+    glUniform1ui(glGetUniformLocation(program, "seed"), request->seed);
+    glUniform1ui(glGetUniformLocation(program, "dimension"), request->dimension);
     glUniform1i(glGetUniformLocation(program, "image_height"), height);
+    glUniform1i(glGetUniformLocation(program, "image_width"), width);
+    glUniform1i(glGetUniformLocation(program, "sampler"), request->sampler);
+    glUniform2i(glGetUniformLocation(program, "fixed_pixel"), request->over_samples ? request->fixed_pixel[0] : -1,
+                request->fixed_pixel[1]);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     size_t row_floats = (size_t)width * 4;
     float *bottom_up = malloc(row_floats * (size_t)height * sizeof(float));
@@ -723,7 +732,7 @@ rt_status gpu_material_test(gpu_context *context, const uint32_t *packed_texels,
     if (status != RT_OK)
         return status;
     char defines[1024];
-    variant_defines(0, 0, 0, defines, sizeof defines);
+    variant_defines(0, NULL, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_MATERIAL_TEST, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
@@ -799,7 +808,7 @@ rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const cha
 {
     (void)context;
     char defines[1024];
-    variant_defines(0, 0, 0, defines, sizeof defines);
+    variant_defines(0, NULL, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;

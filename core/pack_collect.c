@@ -451,15 +451,10 @@ bool pack_is_emissive(const scene *s, uint32_t material)
  * instance and in the world when baked, which agree under similarities only. Solid
  * textures (checker, noise) read the world position either way. Volumes never bake: a
  * path's media are instance numbers (glsl/tracer.frag, media_enter).
- *
- * For now objects with a dielectric material stay instanced too. Baking moves their
- * arithmetic by float rounding like any other's, but a path through glass carries that
- * rounding to wherever it lands, and scenes/crystal-ball.txt's checker floor lies on a
- * cell boundary (y = 0, cells of 0.5: texture_value in glsl/tracer.frag takes
- * floor(p.y / 0.5), which is 0 or -1 by the sign of p.y's rounding): baked, its crystal
- * re-coloured 7% of the golden image's pixels (with the floor a plain colour, or lifted
- * by 0.001, no pixel moved by more than 1e-4). Once the checker is robust to points on
- * its cell boundaries, this exception can go. */
+ * Glass bakes like anything else: a path through it carries the float rounding of the
+ * baked arithmetic to wherever it lands, which matters only where the colour there
+ * hangs on rounding, as it did on a checker's cell boundary before the checker's cells
+ * were offset (glsl/textures.glsl). */
 
 /* What a placement's object holds under it, as far as baking is concerned. */
 typedef struct placement_needs {
@@ -467,7 +462,6 @@ typedef struct placement_needs {
     bool spheres;         /* spheres or moving spheres: a similarity is needed */
     bool spheres_oriented;/* one of them reads uv or has a normal map: no rotation either */
     bool shading_frame;   /* vertex normals or a normal map on a triangle or quad: a similarity */
-    bool dielectric;      /* a dielectric material: instanced for now (see above) */
 } placement_needs;
 
 /* Whether texture (an index of s->textures, or -1) reads the surface's uv: an image, or
@@ -512,12 +506,11 @@ static placement_needs placement_needs_of(const scene *s, const scene_instance *
     if (object->mesh >= 0) {
         const scene_mesh *mesh = &s->meshes[object->mesh];
         needs.shading_frame = mesh->normals != NULL;
-        for (int t = 0; t < mesh->triangle_count && !(needs.emits && needs.shading_frame && needs.dielectric); t++) {
+        for (int t = 0; t < mesh->triangle_count && !(needs.emits && needs.shading_frame); t++) {
             int own = mesh->triangle_materials ? mesh->triangle_materials[t] : -1;
             uint32_t material = resolve_material(own, instance->material);
             needs.emits |= pack_is_emissive(s, material);
             needs.shading_frame |= material_normal_map(s, material, &reads_uv);
-            needs.dielectric |= material_is(s, material, MATERIAL_DIELECTRIC);
         }
         return needs;
     }
@@ -533,7 +526,6 @@ static placement_needs placement_needs_of(const scene *s, const scene_instance *
         }
         if (shape->type != SHAPE_MOVING_SPHERE)
             needs.emits |= pack_is_emissive(s, material);
-        needs.dielectric |= material_is(s, material, MATERIAL_DIELECTRIC);
     }
     return needs;
 }
@@ -567,7 +559,7 @@ static placement placement_of(const scene *s, const scene_instance *instance)
         return PLACEMENT_INSTANCE;
     if (needs.emits)
         return PLACEMENT_BAKE;
-    if (!(linear_determinant(m) > 0) || (needs.shading_frame && !(similarity_scale(m) > 0)) || needs.dielectric)
+    if (!(linear_determinant(m) > 0) || (needs.shading_frame && !(similarity_scale(m) > 0)))
         return PLACEMENT_INSTANCE;
     return PLACEMENT_MAY_BAKE;
 }

@@ -41,20 +41,33 @@ static void write_area_lights(packer *p, double *power)
         double luminance = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
         double area;
         uint32_t type;
+        vec3 centre, normal = {0, 0, 0};
         if (item->type == PRIMITIVE_SPHERE) {
             area = 4 * M_PI * item->data[0][3] * item->data[0][3];
             type = LIGHT_SPHERE;
+            glm_vec3_copy((float *)item->data[0], centre);
         } else {
-            vec3 normal;
             glm_vec3_cross((float *)item->data[1], (float *)item->data[2], normal);
             area = sqrt((double)glm_vec3_norm2(normal)) * (item->type == PRIMITIVE_QUAD ? 1.0 : 0.5);
+            glm_vec3_normalize(normal);
             type = item->type == PRIMITIVE_QUAD ? LIGHT_QUAD : LIGHT_TRIANGLE;
+            /* The centre: of the parallelogram Q + (u + v) / 2, of the triangle v0 + (e1 + e2) / 3. */
+            float share = item->type == PRIMITIVE_QUAD ? 0.5f : 1.0f / 3.0f;
+            for (int axis = 0; axis < 3; axis++)
+                centre[axis] = item->data[0][axis] + share * (item->data[1][axis] + item->data[2][axis]);
         }
         /* A light of no power is still listed (for MIS weights) but never chosen. */
         power[light] = luminance * area * M_PI;
         /* Slots ascend with light: the shader finds a primitive's light by a binary
          * search of the first area_light_count lights. */
-        put_texel(p->texels, p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE, type, slot, 0, 0);
+        uint64_t base = p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
+        put_texel(p->texels, base, type, slot, 0, 0);
+        /* What the shader's estimate of this light's irradiance at a point reads
+         * (glsl/lights.glsl, light_importance); texel 1's w is the cdf, written last. */
+        put_texel(p->texels, base + 1, float_bits(centre[0]), float_bits(centre[1]), float_bits(centre[2]), 0);
+        put_texel(p->texels, base + 2, float_bits(normal[0]), float_bits(normal[1]), float_bits(normal[2]),
+                  float_bits((float)(luminance * area)));
+        put_texel(p->texels, base + 3, float_bits((float)area), 0, 0, 0);
         p->out->summary.light_types |= 1u << type;
         light++;
     }
@@ -161,8 +174,10 @@ static rt_status write_environment(packer *p, uint32_t light, double radius, dou
     }
     free(row_sums);
     power[light] = 4 * M_PI * radius * radius * mean * p->scene->sky.intensity;
-    put_texel(texels, p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE, LIGHT_ENVIRONMENT,
-              (uint32_t)width, (uint32_t)height, 0);
+    uint64_t base = p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
+    put_texel(texels, base, LIGHT_ENVIRONMENT, (uint32_t)width, (uint32_t)height, 0);
+    /* The irradiance it gives a surface facing any way, about pi x its mean radiance. */
+    put_texel(texels, base + 2, 0, 0, 0, float_bits((float)(M_PI * mean * p->scene->sky.intensity)));
     p->out->summary.light_types |= 1u << LIGHT_ENVIRONMENT;
     return RT_OK;
 }

@@ -1,7 +1,8 @@
 /* packed_layout.h: the one definition of the packed scene records, shared by C and GLSL.
  *
- * This file is included by the C packer (core/pack.c) and prepended, byte for byte, to the
- * GLSL tracer when the shader is built (see core/shader_sources.S). It must therefore stay
+ * This file is included by the C packer (core/pack*.c, through pack_internal.h) and
+ * prepended, byte for byte, to the GLSL tracer when the shader is built (see
+ * core/shader_sources.S). It must therefore stay
  * valid in both languages: only comments, include guards and #define of plain integers.
  *
  * The packed scene is an array of texels of four 32-bit unsigned integers (GL_RGBA32UI).
@@ -174,7 +175,8 @@
  * float bits, one texel each, rows top to bottom, after all the records */
 #define PACKED_IMAGE_STRIDE 1
 
-/* ---- lights: 4 texels (what next-event estimation samples, chosen by power)
+/* ---- lights: 4 texels (what next-event estimation samples: see glsl/lights.glsl for how
+ * one is chosen: by power, or by its estimated irradiance at the point)
  *   texel 0 = (type tag, primitive slot (area lights), 0, 0) -- see below for the others
  *   texel 1 = (position.xyz (point, spot) or direction towards the light (sun), cdf)
  *             cdf: the probability of choosing this light or any before it
@@ -184,9 +186,12 @@
  *   texel 1 .xyz = position (point, spot) or the direction towards the sun, texel 2 .w = cos
  *   of the spot's outer half-angle or of the sun's angular radius.
  * Area lights are emissive world primitives (spheres, quads, triangles), listed first and
- * in primitive order (see primitives): their radiance is their material's emission.
+ * in primitive order (see primitives): their radiance is their material's emission;
+ * texel 1 .xyz = their centre, texel 2 = (unit normal.xyz (spheres: 0), emitted
+ * luminance x area), texel 3 .x = their area.
  * environment (an equirectangular sky): texel 0 = (LIGHT_ENVIRONMENT, image width, image
- * height, 0); it is importance-sampled by the environment section: one float per texel
+ * height, 0), texel 2 .w = the irradiance it gives (pi x its mean luminance x the sky's
+ * intensity); it is importance-sampled by the environment section: one float per texel
  * (in .x): the cumulative distribution over rows (height values), then for each row the
  * cumulative distribution over its pixels (width values), of luminance x sin(latitude). */
 #define PACKED_LIGHT_STRIDE 4

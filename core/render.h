@@ -57,6 +57,8 @@ typedef struct render_options {
                                   * the scene cannot reach (gpu.h GPU_OMIT_*); for checking
                                   * that leaving them out changes no image */
     render_integrator integrator;
+    int sampler;                 /* SAMPLER_* of tracer_interface.h: 0, the default, is
+                                  * SAMPLER_SOBOL; SAMPLER_INDEPENDENT for comparisons */
     bool aovs;                   /* also render the AOV image (see render_result.aovs) */
     uint32_t russian_roulette_depth;
     uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */

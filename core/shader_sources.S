@@ -26,7 +26,7 @@
     .balign 16
     .global shader_modules
 shader_modules:
-    module "core/tracer_interface.h", SHADER_PROGRAM_SHADING        /* ids, the parameter list */
+    module "core/tracer_interface.h", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST /* ids, parameters */
     module "core/packed_layout.h", SHADER_PROGRAM_SHADING           /* the packed scene's records */
     module "glsl/random.glsl", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST
     module "glsl/random_test.frag", SHADER_PROGRAM_RANDOM_TEST

@@ -33,6 +33,15 @@
 #define SKY_ENVIRONMENT 3            /* an equirectangular (latitude-longitude) image */
 #define SKY_TYPE_COUNT 4
 
+/* ---- samplers (the parameter sampler; glsl/random.glsl) */
+#define SAMPLER_SOBOL 0              /* padded, shuffled, Owen-scrambled Sobol pairs (default) */
+#define SAMPLER_INDEPENDENT 1        /* independent hashed numbers */
+#define SAMPLER_COUNT 2
+
+/* ---- light choice (glsl/lights.glsl): scenes of 2 to this many lights choose a light by its
+ * estimated irradiance at the point; others by power alone */
+#define LIGHT_LOCAL_CHOICE_MAX 8
+
 /* ---- pass state: one texture per target, read by unit TRACER_STATE_* (sampler binding)
  * and written to colour attachment TRACER_STATE_* (output location) of each pass
  * (glsl/main.glsl says what each holds) */
@@ -89,6 +98,7 @@
     P(uvec2, sky_faces_z)            /* +Z, -Z */ \
     P(uint, sky_environment)         /* environment: image index */ \
     P(uint, seed)                    /* the random seed */ \
+    P(int, sampler)                  /* SAMPLER_* */ \
     P(uint, sample_start)            /* first sample index (sample ranges) */ \
     P(uint, samples_per_pixel) \
     P(uint, max_depth)               /* at most this many path segments per sample */ \

@@ -55,8 +55,9 @@ LightQuery surface_light_query(bool wanted, int model, vec3 p, ShadingFrame fram
 
 // The light the query's point sends towards view (the reverse of the incoming ray),
 // per unit of the path's throughput: the caller multiplies by query.weight. media and
-// time are the path's, bounce picks the random numbers.
-vec3 direct_light(LightQuery query, vec3 view, uint media, float time, uint bounce)
+// time are the path's, bounce picks the random numbers; light_total receives what MIS at
+// the path's next emitter hit needs of the light choice here (glsl/lights.glsl).
+vec3 direct_light(LightQuery query, vec3 view, uint media, float time, uint bounce, inout float light_total)
 {
     bool phong_model = query.model == DIRECT_PHONG;
     vec3 result = phong_model ? ambient * query.material.albedo : vec3(0.0);
@@ -69,12 +70,19 @@ vec3 direct_light(LightQuery query, vec3 view, uint media, float time, uint boun
         work++;
         vec4 u = !phong_model ? random4(bounce, 5u)
                               : fract(random4(bounce, 6u + (k & 1u)) + float(k >> 1u) * 0.6180339887);
-        uint light = choose ? choose_light(u.x) : k;
-        float choice = choose ? light_probability(light) : 1.0;
+        float choice = 1.0;
+        uint light = k;
+        if (!phong_model)
+            light = choose_light_at(u.x, query.position, choice, light_total);
+        else if (choose) {
+            light = choose_light(u.x);
+            choice = light_power_probability(light);
+        }
         if (choice <= 0.0)
             continue;
         LightSample light_sample;
-        if (!sample_light_from(light, query.position, u.yz, light_sample))
+        // u.x chooses the light; the point on it is the stratified pair (z, w).
+        if (!sample_light_from(light, query.position, u.zw, light_sample))
             continue;
         vec3 to_light = light_sample.direction;
         vec3 value;

@@ -8,7 +8,10 @@ bool path_samples_lights() { return light_sampling != 0; }
 
 // A path that leaves the scene sees the sky, weighted by MIS against light sampling of
 // an environment sky.
-float path_sky_weight(PixelState s) { return environment_mis_weight(s.previous_pdf, s.direction); }
+float path_sky_weight(PixelState s)
+{
+    return environment_mis_weight(s.previous_pdf, s.light_total, s.origin - s.since_vertex * s.direction, s.direction);
+}
 
 // At a surface the path goes on as the material samples it, and gathers direct light
 // where the material says (weighted by MIS: previous_pdf keeps the sample's density).

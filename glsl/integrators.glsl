@@ -111,7 +111,7 @@ void integrate(inout PixelState s)
             }
         }
         if (HAS_DIRECT_LIGHT && query.wanted)
-            s.radiance += query.weight * direct_light(query, -incoming, s.media, time, segment_bounce);
+            s.radiance += query.weight * direct_light(query, -incoming, s.media, time, segment_bounce, s.light_total);
         if (path_done)
             finish_sample(s);
         if (overflow)

@@ -1,9 +1,25 @@
-// lights.glsl: light sampling: choosing a light by power, a direction towards it and its
-// density, and the multiple importance sampling (MIS) weights that combine light sampling
-// with BSDF sampling (the light records are core/packed_layout.h "lights").
+// lights.glsl: light sampling: choosing a light, a direction towards it and its density,
+// and the multiple importance sampling (MIS) weights that combine light sampling with
+// BSDF sampling (the light records are core/packed_layout.h "lights").
+
+// ---- choosing a light
+//
+// By power (choose_light, light_power_probability): a binary search of the cdf the packer
+// wrote, the same wherever the point is. By the point (choose_light_at,
+// light_choice_probability), for scenes of 2 to LOCAL_CHOICE_MAX lights: each light's
+// chance follows an estimate of the irradiance it gives the point (light_importance: its
+// power over the squared distance, the light's own orientation, a spot's cone), mixed
+// with its power-based chance (POWER_SHARE of it) so that every light that could light
+// the point keeps a chance. The estimate leaves out the receiver's orientation, so the
+// probability MIS needs when a path hits an emitter depends only on the position of the
+// vertex it came from. Scenes with more lights choose by power: the estimate's loop over
+// all lights would cost more than it saves (a light tree is the answer for those).
+const uint LOCAL_CHOICE_MAX = uint(LIGHT_LOCAL_CHOICE_MAX);
+const float POWER_SHARE = 0.25;
+const vec3 LUMINANCE = vec3(0.2126, 0.7152, 0.0722);   // Rec. 709, as the packer's powers
 
 // The probability that choose_light() picks light.
-float light_probability(uint light)
+float light_power_probability(uint light)
 {
     float cdf = packed_vec4(light_offset + light * uint(PACKED_LIGHT_STRIDE) + 1u).w;
     float before = light > 0u ? packed_vec4(light_offset + (light - 1u) * uint(PACKED_LIGHT_STRIDE) + 1u).w : 0.0;
@@ -11,6 +27,97 @@ float light_probability(uint light)
 }
 
 // Picks a light by power: binary search of the cumulative probabilities.
+uint choose_light(float u);
+
+// An estimate of the irradiance light gives point p, up to one factor common to all
+// lights (luminance, no receiver cosine, no occlusion): what choose_light_at weighs by.
+float light_importance(uint light, vec3 p)
+{
+    uint base = light_offset + light * uint(PACKED_LIGHT_STRIDE);
+    uvec4 head = packed_texel(base);
+    vec4 where = packed_vec4(base + 1u);
+    vec4 colour = packed_vec4(base + 2u);
+    if (head.x == uint(LIGHT_ENVIRONMENT))
+        return colour.w;
+    if (head.x == uint(LIGHT_SUN))
+        return dot(colour.rgb, LUMINANCE);
+    vec3 to_light = where.xyz - p;
+    float distance_squared = max(dot(to_light, to_light), 1e-20);
+    if (head.x <= uint(LIGHT_TRIANGLE)) {
+        // Radiance x the solid angle it covers (at most a hemisphere): the projected area
+        // over the squared distance; a sphere's projected area is a quarter of its area.
+        float area = max(packed_vec4(base + 3u).x, 1e-30);
+        float facing = head.x == uint(LIGHT_SPHERE) ? 0.25 : abs(dot(colour.xyz, to_light)) * inversesqrt(distance_squared);
+        return colour.w / area * min(area * facing / distance_squared, 2.0 * PI);
+    }
+    vec3 attenuation = uintBitsToFloat(head.yzw);
+    float distance = sqrt(distance_squared);
+    float falloff = attenuation == vec3(0.0) ? distance_squared
+                  : attenuation.x + attenuation.y * distance + attenuation.z * distance_squared;
+    float importance = dot(colour.rgb, LUMINANCE) / max(falloff, 1e-12);
+    if (head.x == uint(LIGHT_SPOT)) {
+        vec4 spot = packed_vec4(base + 3u);
+        importance *= smoothstep(colour.w, max(spot.w, colour.w + 1e-6), dot(-to_light / distance, spot.xyz));
+    }
+    return importance;
+}
+
+// Whether lights are chosen by the point (see above) in this scene. The variant leaves the
+// code out when the host knows they are not (HAS_LIGHT_CHOICE): llvmpipe would run its
+// loops once however many lights there are.
+bool chooses_by_point() { return HAS_LIGHT_CHOICE && light_count > 1u && light_count <= LOCAL_CHOICE_MAX; }
+
+// The probability that choose_light_at(u, p) picks light (importance: its
+// light_importance at p, total: the sum over all lights).
+float mixed_probability(uint light, float importance, float total)
+{
+    float power = light_power_probability(light);
+    return total > 0.0 ? mix(importance / total, power, POWER_SHARE) : power;
+}
+
+// The probability that choose_light_at() picks light for point p, where it found the
+// importances' total (its out parameter).
+float light_choice_probability(uint light, vec3 p, float total)
+{
+    if (!chooses_by_point())
+        return light_power_probability(light);
+    return mixed_probability(light, light_importance(light, p), total);
+}
+
+// Picks a light for point p from u uniform in [0, 1) (see above); probability receives the
+// chance it had, total the sum of all lights' importance at p (0 when chosen by power),
+// which light_choice_probability() needs for the same point.
+uint choose_light_at(float u, vec3 p, out float probability, out float total)
+{
+    total = 0.0;
+    if (!chooses_by_point()) {
+        uint light = choose_light(u);
+        probability = light_power_probability(light);
+        return light;
+    }
+    float importance[LOCAL_CHOICE_MAX];
+    for (uint l = 0u; l < light_count; l++) {
+        work++;
+        importance[l] = light_importance(l, p);
+        total += importance[l];
+    }
+    uint chosen = light_count - 1u;
+    probability = mixed_probability(chosen, importance[chosen], total);
+    float cumulative = 0.0;
+    bool found = false;
+    for (uint l = 0u; l + 1u < light_count; l++) {
+        work++;
+        float q = mixed_probability(l, importance[l], total);
+        cumulative += q;
+        if (!found && u < cumulative) {
+            found = true;
+            chosen = l;
+            probability = q;
+        }
+    }
+    return chosen;
+}
+
 uint choose_light(float u)
 {
     uint low = 0u, high = light_count - 1u;
@@ -53,11 +160,83 @@ uint area_light_of(uint slot)
                                                                                                            : NONE;
 }
 
+// ---- rectangles by solid angle (Urena, Fajardo and King, "An Area-Preserving
+// Parametrization for Spherical Rectangles", EGSR 2013): a point seen from p is drawn
+// uniformly in the solid angle the rectangle covers, so a nearby or slanted light is not
+// sampled mostly where it looks small. Parallelograms that are not rectangles, and
+// rectangles that cover less than RECTANGLE_MIN_SOLID_ANGLE (where float32 angles lose
+// their relative precision), are sampled by area instead; the choice depends on p and
+// the quad alone, so sampling and the density MIS asks for agree.
+const float RECTANGLE_MIN_SOLID_ANGLE = 1e-3;
+
+struct SphericalRectangle {
+    vec3 x, y, z;              // the rectangle's frame: edges (unit) and the normal facing away from p
+    float z0;                  // the plane's signed distance along z (< 0: z points away from p)
+    float x0, y0, x1, y1;      // the rectangle's extent in the frame, relative to p
+    float b0, b1, k;           // the parametrization's constants
+    float solid_angle;
+};
+
+// The spherical rectangle of the quad (corner, edge_x, edge_y) seen from p; false when
+// the quad is not a rectangle or covers too small a solid angle for this method.
+bool spherical_rectangle(vec3 corner, vec3 edge_x, vec3 edge_y, vec3 p, out SphericalRectangle r)
+{
+    float length_x = length(edge_x), length_y = length(edge_y);
+    r.x = edge_x / length_x;
+    r.y = edge_y / length_y;
+    r.z = cross(r.x, r.y);
+    vec3 d = corner - p;
+    r.z0 = dot(d, r.z);
+    if (r.z0 > 0.0) {
+        r.z = -r.z;
+        r.z0 = -r.z0;
+    }
+    r.x0 = dot(d, r.x);
+    r.y0 = dot(d, r.y);
+    r.x1 = r.x0 + length_x;
+    r.y1 = r.y0 + length_y;
+    // The normals of the great circles through its edges, and its inner angles.
+    vec3 n0 = normalize(vec3(0.0, r.z0, -r.y0));
+    vec3 n1 = normalize(vec3(-r.z0, 0.0, r.x1));
+    vec3 n2 = normalize(vec3(0.0, -r.z0, r.y1));
+    vec3 n3 = normalize(vec3(r.z0, 0.0, -r.x0));
+    float g0 = acos(clamp(-dot(n0, n1), -1.0, 1.0));
+    float g1 = acos(clamp(-dot(n1, n2), -1.0, 1.0));
+    float g2 = acos(clamp(-dot(n2, n3), -1.0, 1.0));
+    float g3 = acos(clamp(-dot(n3, n0), -1.0, 1.0));
+    r.b0 = n0.z;
+    r.b1 = n2.z;
+    r.k = 2.0 * PI - g2 - g3;
+    r.solid_angle = g0 + g1 - r.k;
+    bool rectangle = HAS_RECTANGLE_LIGHTS && abs(dot(r.x, r.y)) < 1e-4;
+    return rectangle && r.z0 < 0.0 && r.solid_angle > RECTANGLE_MIN_SOLID_ANGLE;
+}
+
+// The point of the rectangle at (u, v) of its solid-angle parametrization, in the frame
+// relative to p (add p to have it in the world): uniform in solid angle for uniform u.
+vec2 spherical_rectangle_point(SphericalRectangle r, vec2 u)
+{
+    float au = u.x * r.solid_angle + r.k;
+    float fu = (cos(au) * r.b0 - r.b1) / sin(au);
+    float cu = clamp((fu >= 0.0 ? 1.0 : -1.0) * inversesqrt(fu * fu + r.b0 * r.b0), -1.0, 1.0);
+    float xu = clamp(-(cu * r.z0) * inversesqrt(max(1.0 - cu * cu, 1e-20)), r.x0, r.x1);
+    float d = sqrt(xu * xu + r.z0 * r.z0);
+    float h0 = r.y0 * inversesqrt(d * d + r.y0 * r.y0);
+    float h1 = r.y1 * inversesqrt(d * d + r.y1 * r.y1);
+    float hv = h0 + u.y * (h1 - h0);
+    float yv = hv * hv < 1.0 - 1e-6 ? clamp(hv * d * inversesqrt(1.0 - hv * hv), r.y0, r.y1) : r.y1;
+    return vec2(xu, yv);
+}
+
 // Solid-angle density, seen from p, of the direction light sampling would pick towards
 // point x on area light (normal n there), given its record head and geometry. Spheres
-// are sampled by their visible cone.
+// are sampled by their visible cone, rectangles by their spherical rectangle, other
+// quads and triangles by area.
 float area_light_pdf(uvec4 head, vec4 a, vec4 edge1, vec4 edge2, vec3 p, vec3 x, vec3 n)
 {
+    SphericalRectangle rectangle;
+    if (head.x == uint(LIGHT_QUAD) && spherical_rectangle(a.xyz, edge1.xyz, edge2.xyz, p, rectangle))
+        return 1.0 / rectangle.solid_angle;
     if (head.x == uint(LIGHT_SPHERE)) {
         float distance_squared = dot(a.xyz - p, a.xyz - p);
         if (distance_squared <= a.w * a.w)
@@ -114,8 +293,16 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
         uv = vec2(0.5 + atan(-n.z, n.x) / (2.0 * PI), acos(clamp(-n.y, -1.0, 1.0)) / PI);
         pdf = 1.0 / (2.0 * PI * max(1.0 - cos_max, 1e-12));
     } else {
-        if (head.x == uint(LIGHT_TRIANGLE) && u.x + u.y > 1.0)
+        SphericalRectangle rectangle;
+        bool by_solid_angle = head.x == uint(LIGHT_QUAD) && spherical_rectangle(a.xyz, edge1.xyz, edge2.xyz, p,
+                                                                                   rectangle);
+        if (by_solid_angle) {
+            vec2 local = spherical_rectangle_point(rectangle, u);
+            uv = vec2((local.x - rectangle.x0) / (rectangle.x1 - rectangle.x0),
+                      (local.y - rectangle.y0) / (rectangle.y1 - rectangle.y0));
+        } else if (head.x == uint(LIGHT_TRIANGLE) && u.x + u.y > 1.0) {
             uv = vec2(1.0) - u;   // fold the square onto the triangle: still uniform
+        }
         x = a.xyz + uv.x * edge1.xyz + uv.y * edge2.xyz;
         n = normalize(cross(edge1.xyz, edge2.xyz));
         vec3 to_light = x - p;
@@ -210,24 +397,27 @@ bool sample_light_from(uint light, vec3 p, vec2 u, out LightSample s)
 // path's last vertex chose its direction, 0 when that vertex sampled no light)
 
 // A path that hit the emissive world primitive hit.primitive at p (geometric normal n),
-// coming from vertex: light sampling could have found it too.
-float emitter_mis_weight(Hit hit, float previous_pdf, vec3 vertex, vec3 p, vec3 n)
+// coming from vertex, where light sampling found the importances' total light_total:
+// light sampling could have found it too.
+float emitter_mis_weight(Hit hit, float previous_pdf, float light_total, vec3 vertex, vec3 p, vec3 n)
 {
     uint light = previous_pdf > 0.0 && hit.instance == NONE ? area_light_of(hit.primitive) : NONE;
     if (light == NONE || light >= light_count)
         return 1.0;
-    float light_pdf = light_probability(light) * light_direction_pdf(light, vertex, p, n);
+    float light_pdf = light_choice_probability(light, vertex, light_total) * light_direction_pdf(light, vertex, p, n);
     return power_heuristic(previous_pdf, light_pdf);
 }
 
-// A path that left the scene along direction: light sampling could have picked that
-// direction of an environment sky too (the environment is the last light).
-float environment_mis_weight(float previous_pdf, vec3 direction)
+// A path that left the scene along direction from vertex (light_total as above): light
+// sampling could have picked that direction of an environment sky too (the environment is
+// the last light).
+float environment_mis_weight(float previous_pdf, float light_total, vec3 vertex, vec3 direction)
 {
     if (previous_pdf > 0.0 && sky_kind() == SKY_ENVIRONMENT && light_count > 0u) {
         uint last = light_count - 1u;
         if (packed_texel(light_offset + last * uint(PACKED_LIGHT_STRIDE)).x == uint(LIGHT_ENVIRONMENT))
-            return power_heuristic(previous_pdf, light_probability(last) * environment_pdf(last, direction));
+            return power_heuristic(previous_pdf,
+                                   light_choice_probability(last, vertex, light_total) * environment_pdf(last, direction));
     }
     return 1.0;
 }

@@ -12,7 +12,7 @@ layout(binding = TRACER_STATE_ACCUMULATED) uniform sampler2D state_accumulated;
 layout(binding = TRACER_STATE_STATISTICS) uniform sampler2D state_statistics;
 
 layout(location = TRACER_STATE_ORIGIN) out vec4 out_origin;            // xyz: origin, w: since_vertex
-layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction
+layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction, w: light_total
 layout(location = TRACER_STATE_THROUGHPUT) out vec4 out_throughput;    // rgb: throughput, a: previous_pdf
 layout(location = TRACER_STATE_RADIANCE) out vec4 out_radiance;        // rgb: radiance
 layout(location = TRACER_STATE_COUNTERS) out uvec4 out_counters;       // samples_started, bounce, media
@@ -31,7 +31,9 @@ PixelState read_state(ivec2 pixel)
     uvec4 counters = texelFetch(state_counters, pixel, 0);
     s.origin = origin.xyz;
     s.since_vertex = origin.w;
-    s.direction = texelFetch(state_direction, pixel, 0).xyz;
+    vec4 direction = texelFetch(state_direction, pixel, 0);
+    s.direction = direction.xyz;
+    s.light_total = direction.w;
     s.throughput = throughput.rgb;
     s.previous_pdf = throughput.w;
     s.radiance = texelFetch(state_radiance, pixel, 0).rgb;
@@ -47,7 +49,7 @@ PixelState read_state(ivec2 pixel)
 void write_state(PixelState s)
 {
     out_origin = vec4(s.origin, s.since_vertex);
-    out_direction = vec4(s.direction, 0.0);
+    out_direction = vec4(s.direction, s.light_total);
     out_throughput = vec4(s.throughput, s.previous_pdf);
     out_radiance = vec4(s.radiance, 0.0);
     out_counters = uvec4(s.samples_started, s.bounce, s.media, 0u);

@@ -28,9 +28,9 @@
 //   4. one line in each function of glsl/material_table.glsl (and in material_emits /
 //      material_emitted if it emits);
 //   5. glsl/material_phong.glsl: whether Whitted shades it with Phong (phong_shades).
-// The parser (core/scene_statements_appearance.c) and the packer (core/pack.h) then make
-// and pack it; tests/unit/test_material_pbr.c shows how to test its sampling on the device
-// (gpu.h gpu_material_test).
+// The parser (core/scene_statements_appearance.c) and the packer (core/pack_materials.c) then
+// make and pack it; tests/unit/test_material_pbr.c shows how to test its sampling on the
+// device (gpu.h gpu_material_test).
 
 // A material record (packed_layout.h "materials") as shading reads it.
 struct Material {

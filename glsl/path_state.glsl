@@ -12,6 +12,9 @@ struct PixelState {
     float previous_pdf;     // the BSDF density of the direction the path left its last
                             // vertex by, when that vertex also sampled a light (then an
                             // emitter hit is weighted by MIS); 0 otherwise
+    float light_total;      // the sum of light_importance over the lights at the vertex
+                            // that last sampled a light (glsl/lights.glsl): with
+                            // previous_pdf, what MIS needs at the next emitter hit
     vec3 radiance;          // gathered by the path in flight
     uint samples_started;
     uint bounce;            // segments of the path in flight; 0: no path in flight
@@ -111,6 +114,6 @@ void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material
     // since_vertex is 0 here (a surface hit resets it first), so after volume boundaries
     // this is the last boundary instead. Kept as it was: fixing it changes images.
     vec3 vertex = s.origin - s.since_vertex * s.direction;
-    float weight = emitter_mis_weight(hit, s.previous_pdf, vertex, surface.position, surface.geometric);
+    float weight = emitter_mis_weight(hit, s.previous_pdf, s.light_total, vertex, surface.position, surface.geometric);
     s.radiance += s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
 }

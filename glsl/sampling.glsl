@@ -2,7 +2,9 @@
 // the warps that turn uniform numbers into directions and points.
 //
 // Random numbers are a pure function of (pixel, sample index, seed, bounce, stream): the
-// same sample renders the same whatever the pass split or the machine. Streams of one
+// same sample renders the same whatever the pass split or the machine. Each stream is one
+// dimension of glsl/random.glsl, four numbers whose (x, y) and (z, w) are the stratified
+// 2D pairs of the Sobol sampler: a 2D warp takes .xy or .zw. Streams of one
 // bounce: 0 the camera ray (film, lens), 1 scattering, 2 Russian roulette, 3 the ray time
 // (bounce 0), 4 the distance to a scattering event in a medium, 5 path tracing's light
 // sample, 6 and 7 Whitted's light samples.
@@ -14,7 +16,7 @@ uint rng_seed_hash;
 // Four uniform numbers in [0, 1) for one (bounce, stream) of the current sample.
 vec4 random4(uint bounce, uint stream)
 {
-    return random_numbers(rng_pixel, rng_sample, rng_seed_hash, bounce * 8u + stream);
+    return random_numbers(rng_pixel, rng_sample, rng_seed_hash, bounce * 8u + stream, sampler_kind());
 }
 
 vec3 random_unit_vector(vec2 u)

@@ -79,8 +79,11 @@ vec3 texture_value(uint texture, vec3 p, vec2 uv)
             return vec3(turbulence(data.w * p));
         if (head.x == uint(TEXTURE_MARBLE))
             return vec3(0.5 * (1.0 + sin(data.w * p.z + 10.0 * turbulence(p))));
-        // Checker: the cell parity of floor(p / scale) picks the even or the odd texture.
-        ivec3 cell = ivec3(floor(p / data.w));
+        // Checker: the cell parity of floor(p / scale + 1/4) picks the even or the odd
+        // texture. The quarter-cell offset keeps cell boundaries off the planes scenes put
+        // surfaces on (a floor at y = 0, walls at whole units), where the sign of a hit
+        // point's rounding would otherwise pick the cell.
+        ivec3 cell = ivec3(floor(p / data.w + 0.25));
         texture = ((cell.x + cell.y + cell.z) & 1) == 0 ? head.y : head.z;
     }
     return vec3(1.0, 0.0, 1.0);

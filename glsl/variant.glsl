@@ -15,6 +15,8 @@ const bool HAS_TRIANGLES = RTSPHERES_OMIT_TRIANGLES == 0;
 const bool HAS_QUADS = RTSPHERES_OMIT_QUADS == 0;
 const bool HAS_INSTANCES = RTSPHERES_OMIT_INSTANCES == 0;         // a second BVH level
 const bool HAS_EMITTERS = RTSPHERES_OMIT_EMITTERS == 0;           // emissive materials
+const bool HAS_LIGHT_CHOICE = RTSPHERES_OMIT_LIGHT_CHOICE == 0;   // lights chosen by the point
+const bool HAS_RECTANGLE_LIGHTS = RTSPHERES_OMIT_RECTANGLE_LIGHTS == 0;   // quad lights
 const bool HAS_PBR = RTSPHERES_OMIT_PBR == 0;                     // the pbr material
 const bool HAS_ALPHA_MASK = RTSPHERES_OMIT_ALPHA_MASK == 0;       // alpha-masked materials
 const bool HAS_VERTEX_COLORS = RTSPHERES_OMIT_VERTEX_COLORS == 0; // the vertex colour section
@@ -25,9 +27,10 @@ const bool HAS_FLAT = HAS_TRIANGLES || HAS_QUADS;
 const bool ONLY_SPHERES = !HAS_TRIANGLES && !HAS_QUADS && !HAS_MOVING_SPHERES && !HAS_INSTANCES;
 const bool ONLY_TRIANGLES = !HAS_SPHERES && !HAS_QUADS && !HAS_INSTANCES;
 
-// The integrator and the sky kind: compiled in as constants (RTSPHERES_FIX_UNIFORMS 1,
+// The integrator, the sky kind and the sampler: compiled in as constants (RTSPHERES_FIX_UNIFORMS 1,
 // gpu.h GPU_FIX_UNIFORMS), or read from the parameter block (the full tracer).
 const bool FIXED_SETTINGS = RTSPHERES_FIX_UNIFORMS != 0;
 
 int tracer_integrator() { return FIXED_SETTINGS ? RTSPHERES_INTEGRATOR : integrator; }
 int sky_kind() { return FIXED_SETTINGS ? RTSPHERES_SKY_TYPE : sky_type; }
+int sampler_kind() { return FIXED_SETTINGS ? RTSPHERES_SAMPLER : sampler; }

@@ -164,6 +164,79 @@ for integrator in path whitted; do
     plane_light sun-tilted "0 0 0" "light sun 0.866025 -0.5 0 intensity 3 angle 0" 0.238732 $integrator
 done
 
+# Rectangle lights on a diffuse plane (albedo 0.5, black sky): the point below a
+# rectangle's centre, parallel to it at height h, receives E = pi L F with F the form
+# factor of the four quarter rectangles (one corner each above the point): F = 4 / (2 pi)
+# (X / sqrt(1 + X^2) atan(Y / sqrt(1 + X^2)) + Y / sqrt(1 + Y^2) atan(X / sqrt(1 + Y^2))),
+# X, Y the quarter's sides over h; radiance albedo L F. Near (2 x 1 at h = 0.3: it covers
+# most of the sky above the point) light sampling draws points by solid angle (the
+# spherical rectangle of glsl/lights.glsl); far (0.5 x 0.5 at h = 50: 1e-4 sr, under the
+# threshold where float32 angles are precise enough) by area. The camera looks from the
+# side, under the light.
+rectangle_light() {
+    name=$1 h=$2 a=$3 b=$4 strength=$5 expected=$6 integrator=$7
+    cat >"$scratch/$name.txt" <<SCENE
+render size 8 8 spp 64 depth 2 seed 1
+camera from 3 0.5 0 at 0 0 0 up 0 1 0 fov 0.2
+sky constant 0 0 0
+ambient 0 0 0
+material floor lambertian 0.5 0.5 0.5 specular 0 0 0
+material panel emissive 1 1 1 strength $strength
+quad -50 0 -50  100 0 0  0 0 100 floor
+quad (-$a / 2) $h (-$b / 2)  $a 0 0  0 0 $b panel
+SCENE
+    if "$program" render "$scratch/$name.txt" -o "$scratch/$name.exr" --integrator "$integrator" --quiet; then
+        mean=$(channel_mean "$scratch/$name.exr" G)
+        if within "$mean" "$expected" 0.01; then pass "$name ($integrator): $mean, analytic $expected"
+        else fail "$name ($integrator)" "$mean, analytic $expected"; fi
+    else
+        fail "$name ($integrator)" "render failed"
+    fi
+}
+for integrator in path whitted; do
+    # F = 0.841662: 0.5 * 0.841662
+    rectangle_light rectangle-near 0.3 2 1 1 0.420831 $integrator
+    # F = 3.18299e-5: 0.5 * 1e4 * 3.18299e-5
+    rectangle_light rectangle-far 50 0.5 0.5 10000 0.159150 $integrator
+done
+
+# Several area lights: light sampling then chooses a light by its estimated irradiance at
+# the point (glsl/lights.glsl, choose_light_at) and samples rectangles by solid angle, a
+# sheared parallelogram and a triangle by area, a sphere by its cone; BSDF sampling alone
+# must converge to the same image, in every quarter.
+cat >"$scratch/area-lights.txt" <<SCENE
+render size 48 27 spp 256 depth 3 seed 1
+camera from 0 2.5 6 at 0 0.5 0 up 0 1 0 fov 45
+sky constant 0 0 0
+material floor lambertian 0.6 0.6 0.6
+material wall lambertian 0.3 0.5 0.7
+material warm emissive 1 0.8 0.6 strength 3
+material cool emissive 0.6 0.8 1 strength 6
+quad -6 0 -6  12 0 0  0 0 12 floor
+box -0.6 0 -0.6  0.6 1.2 0.6 wall
+quad -3 2 -1  1.5 0 0  0 0 1 warm
+quad 1.5 1.5 0  0.8 0 0  0.3 0.2 0.9 cool
+triangle 0 3 -2  1 3 -2  0 3 -1 warm
+sphere -2 0.5 1.5 0.25 cool
+SCENE
+a="$scratch/area-lights-on.exr"
+b="$scratch/area-lights-off.exr"
+if "$program" render "$scratch/area-lights.txt" -o "$a" --light-sampling on --quiet &&
+   "$program" render "$scratch/area-lights.txt" -o "$b" --light-sampling off --quiet; then
+    problems=""
+    for crop in 0,0,24,14 24,0,48,14 0,14,24,27 24,14,48,27; do
+        for channel in R G B; do
+            mean_a=$(channel_mean "$a" $channel $crop)
+            mean_b=$(channel_mean "$b" $channel $crop)
+            within "$mean_a" "$mean_b" 0.03 || problems="$problems $crop/$channel: $mean_a vs $mean_b;"
+        done
+    done
+    if [ -z "$problems" ]; then pass "four area lights: light sampling and BSDF sampling agree in every quarter (within 3%)"
+    else fail "four area lights: light sampling and BSDF sampling agree" "$problems"; fi
+else
+    fail "four area lights" "render failed"
+fi
+
 # An environment map as a light: a dim sky with one small, very bright patch (a "sun" of
 # four pixels). Importance sampling it must give the image that BSDF sampling alone
 # converges to (the mean of the floor agrees within 3%), with much less noise.
