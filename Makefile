@@ -56,7 +56,7 @@ SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer
 endif
 
 PKG_CONFIG ?= pkg-config
-PKGS := epoxy egl OpenImageIO tinyobjloader cglm
+PKGS := epoxy egl OpenImageIO tinyobjloader tinygltf cglm
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell $(PKG_CONFIG) --libs $(PKGS) 2>/dev/null)
 CMOCKA_LIBS = $(shell $(PKG_CONFIG) --libs cmocka 2>/dev/null)
