@@ -61,6 +61,14 @@ std::string number(double value)
     return text;
 }
 
+/* A whole number (a byte count that may not fit 64 bits) for a message. */
+std::string whole(double value)
+{
+    char text[64];
+    snprintf(text, sizeof text, "%.0f", value);
+    return text;
+}
+
 /* Copies text into a fixed buffer of size bytes, cut to fit. */
 void copy_name(char *buffer, size_t size, const std::string &text)
 {
@@ -82,6 +90,8 @@ template <typename T> T *to_malloc(const std::vector<T> &values)
 /* What the shim collects besides the model: warnings, each once. */
 struct context {
     std::vector<std::string> warnings;
+    std::string first_skipped;   /* the first primitive of points or lines, or "" */
+    size_t skipped = 0;          /* how many there are */
 
     void warn(const std::string &warning)
     {
@@ -341,7 +351,7 @@ element_source locate(const tinygltf::Model &model, const std::string &where, co
         offset + stride * (uint64_t)(count - 1) + element_size > limit)
         fail(where, what + " reads past the end of buffer view " + std::to_string(view_index) + " (of buffer "
                         + std::to_string(view.buffer) + "): it needs bytes " + std::to_string(offset) + " to "
-                        + std::to_string((double)offset + (double)stride * (double)(count - 1) + (double)element_size)
+                        + whole((double)offset + (double)stride * (double)(count - 1) + (double)element_size)
                         + ", the view has " + std::to_string(view.byteLength));
     element_source source;
     source.first = buffer.data.data() + view.byteOffset + offset;
@@ -672,9 +682,10 @@ void flat_normal(const float *p0, const float *p1, const float *p2, float out[3]
 }
 
 /* Adds primitive p of mesh m (at where) to the mesh being built; transforms holds each
- * material's uv transform. Returns false for a primitive of points or lines. */
+ * material's uv transform; mesh_has_normals says whether any primitive of the mesh has
+ * normals. Returns false for a primitive of points or lines. */
 bool add_primitive(const tinygltf::Model &model, const tinygltf::Primitive &p, const std::string &where,
-                   const std::vector<uv_transform> &transforms, mesh_builder *b)
+                   const std::vector<uv_transform> &transforms, bool mesh_has_normals, mesh_builder *b)
 {
     int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
     if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP)
@@ -734,7 +745,7 @@ bool add_primitive(const tinygltf::Model &model, const tinygltf::Primitive &p, c
 
     /* A primitive without normals among others with them: its own vertex per corner,
      * with its triangle's flat normal. */
-    bool unshared = normals.empty();
+    bool unshared = normals.empty() && mesh_has_normals;
     const size_t base = b->positions.size() / 3;
     if (base + (unshared ? corners.size() : vertex_count) > (size_t)INT_MAX)
         fail(where, "the mesh has more than 2^31 - 1 vertices");
@@ -797,12 +808,16 @@ void convert_mesh(const tinygltf::Model &model, size_t index, const std::vector<
     const std::string where = at("meshes", index);
     copy_name(out->name, sizeof out->name, mesh.name);
     mesh_builder b;
+    bool has_normals = false;
+    for (const tinygltf::Primitive &p : mesh.primitives)
+        has_normals |= p.attributes.count("NORMAL") > 0 && !(p.mode >= 0 && p.mode <= TINYGLTF_MODE_LINE_STRIP);
     for (size_t i = 0; i < mesh.primitives.size(); i++) {
         const tinygltf::Primitive &p = mesh.primitives[i];
         const std::string primitive_where = where + at(".primitives", i);
-        if (!add_primitive(model, p, primitive_where, transforms, &b))
-            c->warn(primitive_where + ": points and lines are not rendered; they are skipped");
-        else if (!p.targets.empty())
+        if (!add_primitive(model, p, primitive_where, transforms, has_normals, &b)) {
+            if (c->skipped++ == 0)
+                c->first_skipped = primitive_where;
+        } else if (!p.targets.empty())
             c->warn(primitive_where + ": morph targets are ignored (the base shape is used)");
     }
     out->positions = to_malloc(b.positions);
@@ -1152,7 +1167,13 @@ void load(const char *path, gltf_model *out)
         convert_mesh(model, i, transforms, &out->meshes[i], &c);
         mesh_counts[i].triangle_count = out->meshes[i].triangle_count;
     }
+    if (c.skipped > 0)
+        c.warn(c.first_skipped + ": points and lines are not rendered: this primitive"
+               + (c.skipped > 1 ? " and " + std::to_string(c.skipped - 1) + " more are" : std::string(" is"))
+               + " skipped");
     scene_walk walk = walk_nodes(model, mesh_counts, &c);
+    if (walk.placements.empty())
+        c.warn("scene: its nodes place no mesh with triangles; nothing of the file is drawn");
     for (size_t n = 0; n < model.nodes.size(); n++)
         if (!model.nodes[n].weights.empty())
             c.warn(at("nodes", n) + ": morph target weights are ignored");

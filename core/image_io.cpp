@@ -512,9 +512,13 @@ std::unique_ptr<OIIO::ImageInput> open_memory_input(const char *name, const memo
     }
     const unsigned char *b = (const unsigned char *)memory.bytes;
     bool jpeg = memory.size >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF;
+    /* OpenImageIO 2.4 ignores open()'s proxy argument when a config is given: the proxy
+     * goes in the config ("oiio:ioproxy", a pointer). */
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto input = OIIO::ImageInput::open(jpeg ? "memory.jpg" : "memory.png", &config, proxy);
+    void *proxy_pointer = proxy;
+    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
+    auto input = OIIO::ImageInput::open(jpeg ? "memory.jpg" : "memory.png", &config);
     if (!input)
         read_failed(error, name, one_line(OIIO::geterror(), "not an image file OpenImageIO reads"));
     return input;
