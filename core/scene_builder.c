@@ -215,7 +215,8 @@ bool builder_add_image(scene_builder *builder, const char *path, source_position
 {
     scene *s = builder->scene;
     for (int i = 0; i < s->image_count; i++) {
-        if (strcmp(s->images[i].path, path) == 0) {
+        /* An image of a glTF model (its bytes in the scene) only has a name, not a file. */
+        if (s->images[i].encoded == NULL && strcmp(s->images[i].path, path) == 0) {
             *image = i;
             return true;
         }

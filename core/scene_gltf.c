@@ -63,9 +63,12 @@ static rt_status image_for(import *im, const gltf_texture_ref *ref, bool data, i
     gltf_image *source = &im->model->images[ref->image];
     scene_image image;
     memset(&image, 0, sizeof image);
-    snprintf(image.path, sizeof image.path, "%.900s: images[%d]%s%.64s%s", im->path, ref->image,
-             source->name[0] != '\0' ? " (" : "", source->name, source->name[0] != '\0' ? ")" : "");
-    snprintf(image.position, sizeof image.position, "%s", where_of(im));
+    snprintf(image.path, sizeof image.path, "images[%d]%s%.64s%s", ref->image, source->name[0] != '\0' ? " (" : "",
+             source->name, source->name[0] != '\0' ? ")" : "");
+    if (im->position != NULL)
+        snprintf(image.position, sizeof image.position, "%s: glTF '%s'", im->position, im->path);
+    else
+        snprintf(image.position, sizeof image.position, "%s", im->path);
     image.data = data;
     image.wrap[0] = ref->wrap_u;
     image.wrap[1] = ref->wrap_v;

@@ -18,8 +18,9 @@
  *     roughness 1), "FILE:default", added when needed;
  *   - images: one scene image per (glTF image, colour or data, sampler wrap modes) used,
  *     with the file's bytes (decoded by scene_load_assets(): sRGB for base colour and
- *     emission, linear for metallic-roughness and normal maps); path "FILE: images[I]"
- *     (plus " (NAME)" when it has a name) only names it in messages;
+ *     emission, linear for metallic-roughness and normal maps); path "images[I]" (plus
+ *     " (NAME)" when it has a name) only names it in messages, which start with
+ *     "POSITION: glTF 'PATH'" (or PATH for a file by itself);
  *   - each mesh with triangles becomes a filled scene mesh (path "FILE: meshes[I]") and
  *     one object, however many nodes place it.
  *

@@ -179,11 +179,16 @@ static void test_node_graph_errors(void **state)
     assert_string_equal(refused(with_nodes(s, "\"nodes\": [{\"children\": [1]}, {\"children\": [2]}, {\"children\": "
                                               "[1]}], \"scenes\": [{\"nodes\": [0]}]", ""), &e),
                         "nodes[2].children: node 1 is already a child of nodes[0] (a node has at most one parent)");
+    /* A cycle, also where no scene reaches it. */
     assert_string_equal(refused(with_nodes(s, "\"nodes\": [{\"children\": [1]}, {\"children\": [0]}], \"scenes\": "
                                               "[{\"nodes\": [0]}]", ""), &e),
-                        "scenes[0].nodes: node 0 is a child of nodes[1], not a root");
-    /* A cycle no scene lists: found from a root-less walk? No root at all, so nothing is
-     * drawn; listing a node of it in a scene is caught above. A cycle below a root: */
+                        "nodes[0].children: node 1 is an ancestor of nodes[0] (the node hierarchy has a cycle)");
+    assert_string_equal(refused(with_nodes(s, "\"nodes\": [{\"mesh\": 0}, {\"children\": [2]}, {\"children\": [3]}, "
+                                              "{\"children\": [1]}], \"scenes\": [{\"nodes\": [0]}]", ""), &e),
+                        "nodes[1].children: node 2 is an ancestor of nodes[1] (the node hierarchy has a cycle)");
+    assert_string_equal(refused(with_nodes(s, "\"nodes\": [{\"children\": [1]}, {\"mesh\": 0}], \"scenes\": "
+                                              "[{\"nodes\": [1]}]", ""), &e),
+                        "scenes[0].nodes: node 1 is a child of nodes[0], not a root");
     assert_string_equal(refused(with_nodes(s, "\"nodes\": [{\"children\": [0]}], \"scenes\": [{\"nodes\": []}]", ""),
                                 &e),
                         "nodes[0].children: the node is its own child (the node hierarchy has a cycle)");

@@ -117,7 +117,8 @@ static void test_statement_adds_materials_and_meshes(void **state)
     assert_close(base->pixels[0], image_srgb_decode(188 / 255.0f), 1e-6);
     assert_close(sc.images[paint->normal_map].pixels[0], 188 / 255.0, 1e-6);
     assert_null(base->encoded);   /* the bytes are freed once decoded */
-    assert_contains(base->path, "m.gltf: images[0]");
+    assert_string_equal(base->path, "images[0]");
+    assert_contains(base->position, "scene.txt:1:1: glTF '");
     /* One mesh, one object, two placements; triangle materials per primitive. */
     assert_int_equal(sc.mesh_count, 1);
     assert_int_equal(sc.object_count, 1);
@@ -203,8 +204,8 @@ static void test_statement_errors(void **state)
     path = write_file(s, "scene.txt", "\ngltf \"text.gltf\"\n");
     assert_int_equal(scene_load_file(path, NULL, &sc, &e), RT_OK);
     assert_int_equal(scene_load_assets(&sc, &e), RT_ERROR_INPUT);
-    assert_contains(e.message, "scene.txt:2:1: cannot read image '");
-    assert_contains(e.message, "text.gltf: images[0]': ");
+    assert_contains(e.message, "scene.txt:2:1: glTF '");
+    assert_contains(e.message, "text.gltf': cannot read image 'images[0]': ");
     scene_free(&sc);
 }
 
