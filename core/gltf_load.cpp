@@ -458,8 +458,8 @@ struct uv_transform {
     bool operator==(const uv_transform &o) const { return memcmp(m, o.m, sizeof m) == 0; }
 };
 
-/* Reads a number array of n at key of object value (fallback when absent); where for
- * messages. */
+/* Reads the array of n numbers at key of object into out (left as it is when absent);
+ * where names the object in messages. */
 void value_numbers(const tinygltf::Value &object, const char *key, int n, double *out, const std::string &where)
 {
     if (!object.Has(key))
@@ -513,7 +513,11 @@ gltf_texture_ref texture_ref(const tinygltf::Model &model, int texture, int texc
         double offset[2] = {0, 0}, scale[2] = {1, 1}, rotation = 0;
         value_numbers(object, "offset", 2, offset, ext_where);
         value_numbers(object, "scale", 2, scale, ext_where);
-        value_numbers(object, "rotation", 1, &rotation, ext_where);
+        if (object.Has("rotation")) {
+            if (!object.Get("rotation").IsNumber())
+                fail(ext_where + ".rotation", "expected a number (radians)");
+            rotation = object.Get("rotation").GetNumberAsDouble();
+        }
         /* glTF's order: translation x rotation x scale, rotation [cos sin; -sin cos]. */
         double cs = std::cos(rotation), sn = std::sin(rotation);
         transform->m[0][0] = cs * scale[0];
