@@ -25,10 +25,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "camera.h"
+#include "fuzz_support.h"
 #include "gltf_load.h"
-#include "pack.h"
-#include "packed_traverse.h"
 #include "scene_assets.h"
 #include "scene_gltf.h"
 #include "scene_parse.h"
@@ -76,27 +74,11 @@ static void remove_fixtures(void)
     rmdir(directory);
 }
 
-/* Writes size bytes of data to path; aborts on failure (the harness would be useless). */
-static void write_file(const char *path, const void *data, size_t size)
-{
-    FILE *file = fopen(path, "wb");
-    if (file == NULL || (size > 0 && fwrite(data, 1, size, file) != size) || fclose(file) != 0) {
-        fprintf(stderr, "fuzz_gltf_load: cannot write %s\n", path);
-        abort();
-    }
-}
-
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
-    const char *temporary = getenv("TMPDIR");
-    snprintf(directory, sizeof directory, "%s/rtspheres-fuzz-gltf.XXXXXX",
-             temporary != NULL && temporary[0] != '\0' ? temporary : "/tmp");
-    if (mkdtemp(directory) == NULL) {
-        perror("fuzz_gltf_load: mkdtemp");
-        abort();
-    }
+    fuzz_make_directory("rtspheres-fuzz-gltf", directory, sizeof directory);
     snprintf(gltf_path, sizeof gltf_path, "%s/model.gltf", directory);
     snprintf(glb_path, sizeof glb_path, "%s/model.glb", directory);
     snprintf(scene_gltf_path, sizeof scene_gltf_path, "%s/gltf.txt", directory);
@@ -104,9 +86,9 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     atexit(remove_fixtures);
     char text[1024];
     int n = snprintf(text, sizeof text, scene_format, "model.gltf", "model.gltf");
-    write_file(scene_gltf_path, text, (size_t)n);
+    fuzz_write_file(scene_gltf_path, text, (size_t)n);
     n = snprintf(text, sizeof text, scene_format, "model.glb", "model.glb");
-    write_file(scene_glb_path, text, (size_t)n);
+    fuzz_write_file(scene_glb_path, text, (size_t)n);
     return 0;
 }
 
@@ -155,31 +137,6 @@ static void check_model(rt_status status, const gltf_model *m, const rt_error *e
             abort();
 }
 
-/* Packs s and traces a few rays through it. */
-static void pack_and_trace(const scene *s)
-{
-    packed_scene packed;
-    rt_error error = {{0}};
-    if (pack_scene(s, NULL, &packed, &error) != RT_OK) {
-        if (error.message[0] == '\0')
-            abort();
-        return;
-    }
-    camera_frame frame;
-    if (camera_frame_compute(&s->camera, s->render.width, s->render.height, &frame, &error) == RT_OK) {
-        static const float film[][2] = {{0.5f, 0.5f}, {0.3f, 0.6f}, {0.7f, 0.4f}, {0.5f, 0.2f}};
-        for (size_t i = 0; i < sizeof film / sizeof film[0]; i++) {
-            float origin[3], direction[3];
-            camera_frame_ray(&frame, film[i][0], film[i][1], 0.0f, 0.0f, origin, direction);
-            packed_hit hit;
-            if (packed_intersect_nearest(&packed, origin, direction, 1e-4f, 1e30f, &hit) &&
-                hit.primitive >= packed.primitive_count)
-                abort();
-        }
-    }
-    packed_scene_free(&packed);
-}
-
 /* Loads the file as a scene by itself and through the scene file, packs and traces each. */
 static void load_pack_and_trace(const char *path, const char *scene_path)
 {
@@ -187,7 +144,7 @@ static void load_pack_and_trace(const char *path, const char *scene_path)
     rt_error error = {{0}};
     if (scene_gltf_load_file(path, NULL, &s, &error) == RT_OK) {
         if (scene_load_assets(&s, &error) == RT_OK)
-            pack_and_trace(&s);
+            fuzz_pack_and_trace(&s);
         else if (error.message[0] == '\0')
             abort();
         scene_free(&s);
@@ -202,7 +159,7 @@ static void load_pack_and_trace(const char *path, const char *scene_path)
         return;
     }
     if (scene_load_assets(&s, &error) == RT_OK)
-        pack_and_trace(&s);
+        fuzz_pack_and_trace(&s);
     else if (error.message[0] == '\0')
         abort();
     scene_free(&s);
@@ -212,7 +169,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     bool binary = size >= 4 && memcmp(data, "glTF", 4) == 0;
     const char *path = binary ? glb_path : gltf_path;
-    write_file(path, data, size);
+    fuzz_write_file(path, data, size);
     gltf_model model;
     rt_error error = {{0}};
     rt_status status = gltf_load(path, &model, &error);

@@ -22,9 +22,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "camera.h"
-#include "pack.h"
-#include "packed_traverse.h"
+#include "fuzz_support.h"
 #include "ply_load.h"
 #include "scene_assets.h"
 #include "scene_parse.h"
@@ -52,31 +50,15 @@ static void remove_fixtures(void)
     rmdir(directory);
 }
 
-/* Writes size bytes of data to path; aborts on failure (the harness would be useless). */
-static void write_file(const char *path, const void *data, size_t size)
-{
-    FILE *file = fopen(path, "wb");
-    if (file == NULL || (size > 0 && fwrite(data, 1, size, file) != size) || fclose(file) != 0) {
-        fprintf(stderr, "fuzz_ply_load: cannot write %s\n", path);
-        abort();
-    }
-}
-
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
-    const char *temporary = getenv("TMPDIR");
-    snprintf(directory, sizeof directory, "%s/rtspheres-fuzz-ply.XXXXXX",
-             temporary != NULL && temporary[0] != '\0' ? temporary : "/tmp");
-    if (mkdtemp(directory) == NULL) {
-        perror("fuzz_ply_load: mkdtemp");
-        abort();
-    }
+    fuzz_make_directory("rtspheres-fuzz-ply", directory, sizeof directory);
     snprintf(ply_path, sizeof ply_path, "%s/mesh.ply", directory);
     snprintf(scene_path, sizeof scene_path, "%s/scene.txt", directory);
     atexit(remove_fixtures);
-    write_file(scene_path, scene_text, sizeof scene_text - 1);
+    fuzz_write_file(scene_path, scene_text, sizeof scene_text - 1);
     return 0;
 }
 
@@ -121,26 +103,7 @@ static void load_pack_and_trace(void)
         abort(); /* the scene text is fixed and valid */
     if (scene_load_assets(&s, &error) != RT_OK)
         abort(); /* ply_load_memory accepted these very bytes */
-    packed_scene packed;
-    if (pack_scene(&s, NULL, &packed, &error) != RT_OK) {
-        if (error.message[0] == '\0')
-            abort();
-        scene_free(&s);
-        return;
-    }
-    camera_frame frame;
-    if (camera_frame_compute(&s.camera, s.render.width, s.render.height, &frame, &error) == RT_OK) {
-        static const float film[][2] = {{0.5f, 0.5f}, {0.3f, 0.6f}, {0.7f, 0.4f}, {0.5f, 0.2f}};
-        for (size_t i = 0; i < sizeof film / sizeof film[0]; i++) {
-            float origin[3], direction[3];
-            camera_frame_ray(&frame, film[i][0], film[i][1], 0.0f, 0.0f, origin, direction);
-            packed_hit hit;
-            if (packed_intersect_nearest(&packed, origin, direction, 1e-4f, 1e30f, &hit) &&
-                hit.primitive >= packed.primitive_count)
-                abort();
-        }
-    }
-    packed_scene_free(&packed);
+    fuzz_pack_and_trace(&s);
     scene_free(&s);
 }
 
@@ -152,7 +115,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     check_mesh(status, &mesh, &error);
     if (status == RT_OK) {
         /* The file on disk reads the same. */
-        write_file(ply_path, data, size);
+        fuzz_write_file(ply_path, data, size);
         ply_mesh again;
         if (ply_load(ply_path, &again, &error) != RT_OK || again.vertex_count != mesh.vertex_count ||
             again.triangle_count != mesh.triangle_count ||
