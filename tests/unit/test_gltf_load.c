@@ -374,6 +374,16 @@ static void test_textures_samplers_and_transforms(void **state)
     gltf_model_free(&m);
     free(png);
 
+    /* A rotation of a quarter turn: u' = v, v' = -u (glTF's [cos sin; -sin cos]); vertex 1
+     * has glTF uv (1, 1): (1, -1), then v up: 1 - (-1). */
+    const char *rotated = "\"images\": [{\"uri\": \"t.png\"}], \"textures\": [{\"source\": 0}], \"materials\": "
+                          "[{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, \"extensions\": "
+                          "{\"KHR_texture_transform\": {\"rotation\": 1.5707963267948966}}}}}]";
+    m = load_ok(gltf_text(s, "m.gltf", NULL, 0, NULL, NULL, meshes, NULL, rotated));
+    assert_close(m.meshes[0].uvs[2], 1, 1e-6);
+    assert_close(m.meshes[0].uvs[3], 2, 1e-6);
+    gltf_model_free(&m);
+
     rt_error e;
     assert_string_equal(refused(gltf_text(s, "m.gltf", NULL, 0, NULL, NULL, NULL, NULL,
                                           "\"materials\": [{\"emissiveTexture\": {\"index\": 3}}]"), &e),

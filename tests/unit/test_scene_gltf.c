@@ -140,6 +140,43 @@ static void test_statement_adds_materials_and_meshes(void **state)
     scene_free(&sc);
 }
 
+/* COLOR_0 reaches the mesh, and the material a coloured mesh uses multiplies by it. */
+static void test_vertex_colours(void **state)
+{
+    scratch *s = *state;
+    unsigned char bytes[QUAD_BYTES + 16];
+    quad_buffer(bytes);
+    const unsigned char colours[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 51, 51, 51, 255};
+    memcpy(bytes + QUAD_BYTES, colours, sizeof colours);
+    const char *views = "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, "
+                        "\"byteOffset\": 48, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 96, \"byteLength\": "
+                        "32}, {\"buffer\": 0, \"byteOffset\": 128, \"byteLength\": 12}, {\"buffer\": 0, \"byteOffset\": "
+                        "144, \"byteLength\": 16}]";
+    const char *accessors =
+        "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\"}, "
+        "{\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\"}, {\"bufferView\": 2, "
+        "\"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 3, \"componentType\": 5123, "
+        "\"count\": 6, \"type\": \"SCALAR\"}, {\"bufferView\": 4, \"componentType\": 5121, \"normalized\": true, "
+        "\"count\": 4, \"type\": \"VEC4\"}]";
+    const char *meshes = "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"COLOR_0\": 4}, "
+                         "\"indices\": 3, \"material\": 0}]}, {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, "
+                         "\"indices\": 3, \"material\": 1}]}]";
+    const char *nodes = "\"nodes\": [{\"mesh\": 0}, {\"mesh\": 1}], \"scenes\": [{\"nodes\": [0, 1]}]";
+    const char *path = gltf_text(s, "c.gltf", bytes, sizeof bytes, views, accessors, meshes, nodes,
+                                 "\"materials\": [{\"name\": \"painted\"}, {\"name\": \"plain\"}]");
+    scene sc;
+    rt_error e = {{0}};
+    assert_int_equal(scene_gltf_load_file(path, NULL, &sc, &e), RT_OK);
+    assert_int_equal(sc.mesh_count, 2);
+    assert_non_null(sc.meshes[0].colors);
+    assert_close(sc.meshes[0].colors[0], 1, 0);
+    assert_close(sc.meshes[0].colors[3 * 3 + 1], 0.2, 1e-7);   /* linear, as glTF defines COLOR_0 */
+    assert_null(sc.meshes[1].colors);
+    assert_true(sc.materials[0].vertex_colors);
+    assert_false(sc.materials[1].vertex_colors);
+    scene_free(&sc);
+}
+
 static void test_statement_places_through_blocks(void **state)
 {
     scratch *s = *state;
@@ -325,6 +362,7 @@ int main(void)
 #define T(name) cmocka_unit_test_setup_teardown(name, make_scratch, remove_scratch)
     const struct CMUnitTest tests[] = {
         T(test_statement_adds_materials_and_meshes),
+        T(test_vertex_colours),
         T(test_statement_places_through_blocks),
         T(test_statement_errors),
         T(test_file_as_a_scene),
