@@ -16,7 +16,8 @@ static void print_help(FILE *stream)
     fprintf(stream,
             "usage: rtspheres render SCENE -o OUTPUT [options]\n"
             "\n"
-            "Renders the scene file SCENE and writes OUTPUT; the format follows the extension:\n"
+            "Renders the scene file SCENE (or a glTF file, .gltf or .glb, as a scene by itself)\n"
+            "and writes OUTPUT; the format follows the extension:\n"
             ".exr (linear float, with metadata and a per-pixel 'samples' channel), .hdr,\n"
             ".png/.jpg/.tif (8-bit sRGB).\n"
             "\n"
@@ -28,6 +29,8 @@ static void print_help(FILE *stream)
             "      --size WxH         image size in pixels, e.g. 640x360\n"
             "      --max-depth N      path segments per sample at most\n"
             "      --seed N           random seed (same seed, same image)\n"
+            "      --camera NAME      a glTF scene: render its camera (or camera node) NAME\n"
+            "                         (default: the first camera its scene places)\n"
             "  -D NAME=VALUE          set scene variable $NAME (wins over the file's `set`)\n"
             "      --frames LIST      render frames, e.g. 1-60 or 1-10,15,20-30:2; each frame\n"
             "                         sets $frame and $time (= frame / --fps)\n"
@@ -76,7 +79,7 @@ enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
-    OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
+    OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER, OPTION_CAMERA,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -316,6 +319,7 @@ static int take_option(int option, const char *value, render_arguments *argument
     switch (option) {
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
+    case OPTION_CAMERA: job->camera = value; break;
     case OPTION_AOVS: job->aovs = true; break;
     case OPTION_DENOISE: job->denoise = true; break;
     case OPTION_FULL_TRACER: job->tracer.full_tracer = true; break;
@@ -372,6 +376,7 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
         {"shard-by", required_argument, NULL, OPTION_SHARD_BY},
         {"checkpoint", required_argument, NULL, OPTION_CHECKPOINT},
         {"resume", required_argument, NULL, OPTION_RESUME},
+        {"camera", required_argument, NULL, OPTION_CAMERA},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
         {"sampler", required_argument, NULL, OPTION_SAMPLER},
         {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},

@@ -90,8 +90,9 @@ void pack_write_textures(packer *p)
     uint64_t next_pixel = p->layout.pixel_offset;
     for (int i = 0; i < s->image_count; i++) {
         const scene_image *image = &s->images[i];
+        uint32_t wrap = (uint32_t)image->wrap[0] | (uint32_t)image->wrap[1] << IMAGE_WRAP_V_SHIFT;
         put_texel(p->texels, p->layout.image_offset + (uint64_t)i * PACKED_IMAGE_STRIDE, (uint32_t)next_pixel,
-                  (uint32_t)image->width, (uint32_t)image->height, 0);
+                  (uint32_t)image->width, (uint32_t)image->height, wrap);
         uint64_t pixels = (uint64_t)image->width * image->height;
         if (image->pixels != NULL)
             for (uint64_t k = 0; k < 4 * pixels; k++)

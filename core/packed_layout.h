@@ -171,9 +171,15 @@
 #define TEXTURE_IMAGE 5
 #define TEXTURE_TYPE_COUNT 6
 
-/* ---- images: 1 texel record = (first pixel texel, width, height, 0); pixels are RGBA
- * float bits, one texel each, rows top to bottom, after all the records */
+/* ---- images: 1 texel record = (first pixel texel, width, height, wrap); pixels are RGBA
+ * float bits, one texel each, rows top to bottom, after all the records. wrap: how a
+ * lookup outside [0, 1] folds, IMAGE_WRAP_* of u in bits 0-1 and of v in bits 2-3 (glTF's
+ * samplers; every other image repeats) */
 #define PACKED_IMAGE_STRIDE 1
+#define IMAGE_WRAP_REPEAT 0
+#define IMAGE_WRAP_CLAMP 1
+#define IMAGE_WRAP_MIRROR 2
+#define IMAGE_WRAP_V_SHIFT 2
 
 /* ---- lights: 4 texels (what next-event estimation samples: see glsl/lights.glsl for how
  * one is chosen: by power, or by its estimated irradiance at the point)

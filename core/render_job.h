@@ -7,10 +7,14 @@
  *
  * ## The job
  * A plain struct; zero means default (render_job_defaults() returns it all zero):
- *   scene_path, output      required; output is a name pattern (batch.h): with frames each
+ *   scene_path, output      required; scene_path a scene file, or a glTF file (.gltf, .glb:
+ *                           a scene by itself, scene_gltf.h); output is a name pattern (batch.h): with frames each
  *                           frame formats it, without them it is formatted once with the
  *                           value of the last define of `frame`, else with 0
- *   defines                 scene variables (scene_parse.h) for every image; none
+ *   defines                 scene variables (scene_parse.h) for every image; none (a glTF
+ *                           scene has no variables: a define is refused)
+ *   camera                  NULL: the scene's camera; a glTF scene's camera (or camera
+ *                           node) of that name; only for a glTF scene
  *   frames                  frame numbers to render (batch.h frame_list); none: one image
  *                           without $frame and $time. Each frame sets $frame and $time =
  *                           frame / frames_per_second (default 24) as optional variables.
@@ -92,6 +96,7 @@ typedef enum render_job_shard_kind {
 typedef struct render_job {
     const char *scene_path;
     const char *output;
+    const char *camera;
     const scene_define *defines;
     int define_count;
     const int *frames;

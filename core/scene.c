@@ -44,8 +44,10 @@ void scene_free(scene *s)
     free(s->meshes);
     free(s->textures);
     free(s->lights);
-    for (int i = 0; i < s->image_count; i++)
+    for (int i = 0; i < s->image_count; i++) {
         free(s->images[i].pixels);
+        free(s->images[i].encoded);
+    }
     free(s->images);
     free(s->warnings);
     scene_defaults(s);

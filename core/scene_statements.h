@@ -80,6 +80,7 @@ bool statement_triangle(scene_parser *p, source_line *line, const token *keyword
 bool statement_quad(scene_parser *p, source_line *line, const token *keyword);
 bool statement_box(scene_parser *p, source_line *line, const token *keyword);
 bool statement_mesh(scene_parser *p, source_line *line, const token *keyword);
+bool statement_gltf(scene_parser *p, source_line *line, const token *keyword);
 bool statement_group(scene_parser *p, source_line *line, const token *keyword);
 bool statement_instance(scene_parser *p, source_line *line, const token *keyword);
 bool statement_volume(scene_parser *p, source_line *line, const token *keyword);

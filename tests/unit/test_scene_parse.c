@@ -523,7 +523,7 @@ static void test_unknown_statement(void **state)
     (void)state;
     assert_parse_error("spere 0 0 0 1 m", "s.txt:1:1: ",
                        "unknown statement 'spere' (expected include, set, camera, render, sky, ambient, light, "
-                       "texture, material, sphere, moving_sphere, triangle, quad, box, mesh, group, instance, "
+                       "texture, material, sphere, moving_sphere, triangle, quad, box, mesh, gltf, group, instance, "
                        "volume, translate, rotate, scale or matrix)");
     assert_parse_error("\n\n   Camera fov 30", "s.txt:3:4: ", "unknown statement 'Camera'");
     assert_parse_error("\"camera\"", "s.txt:1:1: ", "unknown statement the string \"camera\"");
