@@ -49,6 +49,9 @@ static void print_help(FILE *stream)
             "                         soft shadows from area lights: fast, nearly noise-free\n"
             "      --aovs             add layers to the EXR: albedo, normal, depth (first hit) and\n"
             "                         per-pixel variance of luminance, next to R, G, B, samples\n"
+            "      --variance         add layers to the EXR: variance.R/G/B, each pixel's sample\n"
+            "                         variance of each colour channel (for `rtspheres diff --test z`\n"
+            "                         and `rtspheres check`)\n"
             "      --denoise          edge-aware a-trous denoiser guided by albedo, normal and depth\n"
             "                         (an EXR keeps the noisy image as noisy.R/G/B)\n"
             "      --blur SIGMA[:N]   Gaussian blur of SIGMA pixels, N times (the seed's blurNum);\n"
@@ -73,7 +76,7 @@ enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
-    OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER,
+    OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -308,6 +311,7 @@ static int take_option(int option, const char *value, render_arguments *argument
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
     case OPTION_AOVS: job->aovs = true; break;
+    case OPTION_VARIANCE: job->variance = true; break;
     case OPTION_DENOISE: job->denoise = true; break;
     case OPTION_FULL_TRACER: job->tracer.full_tracer = true; break;
     case 'q': arguments->quiet = true; break;
@@ -367,6 +371,7 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
         {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
         {"aovs", no_argument, NULL, OPTION_AOVS},
+        {"variance", no_argument, NULL, OPTION_VARIANCE},
         {"denoise", no_argument, NULL, OPTION_DENOISE},
         {"blur", required_argument, NULL, OPTION_BLUR},
         {"tonemap", required_argument, NULL, OPTION_TONEMAP},
