@@ -225,8 +225,16 @@ static void note_extreme(image_stat_scale *scale, double z, int x, int y, int ch
     }
 }
 
-/* Runs the pixel scale into result->scales[0] and the z-score moments; significance
- * (NULL or one per pixel) gets each pixel's largest |z| / threshold. */
+/* Keeps in *kept the z of larger magnitude of *kept and z. */
+static void keep_larger(float *kept, double z)
+{
+    if (fabs(z) > fabsf(*kept))
+        *kept = (float)z;
+}
+
+/* Runs the pixel scale into result->scales[0] and the z-score moments; z_scores (NULL or
+ * 3 per pixel) gets the z-scores, significance (NULL or one per pixel) each pixel's z of
+ * largest magnitude over its channels / the threshold. */
 static void pixel_scale(const pixel_table *table, const stat_settings *settings, image_stat_result *result,
                         float *z_scores, float *significance)
 {
@@ -251,7 +259,7 @@ static void pixel_scale(const pixel_table *table, const stat_settings *settings,
             if (z_scores != NULL)
                 z_scores[i] = (float)z;
             if (significance != NULL)
-                significance[p] = fmaxf(significance[p], (float)(fabs(z) / scale->z_threshold));
+                keep_larger(&significance[p], z / scale->z_threshold);
         }
     }
     result->passing_share = 1.0 - (double)scale->failing / channel_tests;
@@ -262,8 +270,9 @@ static void pixel_scale(const pixel_table *table, const stat_settings *settings,
 }
 
 /* Runs the block scale of side size (IMAGE_STAT_WHOLE_IMAGE: one block) with its share
- * scale_alpha into *scale; significance as pixel_scale(). block_z is scratch of at least
- * 3 * the number of blocks. */
+ * scale_alpha into *scale; significance (NULL or one per pixel) gets the z of largest
+ * magnitude over the channels of each pixel's block / the threshold. block_z is scratch
+ * of at least 3 * the number of blocks. */
 static void block_scale(const pixel_table *table, const stat_settings *settings, int size, double scale_alpha,
                         image_stat_scale *scale, double *block_z, float *significance)
 {
@@ -313,7 +322,7 @@ static void block_scale(const pixel_table *table, const stat_settings *settings,
             float *s = &significance[(size_t)y * table->width + x];
             for (int c = 0; c < 3; c++)
                 if (!isnan(z[c]))
-                    *s = fmaxf(*s, (float)(fabs(z[c]) / scale->z_threshold));
+                    keep_larger(s, z[c] / scale->z_threshold);
         }
 }
 
@@ -334,15 +343,30 @@ static rt_status run_scales(const pixel_table *table, const stat_settings *setti
         status = rt_error_set(error, RT_ERROR_RUNTIME, "DIFF: out of memory comparing %dx%d images", table->width,
                               table->height);
     if (status == RT_OK) {
-        pixel_scale(table, settings, result, z_scores, significance);
+        pixel_scale(table, settings, result, z_scores, NULL);
         double scale_alpha = settings->block_count > 0 ? sidak(settings->block_alpha, settings->block_count) : 0;
         for (int i = 0; i < settings->block_count; i++)
             block_scale(table, settings, settings->block_sizes[i], scale_alpha, &result->scales[1 + i], block_z,
-                        significance);
+                        NULL);
         result->scale_count = 1 + settings->block_count;
         result->passed = true;
         for (int i = 0; i < result->scale_count; i++)
             result->passed = result->passed && result->scales[i].passed;
+        /* The map shows the finest scale that fails (the pixels when none does): where
+         * the difference is, as sharply as the test can tell. */
+        result->map_scale = 0;
+        while (result->map_scale < result->scale_count - 1 && result->scales[result->map_scale].passed)
+            result->map_scale++;
+        if (result->scales[result->map_scale].passed)
+            result->map_scale = 0;
+        if (significance != NULL && result->map_scale == 0) {
+            image_stat_result again = *result;
+            pixel_scale(table, settings, &again, NULL, significance);
+        } else if (significance != NULL) {
+            image_stat_scale again = {0};
+            block_scale(table, settings, settings->block_sizes[result->map_scale - 1], scale_alpha, &again, block_z,
+                        significance);
+        }
     }
     if (status == RT_OK && maps != NULL)
         status = image_create(maps, table->width, table->height, 4, error);
@@ -403,12 +427,15 @@ rt_status image_stat_diff(const rt_image *a, const rt_image *b, const image_stat
     return status;
 }
 
-/* The heat map's colour ramp at significance s: black, blue at 0.5, red at 1, yellow at
- * 1.5, white from 2 on. */
+/* The heat map's colours at signed significance s (z / threshold): black at 0; new
+ * brighter than the reference (s > 0) dark red at 0.5, red at 1 (a failing test), yellow
+ * at 1.5; darker (s < 0) dark blue, blue, cyan; white from 2 on. */
 static void heat_colour(float s, float *rgb)
 {
-    static const float stops[5][3] = {{0, 0, 0}, {0.05f, 0.15f, 0.9f}, {1, 0.05f, 0.05f}, {1, 0.9f, 0}, {1, 1, 1}};
-    float position = fminf(fmaxf(s, 0.0f), 2.0f) * 2.0f;   /* 0 .. 4 */
+    static const float warm[5][3] = {{0, 0, 0}, {0.35f, 0.02f, 0.02f}, {1, 0.05f, 0.02f}, {1, 0.85f, 0}, {1, 1, 1}};
+    static const float cool[5][3] = {{0, 0, 0}, {0.02f, 0.05f, 0.4f}, {0.05f, 0.25f, 1}, {0, 0.9f, 1}, {1, 1, 1}};
+    const float(*stops)[3] = s >= 0 ? warm : cool;
+    float position = fminf(fabsf(s), 2.0f) * 2.0f;   /* 0 .. 4 */
     int low = (int)position < 4 ? (int)position : 3;
     float t = position - (float)low;
     for (int c = 0; c < 3; c++)

@@ -95,6 +95,8 @@ typedef struct image_stat_result {
                                   * two renders of one scene */
     long tested_pixels, skipped_pixels;
     bool variance_of_a, variance_of_b;   /* which images had variance layers */
+    int map_scale;               /* the scale the maps' significance shows: the first that
+                                  * fails, or 0 (the pixels) when none does */
     bool passed;
 } image_stat_result;
 
@@ -104,15 +106,18 @@ image_stat_options image_stat_options_defaults(void);
 /* Compares a and b (see above). Different sizes, a missing R, G, B or samples channel, no
  * variance layers in either, a NaN, or bad options are RT_ERROR_INPUT. options may be
  * NULL. When maps is not NULL it receives (allocated; free with image_free) a 4-channel
- * image: z.R, z.G, z.B (the pixel z-scores, 0 where skipped) and "significance", each
- * pixel's largest |z| / z_threshold over every scale's test that covers it (1 and above:
- * a failing test covers the pixel), for image_stat_heat_map(). */
+ * image: z.R, z.G, z.B (the pixel z-scores, 0 where skipped) and "significance": at the
+ * scale result->map_scale, the z of the test covering the pixel (its block's, or its own
+ * at the pixel scale; of the channel of largest |z|) over that scale's threshold, signed
+ * (positive: a brighter than b); |significance| above 1 is a failing test. For
+ * image_stat_heat_map(). */
 rt_status image_stat_diff(const rt_image *a, const rt_image *b, const image_stat_options *options,
                           image_stat_result *result, rt_image *maps, rt_error *error);
 
 /* Makes *heat (allocated; free with image_free) an RGB picture of maps' significance
- * channel for people: black at 0, blue at 0.5, red at 1 (a failing test), yellow to white
- * from 1 to 2 and above; linear values, meant to be written as PNG. */
+ * channel for people: black at 0; where a is brighter, dark red at 0.5, red at 1 (a
+ * failing test), yellow at 1.5; where it is darker, dark blue, blue, cyan; white from 2
+ * on. Linear values, meant to be written as PNG. */
 rt_status image_stat_heat_map(const rt_image *maps, rt_image *heat, rt_error *error);
 
 /* Returns the |z| above which a two-sided test of level test_alpha (0 < test_alpha < 1)

@@ -284,15 +284,16 @@ static void errors_and_skipped_pixels(void **state)
     image_free(&a), image_free(&b), image_free(&c), image_free(&d), image_free(&plain), image_free(&small);
 }
 
-/* The maps: pixel z-scores and significance, which reaches 1 where a failing test covers
- * a pixel; the heat map is black at 0 and red at 1. */
+/* The maps: pixel z-scores, and the significance of the finest failing scale, signed:
+ * below -1 where a is darker than b (by a failing test), within (-1, 1) elsewhere; the
+ * heat map is black at 0, red at 1 and blue at -1. */
 static void maps_and_heat(void **state)
 {
     (void)state;
     synthetic how = noisy(64, 32);
     rt_image a = make_render(&how, disc_on_ramp, 5);
     how.box[0] = 0, how.box[1] = 0, how.box[2] = 32, how.box[3] = 32;
-    how.scale = 1.1;
+    how.scale = 1.3;
     rt_image b = make_render(&how, disc_on_ramp, 6);
     image_stat_result result;
     rt_image maps, heat;
@@ -301,22 +302,31 @@ static void maps_and_heat(void **state)
     image_stat_options options = {.block_sizes = {4, 8, 16}, .block_count = 3};
     assert_int_equal(image_stat_diff(&a, &b, &options, &result, &maps, &error), RT_OK);
     assert_false(result.passed);
+    assert_true(result.scales[0].passed);   /* 30% at a pixel's 18% noise: few pixels see it */
+    assert_int_equal(result.map_scale, 1);  /* 4x4 blocks do */
+    assert_false(result.scales[1].passed);
     assert_int_equal(maps.channels, 4);
     assert_string_equal(maps.channel_names[3], "significance");
     double left = 0, right = 0;
     for (int y = 0; y < 32; y++)
-        for (int x = 0; x < 64; x++)
-            *(x < 32 ? &left : &right) = fmax(*(x < 32 ? &left : &right), maps.pixels[(y * 64 + x) * 4 + 3]);
-    assert_true(left > 1.0);    /* the changed half is covered by failing tests */
+        for (int x = 0; x < 64; x++) {
+            double s = maps.pixels[(y * 64 + x) * 4 + 3];
+            if (x < 32)
+                left = fmin(left, s);
+            else
+                right = fmax(right, fabs(s));
+        }
+    assert_true(left < -1.0);    /* the changed half is covered by failing tests */
     assert_true(right < 1.0);
-    assert_int_equal(image_stat_heat_map(&maps, &heat, &error), RT_OK);
     maps.pixels[3] = 0.0f;
     maps.pixels[7] = 1.0f;
-    image_free(&heat);
+    maps.pixels[11] = -1.0f;
     assert_int_equal(image_stat_heat_map(&maps, &heat, &error), RT_OK);
     assert_close(heat.pixels[0] + heat.pixels[1] + heat.pixels[2], 0.0, 1e-6);
     assert_close(heat.pixels[3], 1.0, 1e-6);
     assert_true(heat.pixels[4] < 0.1f && heat.pixels[5] < 0.1f);
+    assert_true(heat.pixels[6] < 0.1f && heat.pixels[7] < 0.3f);
+    assert_close(heat.pixels[8], 1.0, 1e-6);
     image_free(&heat), image_free(&maps), image_free(&a), image_free(&b);
 }
 
