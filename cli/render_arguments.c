@@ -244,12 +244,13 @@ static const char *take_value(int option, const char *value, render_job *job)
 
 /* --tile and --shard: I/N (batch.h shard_parse(), whose message says what is wrong)
  * into *index and *count. Returns EXIT_OK, or EXIT_BAD_INPUT after printing why. */
-static int take_split(const char *option_name, const char *value, int *index, int *count)
+static int take_split(const render_arguments *arguments, const char *option_name, const char *value, int *index,
+                      int *count)
 {
     rt_error error = {{0}};
     if (shard_parse(value, index, count, &error) == RT_OK)
         return EXIT_OK;
-    fprintf(stderr, "rtspheres render: %s %s\n", option_name, error.message);
+    fprintf(arguments->messages, "%s%s %s\n", arguments->message_prefix, option_name, error.message);
     return EXIT_BAD_INPUT;
 }
 
@@ -265,14 +266,14 @@ static int take_part(int option, const char *value, render_arguments *arguments)
         job->frames = NULL;
         job->frame_count = 0;
         if (frame_list_parse(value, &arguments->frames, &error) != RT_OK) {
-            fprintf(stderr, "rtspheres render: --%s\n", error.message);
+            fprintf(arguments->messages, "%s--%s\n", arguments->message_prefix, error.message);
             return EXIT_BAD_INPUT;
         }
         job->frames = arguments->frames.frames;
         job->frame_count = arguments->frames.count;
         return EXIT_OK;
-    case OPTION_TILE: return take_split("--tile", value, &job->tile_index, &job->tile_count);
-    case OPTION_SHARD: return take_split("--shard", value, &job->shard_index, &job->shard_count);
+    case OPTION_TILE: return take_split(arguments, "--tile", value, &job->tile_index, &job->tile_count);
+    case OPTION_SHARD: return take_split(arguments, "--shard", value, &job->shard_index, &job->shard_count);
     }
     return EXIT_OK;
 }
@@ -336,17 +337,23 @@ static int take_option(int option, const char *value, render_arguments *argument
         break;
     }
     if (out_of_memory) {
-        fprintf(stderr, "rtspheres render: out of memory\n");
+        fprintf(arguments->messages, "%sout of memory\n", arguments->message_prefix);
         return EXIT_RUNTIME;
     }
     if (complaint != NULL) {
-        fprintf(stderr, "rtspheres render: %s, not '%s'\n", complaint, value);
+        fprintf(arguments->messages, "%s%s, not '%s'\n", arguments->message_prefix, complaint, value);
         return EXIT_BAD_INPUT;
     }
     return EXIT_OK;
 }
 
 int render_arguments_parse(int argc, char **argv, render_arguments *arguments, bool *help_shown)
+{
+    return render_arguments_parse_to(argc, argv, arguments, help_shown, stderr, "rtspheres render: ");
+}
+
+int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments, bool *help_shown, FILE *messages,
+                              const char *prefix)
 {
     static const struct option long_options[] = {
         {"output", required_argument, NULL, 'o'},
@@ -383,14 +390,24 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
     memset(arguments, 0, sizeof *arguments);
     arguments->job = render_job_defaults();
     arguments->device = -1;
+    arguments->messages = messages;
+    arguments->message_prefix = prefix;
     *help_shown = false;
+    /* getopt's own messages go to stderr: elsewhere ours say the same. */
+    bool own_messages = messages != stderr;
+    opterr = !own_messages;
     optind = 1;
     int option;
-    while ((option = getopt_long(argc, argv, "o:s:D:qvh", long_options, NULL)) != -1) {
+    while ((option = getopt_long(argc, argv, own_messages ? ":o:s:D:qvh" : "o:s:D:qvh", long_options, NULL)) != -1) {
         if (option == 'h') {
             print_help(stdout);
             *help_shown = true;
             return EXIT_OK;
+        }
+        if (own_messages && (option == '?' || option == ':')) {
+            fprintf(messages, option == '?' ? "%sunknown render option '%s'\n" : "%s%s needs a value\n", prefix,
+                    argv[optind - 1]);
+            return EXIT_BAD_INPUT;
         }
         if (option == '?' || option == ':')
             return EXIT_BAD_INPUT;  /* getopt has said what is wrong */
@@ -399,16 +416,17 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
             return code;
     }
     if (optind >= argc) {
-        fprintf(stderr, "rtspheres render: which scene? usage: rtspheres render SCENE -o OUTPUT\n");
+        fprintf(arguments->messages, "%swhich scene? usage: rtspheres render SCENE -o OUTPUT\n", arguments->message_prefix);
         return EXIT_BAD_INPUT;
     }
     if (optind + 1 < argc) {
-        fprintf(stderr, "rtspheres render: one scene at a time; unexpected '%s'\n", argv[optind + 1]);
+        fprintf(arguments->messages, "%sone scene at a time; unexpected '%s'\n", arguments->message_prefix, argv[optind + 1]);
         return EXIT_BAD_INPUT;
     }
     arguments->job.scene_path = argv[optind];
     if (arguments->job.output == NULL) {
-        fprintf(stderr, "rtspheres render: no output file; add -o OUTPUT (.exr, .png, .jpg, .hdr, .tif)\n");
+        fprintf(arguments->messages, "%sno output file; add -o OUTPUT (.exr, .png, .jpg, .hdr, .tif)\n",
+                arguments->message_prefix);
         return EXIT_BAD_INPUT;
     }
     return EXIT_OK;
