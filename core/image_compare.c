@@ -189,10 +189,6 @@ void image_compare_metrics(const image_compare_result *result, const image_compa
     const image_stat_result *stat = &result->stat;
     append(text, size, &used, "size: %dx%d, %ld pixels tested, %ld skipped (fewer than 2 samples)\n", result->width,
            result->height, stat->tested_pixels, stat->skipped_pixels);
-    append(text, size, &used, "variance: %s\n",
-           stat->variance_of_a && stat->variance_of_b ? "of A and of B"
-           : stat->variance_of_a                      ? "of A (B's taken from it)"
-                                                      : "of B (A's taken from it)");
     append(text, size, &used, "mean error: %.6g\nrms error: %.6g\n", idiff->mean_error, idiff->rms_error);
     append(text, size, &used, "max error: %.6g at (%d, %d)\n", idiff->max_error, idiff->max_x, idiff->max_y);
     append(text, size, &used, "pixel z-scores: mean %.4f, sd %.4f\n", stat->z_mean, stat->z_sd);

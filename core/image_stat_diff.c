@@ -127,8 +127,7 @@ static void pixel_table_free(pixel_table *table)
     memset(table, 0, sizeof *table);
 }
 
-/* Fills table from a and b. The variance of a pixel's mean is s^2 / (n - 1); an image
- * without variance layers borrows the other's s^2 (see the header). */
+/* Fills table from a and b. The variance of a pixel's mean is s^2 / (n - 1). */
 static rt_status fill_pixel_table(const rt_image *a, const image_channels *in_a, const rt_image *b,
                                   const image_channels *in_b, pixel_table *table, image_stat_result *result,
                                   rt_error *error)
@@ -153,8 +152,7 @@ static rt_status fill_pixel_table(const rt_image *a, const image_channels *in_a,
             result->skipped_pixels++;
         for (int c = 0; c < 3; c++) {
             double mean_a = pixel_a[in_a->colour[c]], mean_b = pixel_b[in_b->colour[c]];
-            double spread_a = in_a->has_variance ? pixel_a[in_a->variance[c]] : pixel_b[in_b->variance[c]];
-            double spread_b = in_b->has_variance ? pixel_b[in_b->variance[c]] : pixel_a[in_a->variance[c]];
+            double spread_a = pixel_a[in_a->variance[c]], spread_b = pixel_b[in_b->variance[c]];
             size_t i = p * 3 + (size_t)c;
             table->difference[i] = table->tested[p] ? mean_a - mean_b : 0.0;
             table->variance[i] = table->tested[p] ? fmax(spread_a, 0.0) / (n_a - 1) + fmax(spread_b, 0.0) / (n_b - 1)
@@ -405,12 +403,12 @@ rt_status image_stat_diff(const rt_image *a, const rt_image *b, const image_stat
     if (a->width != b->width || a->height != b->height)
         return rt_error_set(error, RT_ERROR_INPUT, "DIFF: sizes differ: %dx%d vs %dx%d", a->width, a->height,
                             b->width, b->height);
-    result->variance_of_a = in_a.has_variance;
-    result->variance_of_b = in_b.has_variance;
-    if (!in_a.has_variance && !in_b.has_variance)
-        return rt_error_set(error, RT_ERROR_INPUT,
-                            "DIFF: neither image has variance.R/G/B layers, which the statistical test needs; "
-                            "render with --variance");
+    for (int i = 0; i < 2; i++)
+        if (!(i == 0 ? in_a : in_b).has_variance)
+            return rt_error_set(error, RT_ERROR_INPUT,
+                                "DIFF: image %s has no variance.R/G/B layers, which the statistical test needs of "
+                                "both images; render it with --variance",
+                                i == 0 ? "A" : "B");
     status = check_for_nan(a, &in_a, "A", error);
     if (status == RT_OK)
         status = check_for_nan(b, &in_b, "B", error);

@@ -8,10 +8,11 @@
  * per-sample variance s^2 of each channel, E[c^2] - E[c]^2 (what `render --variance`
  * writes, render.h). The variance of a pixel's mean is then s^2 / (n - 1) (the unbiased
  * sample variance s^2 n / (n - 1), over n). Pixels with fewer than 2 samples in either
- * image are left out of every test (skipped_pixels). When only one image has variance
- * layers, the other's is taken from it, scaled by the two pixels' sample counts: the test's
- * hypothesis is that both render the same image, so both estimate the same s^2. Neither:
- * RT_ERROR_INPUT.
+ * image are left out of every test (skipped_pixels). Both images need the variance layers:
+ * a pixel's own variance is what keeps a rare bright sample (a path that found a small
+ * light) from failing it, since that sample raises its variance as much as its mean;
+ * borrowing the other image's variance loses that (measured: a render without variance
+ * failed 1.2% of pixel channels against its own scene). A missing one is RT_ERROR_INPUT.
  *
  * Two facts about rtspheres' samples the test relies on: pixels are independent of each
  * other (each has its own random numbers), and a pixel's samples are independent or, with
@@ -94,7 +95,6 @@ typedef struct image_stat_result {
     double z_mean, z_sd;         /* of the pixel z-scores: near 0 and at most about 1 for
                                   * two renders of one scene */
     long tested_pixels, skipped_pixels;
-    bool variance_of_a, variance_of_b;   /* which images had variance layers */
     int map_scale;               /* the scale the maps' significance shows: the first that
                                   * fails, or 0 (the pixels) when none does */
     bool passed;
