@@ -8,8 +8,8 @@
  * a scene_instance (core/scene_builder.c). The checks that decide whether a direction
  * exists (zero vectors, parallel edges, a camera's up along its view) use the same
  * functions, so every part of the parser (core/scene_*.c) tests them one way. The
- * renderer's own maths is float (core/camera.c with cglm, core/pack.c); nothing here is
- * for it.
+ * renderer's own maths is float (core/camera.c with cglm, the packer's core/pack_*.c);
+ * nothing here is for it.
  *
  * An affine map is p' = m[:, 0..2] p + m[:, 3], rows x, y, z: the layout of
  * scene_instance.object_to_world. Every function is pure: it reads its arguments and

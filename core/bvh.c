@@ -299,6 +299,41 @@ static rt_status build_empty(bvh *out, rt_error *error)
     return RT_OK;
 }
 
+/* Frees the working arrays of bvh_build (any may be NULL). */
+static void free_build_arrays(build_item *items, split_scratch *scratch)
+{
+    free(items);
+    free(scratch->bins);
+    free(scratch->right_weighted_area);
+    free(scratch->right_count);
+}
+
+/* Decides how the task's items (bounded by box, their centroids by centroid_box) are split:
+ * returns false when they become a leaf (splitting costs more than the leaf, and the leaf
+ * is small enough), else true with the items partitioned at *middle. */
+static bool split_task(build_item *items, const build_task *task, const bvh_box *box, const bvh_box *centroid_box,
+                       const build_settings *settings, split_scratch *scratch, uint32_t *middle)
+{
+    uint32_t task_size = task->end - task->begin;
+    bool by_edge_length = box_metric(box, false) == 0;
+    double node_metric = box_metric(box, by_edge_length);
+    split_plane plane;
+    if (choose_split(items, task->begin, task->end, centroid_box, node_metric, by_edge_length, settings, scratch,
+                     &plane)) {
+        double leaf_cost = settings->intersection_cost * task_size * node_metric;
+        if (plane.cost >= leaf_cost && task_size <= settings->max_leaf_size)
+            return false;
+        *middle = partition_items(items, task->begin, task->end, &plane, settings->bin_count);
+        return true;
+    }
+    if (task_size <= settings->max_leaf_size)
+        return false;
+    /* Every centroid is the same point: no plane separates them, and the order among them
+     * does not matter, so halve by index. */
+    *middle = task->begin + task_size / 2;
+    return true;
+}
+
 /* Builds the tree into *out (zeroed first, and left zeroed on failure). Returns RT_OK,
  * RT_ERROR_INPUT for a bad config or box, RT_ERROR_RUNTIME when memory runs out. The
  * caller frees *out with bvh_free(). */
@@ -339,10 +374,7 @@ rt_status bvh_build(const bvh_box *boxes, uint32_t count, const bvh_build_config
     }
     if (out->nodes == NULL || out->primitive_indices == NULL || items == NULL ||
         scratch.bins == NULL || scratch.right_weighted_area == NULL || scratch.right_count == NULL) {
-        free(items);
-        free(scratch.bins);
-        free(scratch.right_weighted_area);
-        free(scratch.right_count);
+        free_build_arrays(items, &scratch);
         bvh_free(out);
         return rt_error_set(error, RT_ERROR_RUNTIME, "BVH: out of memory for %u primitives", count);
     }
@@ -372,27 +404,8 @@ rt_status bvh_build(const bvh_box *boxes, uint32_t count, const bvh_build_config
             tree_depth = task.depth;
 
         uint32_t middle = 0;
-        bool make_leaf = task_size == 1 || task.depth >= settings.max_depth;
-        if (!make_leaf) {
-            bool by_edge_length = box_metric(&node->box, false) == 0;
-            double node_metric = box_metric(&node->box, by_edge_length);
-            split_plane plane;
-            if (choose_split(items, task.begin, task.end, &centroid_box, node_metric, by_edge_length,
-                             &settings, &scratch, &plane)) {
-                double leaf_cost = settings.intersection_cost * task_size * node_metric;
-                if (plane.cost >= leaf_cost && task_size <= settings.max_leaf_size)
-                    make_leaf = true;
-                else
-                    middle = partition_items(items, task.begin, task.end, &plane, settings.bin_count);
-            } else if (task_size <= settings.max_leaf_size) {
-                make_leaf = true;
-            } else {
-                /* Every centroid is the same point: no plane separates them, and the order
-                 * among them does not matter, so halve by index. */
-                middle = task.begin + task_size / 2;
-            }
-        }
-
+        bool make_leaf = task_size == 1 || task.depth >= settings.max_depth
+                         || !split_task(items, &task, &node->box, &centroid_box, &settings, &scratch, &middle);
         if (make_leaf) {
             node->first = task.begin;
             node->count = task_size;
@@ -413,10 +426,7 @@ rt_status bvh_build(const bvh_box *boxes, uint32_t count, const bvh_build_config
 
     for (uint32_t i = 0; i < count; i++)
         out->primitive_indices[i] = items[i].primitive;
-    free(items);
-    free(scratch.bins);
-    free(scratch.right_weighted_area);
-    free(scratch.right_count);
+    free_build_arrays(items, &scratch);
 
     /* Give back the nodes that bigger leaves left unused; keeping the larger block is fine
      * if the system will not shrink it. */

@@ -1,7 +1,8 @@
 /* expression.h: evaluates the arithmetic expressions of the scene format, in double.
  *
- * Used by scene_parse.c for numbers written as `( ... )`, `$name` and the right-hand side
- * of `set`, and on its own for the value of a command-line -D NAME=VALUE.
+ * Used by the scene parser (core/scene_values.c, core/scene_statements.c) for numbers
+ * written as `( ... )`, `$name` and the right-hand side of `set`, and on its own for the
+ * value of a command-line -D NAME=VALUE.
  *
  * Grammar, from the loosest to the tightest binding:
  *   sum      = product { ('+' | '-') product }          left associative

@@ -204,9 +204,7 @@ extern "C" {
 
 image_diff_options image_diff_options_defaults(void)
 {
-    image_diff_options options;
-    memset(&options, 0, sizeof options);
-    return options;
+    return image_diff_options{};
 }
 
 rt_status image_diff(const rt_image *a, const rt_image *b, const image_diff_options *options,

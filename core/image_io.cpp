@@ -597,15 +597,36 @@ rt_status image_read_attribute_impl(const char *path, const char *name, char *va
     return RT_OK;
 }
 
+/* image_read() and image_read_linear(): reads path with image_read_impl(), turning every C++
+ * exception into a status; on failure out is freed and zeroed. */
+rt_status image_read_guarded(const char *path, int max_side, bool linear, rt_image *out,
+                             rt_error *error)
+{
+    memset(out, 0, sizeof *out);
+    if (path == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read an image from");
+    try {
+        return image_read_impl(path, max_side, linear, out, error);
+    } catch (const std::bad_alloc &) {
+        image_free(out);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory",
+                            path);
+    } catch (const std::exception &e) {
+        image_free(out);
+        return read_failed(error, path, one_line(e.what()));
+    } catch (...) {
+        image_free(out);
+        return read_failed(error, path, "unexpected C++ exception");
+    }
+}
+
 }  // namespace
 
 extern "C" {
 
 image_write_options image_write_options_defaults(void)
 {
-    image_write_options options;
-    memset(&options, 0, sizeof options);
-    return options;
+    return image_write_options{};
 }
 
 image_format image_format_of(const char *path)
@@ -696,42 +717,12 @@ rt_status image_write(const char *path, const rt_image *image, const image_write
 
 rt_status image_read(const char *path, rt_image *out, rt_error *error)
 {
-    memset(out, 0, sizeof *out);
-    if (path == nullptr)
-        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read an image from");
-    try {
-        return image_read_impl(path, 0, false, out, error);
-    } catch (const std::bad_alloc &) {
-        image_free(out);
-        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory",
-                            path);
-    } catch (const std::exception &e) {
-        image_free(out);
-        return read_failed(error, path, one_line(e.what()));
-    } catch (...) {
-        image_free(out);
-        return read_failed(error, path, "unexpected C++ exception");
-    }
+    return image_read_guarded(path, 0, false, out, error);
 }
 
 rt_status image_read_linear(const char *path, int max_side, rt_image *out, rt_error *error)
 {
-    memset(out, 0, sizeof *out);
-    if (path == nullptr)
-        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read an image from");
-    try {
-        return image_read_impl(path, max_side, true, out, error);
-    } catch (const std::bad_alloc &) {
-        image_free(out);
-        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory",
-                            path);
-    } catch (const std::exception &e) {
-        image_free(out);
-        return read_failed(error, path, one_line(e.what()));
-    } catch (...) {
-        image_free(out);
-        return read_failed(error, path, "unexpected C++ exception");
-    }
+    return image_read_guarded(path, max_side, true, out, error);
 }
 
 rt_status image_read_attribute(const char *path, const char *name, char *value, int value_size,

@@ -2,20 +2,23 @@
  * without a GPU). The record layout is packed_layout.h, the one definition shared with the
  * shader.
  *
- * What it builds: one bottom-level BVH per object that an instance places with a transform,
- * a volume flag or a mesh (each object once, however often it is placed), and a top-level
- * BVH (root: node 0) over the world's own primitives (spheres, and the shapes and mesh
- * triangles of objects placed with the identity and no volume: those are copied into the
- * top level, so simple scenes pay nothing for instancing and emissive meshes become
- * lights) and the instances. Shapes without a material get the
- * instance's, and failing that a default grey Lambertian material (appended last).
+ * What it builds: a top-level BVH (root: node 0) over the world's own primitives and the
+ * instances, and one bottom-level BVH per object that an instance places (each object
+ * once, however often it is placed). The world's primitives are its spheres, the shapes
+ * and mesh triangles of objects placed with the identity and no volume (copied into the
+ * top level), and those of placements baked into it (moved by their transform: emitters,
+ * so that they become lights, and placements whose shapes a transform keeps exactly,
+ * within a memory budget; core/pack_collect.c has the rule). Volumes and the other
+ * placements are instances. Shapes without a material get the instance's, and failing
+ * that a default grey Lambertian material (appended last).
  *
  * Output: texel_count texels of four uint32 each (texels[4*i .. 4*i+3] is texel i);
  * floats are stored as their bit patterns. Reading them back on the CPU (records, the
  * shader's traversal) is packed_traverse.h's. The packer's steps and files:
  * pack_internal.h.
  *
- * Defaults of pack_options (all zero): BVHs built with bvh_build_config defaults.
+ * Defaults of pack_options (all zero): BVHs built with bvh_build_config defaults, a bake
+ * budget of PACK_DEFAULT_BAKE_BUDGET (262,144) primitives, placements baked by the rule.
  */
 #ifndef RT_PACK_H
 #define RT_PACK_H
@@ -27,8 +30,18 @@
 #include "scene.h"
 #include "status.h"
 
+/* The default of pack_options.bake_budget. */
+#define PACK_DEFAULT_BAKE_BUDGET 262144
+
 typedef struct pack_options {
     const bvh_build_config *bvh_config;  /* NULL: defaults */
+    uint32_t bake_budget;    /* an object's placements with a transform are baked into the
+                              * top level while the copies beyond the first hold at most
+                              * this many primitives (core/pack_collect.c says when else);
+                              * 0: PACK_DEFAULT_BAKE_BUDGET */
+    bool keep_instances;     /* true: only identity placements and emitters join the top
+                              * level, every other placement stays an instance (the rule
+                              * before baking; for tests and measurements) */
 } pack_options;
 
 /* What a packed scene holds, noted by each section's writer as it writes: render.c

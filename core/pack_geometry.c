@@ -9,8 +9,8 @@
 rt_status pack_order_vertices(packer *p, uint32_t *vertex_count, rt_error *error)
 {
     /* Vertices are stored in the order the triangles, in leaf order, first use them: a
-     * leaf's triangles then read neighbouring vertex texels (the 1.3M-triangle mesh
-     * traced about 1.3x slower with the loader's vertex order). Unused ones are dropped. */
+     * leaf's triangles then read neighbouring vertex texels (docs/performance.md, the log:
+     * vertices renumbered). Unused ones are dropped. */
     const scene *s = p->scene;
     p->vertex_order = malloc(((size_t)p->vertices.count + 1) * sizeof *p->vertex_order);
     if (p->vertex_order == NULL)

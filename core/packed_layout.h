@@ -1,7 +1,8 @@
 /* packed_layout.h: the one definition of the packed scene records, shared by C and GLSL.
  *
- * This file is included by the C packer (core/pack.c) and prepended, byte for byte, to the
- * GLSL tracer when the shader is built (see core/shader_sources.S). It must therefore stay
+ * This file is included by the C packer (core/pack*.c, through pack_internal.h) and
+ * prepended, byte for byte, to the GLSL tracer when the shader is built (see
+ * core/shader_sources.S). It must therefore stay
  * valid in both languages: only comments, include guards and #define of plain integers.
  *
  * The packed scene is an array of texels of four 32-bit unsigned integers (GL_RGBA32UI).

@@ -1,5 +1,6 @@
-/* packed_traverse.c: see packed_traverse.h. The traversal follows glsl/tracer.frag's
- * (intersection, BVH walk, instances) operation for operation, so that CPU and shader
+/* packed_traverse.c: see packed_traverse.h. The traversal follows the tracer's
+ * (glsl/intersect.glsl, glsl/traverse.glsl: intersection, BVH walk, instances) operation
+ * for operation, so that CPU and shader
  * agree on what a ray hits. */
 #include "packed_traverse.h"
 
@@ -102,7 +103,7 @@ packed_primitive packed_primitive_at(const packed_scene *packed, uint32_t slot)
 
 /* ---- the shader's traversal, in C ---------------------------------------------------- */
 
-/* tracer.frag intersect_sphere: nearest root in (0, t_max) for any direction length. */
+/* glsl/intersect.glsl intersect_sphere: nearest root in (0, t_max) for any direction length. */
 static float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direction, float t_max)
 {
     float length = glm_vec3_norm(direction);
@@ -133,7 +134,7 @@ static float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direc
     return INFINITY;
 }
 
-/* tracer.frag intersect_triangle (Moller-Trumbore), and quads by their plane. */
+/* glsl/intersect.glsl intersect_flat: Moller-Trumbore for triangles, quads by their plane. */
 static float intersect_flat(packed_primitive *primitive, vec3 origin, vec3 direction, float t_max)
 {
     float *corner = primitive->data[0], *edge1 = primitive->data[1], *edge2 = primitive->data[2];
@@ -168,8 +169,8 @@ static void ray_set(moving_ray *ray, vec3 origin, vec3 direction)
     glm_vec3_div(GLM_VEC3_ONE, direction, ray->inverse_direction);
 }
 
-/* tracer.frag's slab test: where the ray enters node's box within (0, t_max), or
- * INFINITY when it misses. */
+/* glsl/intersect.glsl intersect_box, the slab test: where the ray enters node's box within
+ * (0, t_max), or INFINITY when it misses. */
 static float intersect_box(const packed_scene *packed, uint32_t node, const moving_ray *ray, float t_max)
 {
     uint32_t base = packed->node_offset + node * PACKED_NODE_STRIDE;

@@ -1,4 +1,4 @@
-/* render.c: see render.h. Plain C: the GL work is gpu.c's. */
+/* render.c: see render.h. Plain C: the GL work is the GPU module's (core/gpu.c, gpu_tracer.c). */
 #include "render.h"
 
 #include <math.h>
@@ -16,9 +16,8 @@
 #define MINIMUM_ADAPTIVE_BUDGET 16
 #define MAXIMUM_ADAPTIVE_BUDGET 16384
 /* Passes of about a second on a CPU rasteriser, a quarter on a GPU (under any watchdog):
- * on llvmpipe every pass costs a share of its time whatever it does (the weekend scene
- * at 1200x675 traced 4.3e6 segments/s with 0.25 s passes, 5.5e6 with 0.5 s and 5.7e6
- * with 1 s), and nothing kills a long draw there. */
+ * on llvmpipe every pass costs a share of its time whatever it does (docs/performance.md,
+ * the log: longer passes), and nothing kills a long draw there. */
 #define DEFAULT_TARGET_PASS_SECONDS 0.25
 #define SOFTWARE_TARGET_PASS_SECONDS 1.0
 #define DEFAULT_RUSSIAN_ROULETTE_DEPTH 4
@@ -283,25 +282,29 @@ static float *resume_sums(const rt_image *partial, int width, int height, uint32
     return sums;
 }
 
-rt_status render_scene(gpu_context *context, const scene *s, const render_options *options,
-                       render_result *result, rt_error *error)
+/* The part of render_scene before the passes: checks the region, frames the camera,
+ * packs the scene (its figures go into *result, with the region and the scene hash),
+ * checks the resumed partial against the hash and creates the tracer (*tracer, which the
+ * caller destroys) with the partial's sums. *region is the region rendered,
+ * *samples_resumed the samples the partial brought and *pass_work_budget the first pass's
+ * budget. On failure nothing is left to free. */
+static rt_status set_up_tracer(gpu_context *context, const scene *s, const render_options *options,
+                               render_result *result, int region[4], uint64_t *samples_resumed, gpu_tracer **tracer,
+                               uint32_t *pass_work_budget, rt_error *error)
 {
-    double start = clock_seconds();
-    memset(result, 0, sizeof *result);
-    render_options defaults = render_options_defaults();
-    if (options == NULL)
-        options = &defaults;
-
-    int region[4] = {0, 0, s->render.width, s->render.height};
+    region[0] = 0;
+    region[1] = 0;
+    region[2] = s->render.width;
+    region[3] = s->render.height;
     if (options->region[0] || options->region[1] || options->region[2] || options->region[3]) {
         const int *r = options->region;
         if (r[0] < 0 || r[1] < 0 || r[2] > s->render.width || r[3] > s->render.height || r[0] >= r[2] || r[1] >= r[3])
             return rt_error_set(error, RT_ERROR_INPUT,
                                 "RENDER: region %d,%d,%d,%d is not a non-empty part of the %dx%d image", r[0], r[1],
                                 r[2], r[3], s->render.width, s->render.height);
-        memcpy(region, r, sizeof region);
+        memcpy(region, r, 4 * sizeof *region);
     }
-    memcpy(result->region, region, sizeof region);
+    memcpy(result->region, region, sizeof result->region);
     int width = region[2] - region[0], height = region[3] - region[1];
 
     camera_frame frame;
@@ -335,10 +338,11 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     tracer_parameters(s, &frame, options, region, &parameters);
     parameters.shader.camera_media = packed_media_at(&packed, s->camera.look_from);
     parameters.omitted_features = omitted_features(&packed, options, parameters.shader.camera_media);
-    uint64_t samples_resumed = 0;
+    *pass_work_budget = parameters.shader.pass_work_budget;
+    *samples_resumed = 0;
     float *sums = NULL;
     if (options->resume != NULL) {
-        sums = resume_sums(options->resume, width, height, (uint32_t)s->render.samples_per_pixel, &samples_resumed,
+        sums = resume_sums(options->resume, width, height, (uint32_t)s->render.samples_per_pixel, samples_resumed,
                            error);
         if (sums == NULL) {
             packed_scene_free(&packed);
@@ -346,65 +350,72 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         }
         parameters.resume = sums;
     }
-    gpu_tracer *tracer = NULL;
-    status = gpu_tracer_create(context, packed.texels, packed.texel_count, packed.texel_hash, &parameters, &tracer,
+    status = gpu_tracer_create(context, packed.texels, packed.texel_count, packed.texel_hash, &parameters, tracer,
                                error);
     packed_scene_free(&packed);
     free(sums);
-    if (status != RT_OK)
-        return status;
-    result->reused_scene = gpu_tracer_reused_scene(tracer);
+    return status;
+}
 
-    render_progress progress = {
-        .samples_total = (uint64_t)width * height * s->render.samples_per_pixel,
-        .samples_done = samples_resumed,
-    };
+/* Moves the adaptive pass budget *budget towards a pass of target_seconds after a pass of
+ * pass_seconds, within [MINIMUM_ADAPTIVE_BUDGET, most_budget], and gives it to the tracer. */
+static void adapt_pass_budget(gpu_tracer *tracer, double pass_seconds, double target_seconds, double most_budget,
+                              double *budget)
+{
+    /* Pass time grows roughly linearly with the budget; move towards the target by at
+     * most a factor of 4 per pass so one odd pass cannot swing it far. */
+    double scale = pass_seconds > 0 ? target_seconds / pass_seconds : 4.0;
+    scale = scale < 0.5 ? 0.5 : scale > 4.0 ? 4.0 : scale;
+    *budget *= scale;
+    *budget = *budget < MINIMUM_ADAPTIVE_BUDGET ? MINIMUM_ADAPTIVE_BUDGET : *budget > most_budget ? most_budget : *budget;
+    gpu_tracer_set_pass_work_budget(tracer, (uint32_t)*budget);
+}
+
+/* The passes of render_scene: runs them until every pixel has its samples or a stop is
+ * requested (*interrupted), adapting the budget (from initial_budget) unless the options
+ * fix it, reporting progress (*progress, whose samples_done starts at the resumed samples)
+ * and writing checkpoints; fills the result's pass timings. start is the render's start. */
+static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const render_options *options, int width,
+                            int height, uint32_t initial_budget, double start, render_progress *progress,
+                            bool *interrupted, render_result *result, rt_error *error)
+{
     double last_checkpoint = clock_seconds();
     double first_pass_end = 0;
-    bool interrupted = false;
     bool adaptive = options->pass_work_budget == 0;
     gpu_info device;
     gpu_get_info(context, &device);
     double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
                             : device.software                ? SOFTWARE_TARGET_PASS_SECONDS
                                                              : DEFAULT_TARGET_PASS_SECONDS;
-    double budget = parameters.shader.pass_work_budget;
+    double budget = initial_budget;
     double most_budget = device.max_pass_work_budget < MAXIMUM_ADAPTIVE_BUDGET ? device.max_pass_work_budget
                                                                                : MAXIMUM_ADAPTIVE_BUDGET;
+    *interrupted = false;
     for (;;) {
         gpu_pass_report report;
         double pass_start = clock_seconds();
-        status = gpu_tracer_run_pass(tracer, &report, error);
+        rt_status status = gpu_tracer_run_pass(tracer, &report, error);
         if (status != RT_OK)
-            break;
-        if (adaptive) {
-            /* Pass time grows roughly linearly with the budget; move towards the target
-             * by at most a factor of 4 per pass so one odd pass cannot swing it far. */
-            double pass_seconds = clock_seconds() - pass_start;
-            double scale = pass_seconds > 0 ? target_seconds / pass_seconds : 4.0;
-            scale = scale < 0.5 ? 0.5 : scale > 4.0 ? 4.0 : scale;
-            budget *= scale;
-            budget = budget < MINIMUM_ADAPTIVE_BUDGET ? MINIMUM_ADAPTIVE_BUDGET
-                     : budget > most_budget ? most_budget : budget;
-            gpu_tracer_set_pass_work_budget(tracer, (uint32_t)budget);
-        }
-        progress.passes++;
-        progress.samples_done += report.samples_finished;
-        progress.elapsed_seconds = clock_seconds() - start;
-        if (progress.passes == 1) {
-            result->first_pass_seconds = progress.elapsed_seconds;
+            return status;
+        if (adaptive)
+            adapt_pass_budget(tracer, clock_seconds() - pass_start, target_seconds, most_budget, &budget);
+        progress->passes++;
+        progress->samples_done += report.samples_finished;
+        progress->elapsed_seconds = clock_seconds() - start;
+        if (progress->passes == 1) {
+            result->first_pass_seconds = progress->elapsed_seconds;
             first_pass_end = clock_seconds();
         } else {
             result->steady_samples += report.samples_finished;
             result->steady_seconds = clock_seconds() - first_pass_end;
         }
         if (options->progress != NULL)
-            options->progress(options->progress_context, &progress);
+            options->progress(options->progress_context, progress);
         if (report.unfinished_pixels == 0)
-            break;
+            return RT_OK;
         if (options->stop_requested != NULL && *options->stop_requested) {
-            interrupted = true;
-            break;
+            *interrupted = true;
+            return RT_OK;
         }
         if (options->checkpoint != NULL && options->checkpoint_seconds > 0
             && clock_seconds() - last_checkpoint >= options->checkpoint_seconds) {
@@ -412,19 +423,27 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
             uint64_t partial_samples;
             status = read_image(tracer, width, height, &partial, NULL, NULL, &partial_samples, error);
             if (status != RT_OK)
-                break;
+                return status;
             status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, result->scene_hash,
                                          error);
             image_free(&partial);
             if (status != RT_OK)
-                break;
+                return status;
             last_checkpoint = clock_seconds();
         }
     }
+}
 
+/* The read-back of render_scene: the image (and the AOVs and variance layers asked for) into
+ * *result, with the path segments; an error, with nothing allocated, when a path
+ * reached the work cap. */
+static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const render_options *options, int width,
+                             int height, render_result *result, rt_error *error)
+{
     gpu_tracer_totals totals = {0};
     float *luminance_squares = NULL;
-    if (status == RT_OK && options->aovs) {
+    rt_status status = RT_OK;
+    if (options->aovs) {
         luminance_squares = malloc((size_t)width * height * sizeof *luminance_squares);
         if (luminance_squares == NULL)
             status = rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
@@ -436,13 +455,14 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (status == RT_OK && options->variance)
         status = add_variance_layers(tracer, width, height, result, error);
     free(luminance_squares);
-    gpu_tracer_destroy(tracer);
     if (status != RT_OK) {
         image_free(&result->image);
         image_free(&result->aovs);
         return status;
     }
     if (totals.traversal_overflows > 0) {
+        gpu_info device;
+        gpu_get_info(context, &device);
         image_free(&result->image);
         image_free(&result->aovs);
         return rt_error_set(error, RT_ERROR_RUNTIME,
@@ -452,9 +472,42 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
                             "of instances)",
                             totals.traversal_overflows, device.work_cap);
     }
+    result->path_segments = totals.path_segments;
+    return RT_OK;
+}
+
+rt_status render_scene(gpu_context *context, const scene *s, const render_options *options,
+                       render_result *result, rt_error *error)
+{
+    double start = clock_seconds();
+    memset(result, 0, sizeof *result);
+    render_options defaults = render_options_defaults();
+    if (options == NULL)
+        options = &defaults;
+
+    int region[4];
+    uint64_t samples_resumed = 0;
+    uint32_t budget = 0;
+    gpu_tracer *tracer = NULL;
+    rt_status status = set_up_tracer(context, s, options, result, region, &samples_resumed, &tracer, &budget, error);
+    if (status != RT_OK)
+        return status;
+    result->reused_scene = gpu_tracer_reused_scene(tracer);
+    int width = region[2] - region[0], height = region[3] - region[1];
+
+    render_progress progress = {
+        .samples_total = (uint64_t)width * height * s->render.samples_per_pixel,
+        .samples_done = samples_resumed,
+    };
+    bool interrupted = false;
+    status = run_passes(context, tracer, options, width, height, budget, start, &progress, &interrupted, result, error);
+    if (status == RT_OK)
+        status = read_result(context, tracer, options, width, height, result, error);
+    gpu_tracer_destroy(tracer);
+    if (status != RT_OK)
+        return status;
 
     result->passes = progress.passes;
-    result->path_segments = totals.path_segments;
     result->seconds = clock_seconds() - start;
     if (interrupted)
         return rt_error_set(error, RT_ERROR_INTERRUPTED, "RENDER: interrupted after %llu of %llu samples",

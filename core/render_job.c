@@ -175,18 +175,17 @@ static rt_status postprocess_result(const render_job *job, const char *output, r
     return status;
 }
 
-/* After the passes: post-processes the result and writes it, to the output when the
- * render finished, else (render_status RT_ERROR_INTERRUPTED) to the partial file, which
+/* After the passes: writes the result, post-processed, to the output when the render
+ * finished, else (render_status RT_ERROR_INTERRUPTED) as it is to the partial file, which
  * the message then names. */
 static rt_status finish_image(job_image *image, render_result *result, rt_status render_status, rt_error *error)
 {
     const render_job_image *plan = &image->plan;
-    rt_status status = postprocess_result(image->run->job, plan->output, result, error);
-    if (status != RT_OK)
-        return status;
     if (render_status == RT_ERROR_INTERRUPTED) {
         /* The partial goes next to the output, never over it: the user's last good image
-         * stays, and --resume continues from the partial. */
+         * stays, and --resume continues from the partial. Like a checkpoint it holds the
+         * raw means and sample counts: --resume adds samples to them, so denoised, blurred
+         * or tone-mapped colour there would be processed twice. */
         rt_error write_error = {{0}};
         if (write_image(image, &result->image, plan->partial, result->samples, false, result, &write_error) != RT_OK)
             return rt_error_set(error, RT_ERROR_INTERRUPTED, "interrupted, and the partial could not be written: %s",
@@ -195,6 +194,9 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
                             "interrupted: wrote the %llu samples finished so far to %s; continue with --resume %s",
                             (unsigned long long)result->samples, plan->partial, plan->partial);
     }
+    rt_status status = postprocess_result(image->run->job, plan->output, result, error);
+    if (status != RT_OK)
+        return status;
     status = write_image(image, &result->image, plan->output, result->samples, true, result, error);
     if (status != RT_OK)
         return status;

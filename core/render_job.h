@@ -54,8 +54,9 @@
  * is loaded with its variables (asset warnings go to the warning callback with the image
  * of the list's first frame only, so a shard by frames without it shows none), planned,
  * rendered (render_scene()), post-processed, and written; on success its partial file is
- * removed. A stop request during a render writes the samples done, post-processed like the
- * output, to the partial file (never over the output) and ends the job; one between
+ * removed. A stop request during a render writes the samples done to the partial file
+ * (never over the output) as a checkpoint does: the raw means and sample counts, not
+ * post-processed, since --resume adds samples to them; then it ends the job. One between
  * frames ends it before the next frame. The first failing image ends the job.
  *
  * Messages name the job's fields by the render command's options (--crop, --shard, ...),

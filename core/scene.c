@@ -50,77 +50,60 @@ void scene_free(scene *s)
     scene_defaults(s);
 }
 
+/* Appends the element_size bytes at item to the array *items of *count elements and room
+ * for *capacity (grown with array_reserve); returns the new element's index, or -1 when
+ * memory runs out (the array is then unchanged). Every scene_add_* but the warnings'. */
+static int append_item(void **items, int *count, size_t *capacity, const void *item, size_t element_size)
+{
+    if (!array_reserve(items, capacity, (size_t)*count + 1, element_size))
+        return -1;
+    memcpy((char *)*items + (size_t)*count * element_size, item, element_size);
+    return (*count)++;
+}
 
 int scene_add_material(scene *s, const scene_material *material)
 {
-    if (!array_reserve((void **)&s->materials, &s->material_capacity, (size_t)s->material_count + 1, sizeof *material))
-        return -1;
-    s->materials[s->material_count] = *material;
-    return s->material_count++;
+    return append_item((void **)&s->materials, &s->material_count, &s->material_capacity, material, sizeof *material);
 }
 
 int scene_add_sphere(scene *s, const scene_sphere *sphere)
 {
-    if (!array_reserve((void **)&s->spheres, &s->sphere_capacity, (size_t)s->sphere_count + 1, sizeof *sphere))
-        return -1;
-    s->spheres[s->sphere_count] = *sphere;
-    return s->sphere_count++;
+    return append_item((void **)&s->spheres, &s->sphere_count, &s->sphere_capacity, sphere, sizeof *sphere);
 }
 
 int scene_add_shape(scene *s, const scene_shape *shape)
 {
-    if (!array_reserve((void **)&s->shapes, &s->shape_capacity, (size_t)s->shape_count + 1, sizeof *shape))
-        return -1;
-    s->shapes[s->shape_count] = *shape;
-    return s->shape_count++;
+    return append_item((void **)&s->shapes, &s->shape_count, &s->shape_capacity, shape, sizeof *shape);
 }
 
 int scene_add_object(scene *s, const scene_object *object)
 {
-    if (!array_reserve((void **)&s->objects, &s->object_capacity, (size_t)s->object_count + 1, sizeof *object))
-        return -1;
-    s->objects[s->object_count] = *object;
-    return s->object_count++;
+    return append_item((void **)&s->objects, &s->object_count, &s->object_capacity, object, sizeof *object);
 }
 
 int scene_add_instance(scene *s, const scene_instance *instance)
 {
-    if (!array_reserve((void **)&s->instances, &s->instance_capacity, (size_t)s->instance_count + 1, sizeof *instance))
-        return -1;
-    s->instances[s->instance_count] = *instance;
-    return s->instance_count++;
+    return append_item((void **)&s->instances, &s->instance_count, &s->instance_capacity, instance, sizeof *instance);
 }
 
 int scene_add_mesh(scene *s, const scene_mesh *mesh)
 {
-    if (!array_reserve((void **)&s->meshes, &s->mesh_capacity, (size_t)s->mesh_count + 1, sizeof *mesh))
-        return -1;
-    s->meshes[s->mesh_count] = *mesh;
-    return s->mesh_count++;
+    return append_item((void **)&s->meshes, &s->mesh_count, &s->mesh_capacity, mesh, sizeof *mesh);
 }
 
 int scene_add_texture(scene *s, const scene_texture *texture)
 {
-    if (!array_reserve((void **)&s->textures, &s->texture_capacity, (size_t)s->texture_count + 1, sizeof *texture))
-        return -1;
-    s->textures[s->texture_count] = *texture;
-    return s->texture_count++;
+    return append_item((void **)&s->textures, &s->texture_count, &s->texture_capacity, texture, sizeof *texture);
 }
 
 int scene_add_image(scene *s, const scene_image *image)
 {
-    if (!array_reserve((void **)&s->images, &s->image_capacity, (size_t)s->image_count + 1, sizeof *image))
-        return -1;
-    s->images[s->image_count] = *image;
-    return s->image_count++;
+    return append_item((void **)&s->images, &s->image_count, &s->image_capacity, image, sizeof *image);
 }
 
 int scene_add_light(scene *s, const scene_light *light)
 {
-    if (!array_reserve((void **)&s->lights, &s->light_capacity, (size_t)s->light_count + 1, sizeof *light))
-        return -1;
-    s->lights[s->light_count] = *light;
-    return s->light_count++;
+    return append_item((void **)&s->lights, &s->light_count, &s->light_capacity, light, sizeof *light);
 }
 
 int scene_add_warning(scene *s, const char *format, ...)

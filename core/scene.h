@@ -1,7 +1,8 @@
 /* scene.h: the scene graph as plain C arrays, the parser's output and the packer's input.
  *
- * A scene is built by scene_parse.c (from text) or by hand (tests); the packer
- * (pack.c) turns it into GPU records. It owns its arrays: scene_free() frees them.
+ * A scene is built by the parser (from text: core/scene_parse.c runs it, core/scene_builder.c
+ * fills the scene) or by hand (tests); the packer (core/pack*.c) turns it into GPU records.
+ * It owns its arrays: scene_free() frees them.
  * Nothing here calls GL.
  *
  * Defaults (scene_defaults()):

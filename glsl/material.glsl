@@ -26,7 +26,8 @@
 //   4. one line in each function of glsl/material_table.glsl (and in material_emits /
 //      material_emitted if it emits);
 //   5. glsl/material_phong.glsl: whether Whitted shades it with Phong (phong_shades).
-// The parser (core/scene_parse.c) and the packer (core/pack.h) then make and pack it.
+// The parser (core/scene_statements_appearance.c) and the packer (core/pack_materials.c) then
+// make and pack it.
 
 // A material record (packed_layout.h "materials") as shading reads it.
 struct Material {

@@ -5,7 +5,7 @@
  * What "plain" means here, on purpose: float32 math, one straightforward loop over all
  * spheres for every ray (no acceleration structure, no hand-written SIMD), OpenMP over
  * image rows, built with -O3 -march=native -fopenmp. Everything else follows rtspheres'
- * own tracer (glsl/tracer.frag) so that the two do the same work per path segment:
+ * own tracer (the GLSL modules of glsl/) so that the two do the same work per path segment:
  *   - the camera of core/camera.c (thin lens, vertical fov, focus distance);
  *   - the sky gradient mix(bottom, top, 0.5 (y + 1));
  *   - Lambertian (normal + unit vector), metal (reflection + fuzz * point in the unit

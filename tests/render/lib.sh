@@ -105,6 +105,22 @@ merge_problem() {
     fi
 }
 
+# render_split_scene: the render that test-merge.sh and test-splits.sh split into parts:
+# sets $scene, $size and $render_options (see render) to the test scene at 48x27 and
+# 16 spp, and renders it whole to $full ($scratch/full.exr); false, after a failed check
+# "full render", when that render fails.
+render_split_scene() {
+    scene=scenes/materials/metal.txt
+    size="--size 48x27"
+    render_options="$size --spp 16"
+    full=$scratch/full.exr
+    if render "$full"; then
+        return 0
+    fi
+    fail "full render" "rtspheres render failed"
+    return 1
+}
+
 # ---- what `stats` prints -------------------------------------------------------------------
 
 # stats_of FILE [--crop C]: runs `stats` once and keeps its output in $scratch/stats, which

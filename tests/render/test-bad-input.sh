@@ -5,8 +5,9 @@
 # must leave no output file behind. The one good input here, an empty scene file,
 # must render (exit 0).
 #   usage: sh tests/render/test-bad-input.sh PROGRAM SCRATCH_DIR
-# Starting the program costs about 0.3 s (its image libraries), so the cases run in two
-# halves at once, each in its own directory; their lines are printed in order at the end.
+# Starting the program costs a noticeable time (its image libraries: docs/performance.md),
+# so the cases run in two halves at once, each in its own directory; their lines are
+# printed in order at the end.
 . "$(dirname "$0")/lib.sh"
 
 # Every render is tiny, so that a case that wrongly succeeds still ends at once.

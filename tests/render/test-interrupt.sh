@@ -6,8 +6,8 @@
 #   usage: sh tests/render/test-interrupt.sh PROGRAM SCRATCH_DIR
 . "$(dirname "$0")/lib.sh"
 scene=scenes/materials/lambertian.txt
-# About 2.7 million samples: seconds on llvmpipe; the tests wait for the first checkpoint
-# before signalling, so a fast device is fine too.
+# About 2.7 million samples (docs/performance.md has how long they take on llvmpipe); the
+# tests wait for the first checkpoint before signalling, so a fast device is fine too.
 options="--size 48x27 --spp 2048 --seed 3"
 
 # wait_for_file FILE: waits (at most 60 s) until FILE exists; false on time-out.
@@ -81,6 +81,30 @@ fi
 if [ ! -f "$scratch/out.partial.exr" ]; then pass "the partial is removed when the render completes"
 else fail "the partial is removed when the render completes" "it is still there"; fi
 
+# An interrupted render whose output is post-processed (here blurred, to a PNG) still
+# writes the raw means and sample counts to its partial, as a checkpoint does: --resume
+# adds samples to them, so processed colour there would be processed twice.
+code=$(interrupt_running INT "$scratch/blur.png" --blur 2)
+if [ "$code" = 1 ] && [ "$(metadata "$scratch/blur.partial.exr" complete)" = 0 ]; then
+    pass "SIGINT during a --blur render to a PNG writes its partial"
+else fail "SIGINT during a --blur render to a PNG writes its partial" "exit $code; $(cat "$scratch/interrupt.err")"; fi
+# Its pixels are the raw means: resumed without post-processing, they give the plain
+# render (reference.exr above), as a checkpoint's partial does.
+# shellcheck disable=SC2086
+if "$program" render $scene -o "$scratch/blur-raw.exr" $options --resume "$scratch/blur.partial.exr" --quiet &&
+   "$program" diff "$scratch/blur-raw.exr" "$scratch/reference.exr" --fail 1e-5 --failpercent 0 >"$scratch/diff.txt"; then
+    pass "the partial of a --blur render holds the raw means, not the blurred colour"
+else fail "the partial of a --blur render holds the raw means" "$(tr '\n' ' ' <"$scratch/diff.txt")"; fi
+# Resumed with the same options it gives the uninterrupted blurred PNG, but for 8-bit
+# rounding (the colours before the blur agree within 1e-5; one level is 1/255).
+# shellcheck disable=SC2086
+"$program" render $scene -o "$scratch/blur-reference.png" $options --blur 2 --quiet
+# shellcheck disable=SC2086
+if "$program" render $scene -o "$scratch/blur.png" $options --blur 2 --resume "$scratch/blur.partial.exr" --quiet &&
+   "$program" diff "$scratch/blur.png" "$scratch/blur-reference.png" --fail 0.004 --failpercent 0 >"$scratch/diff.txt"; then
+    pass "a resumed --blur render to a PNG equals the uninterrupted one"
+else fail "a resumed --blur render to a PNG equals the uninterrupted one" "$(tr '\n' ' ' <"$scratch/diff.txt")"; fi
+
 # A partial of another render is refused: different seed, different size.
 code=$(interrupt_running INT "$scratch/other.exr")
 # shellcheck disable=SC2086
@@ -96,8 +120,8 @@ if [ "$code" = 2 ]; then pass "resume refuses another size"
 else fail "resume refuses another size" "exit $code: $(cat "$scratch/err")"; fi
 
 # --checkpoint writes the partial while the render runs. A render that cannot finish
-# before it is killed (with $options it took about 0.9 s, and it once finished and removed
-# its partial between the file's appearance and the checks below).
+# before it is killed (one with $options once finished and removed its partial between
+# the file's appearance and the checks below; docs/performance.md has its time).
 "$program" render $scene -o "$scratch/cp.exr" --size 48x27 --spp 1000000 --seed 3 --checkpoint 0.3 --quiet &
 pid=$!
 if wait_for_file "$scratch/cp.partial.exr" && kill -0 "$pid" 2>/dev/null &&

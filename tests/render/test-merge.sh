@@ -5,11 +5,8 @@
 #   usage: sh tests/render/test-merge.sh PROGRAM SCRATCH_DIR
 . "$(dirname "$0")/lib.sh"
 
-scene=scenes/materials/metal.txt
-size="--size 48x27"
-# What every render of the test scene gets (render in lib.sh): the test size, 16 spp.
-render_options="$size --spp 16"
-full=$scratch/full.exr
+# The test scene and its whole render $full (lib.sh); nothing to compare without it.
+render_split_scene || { finish; exit; }
 
 # merge_ok NAME EXPECTED TOLERANCE PARTS...: merges PARTS into $scratch/NAME.exr and
 # compares the result with EXPECTED by `diff --fail TOLERANCE --failpercent 0`; also
@@ -38,12 +35,6 @@ refuse() {
     expect_refusal "$refuse_name" "$refuse_pattern" "$scratch/refused" \
         "$program" merge "$@" -o "$scratch/refused/out.exr"
 }
-
-if ! render "$full"; then
-    fail "full render" "rtspheres render failed"
-    finish
-    exit
-fi
 
 # (a) Two sample-range parts, 0:6 and 6:10: the same samples as the full render, summed in
 # another order, so equal within float rounding.

@@ -1,9 +1,9 @@
 #!/bin/sh
 # test-placed-lights.sh: emitters of placed objects (shapes in a group with a transform,
 # meshes placed by groups and instances) are lights like world ones: the packer bakes
-# such a placement into the world (core/pack_collect.c, instance_bakes), so light
-# sampling and the Whitted integrator see them. Spheres under a rotation or a non-uniform
-# scale stay instanced (found by BSDF sampling only): checked too.
+# such a placement into the world (core/pack_collect.c, placement_of), so light
+# sampling and the Whitted integrator see them. Spheres under a non-uniform scale stay
+# instanced (found by BSDF sampling only): checked too.
 #   usage: sh tests/render/test-placed-lights.sh PROGRAM SCRATCH_DIR
 . "$(dirname "$0")/lib.sh"
 
@@ -69,22 +69,26 @@ else
     fail "placed mesh light" "render failed"
 fi
 
-# An emissive sphere in a turned group stays an instance (no light); moved and scaled
-# uniformly it is baked: a light of twice the radius.
+# An emissive sphere in a group stretched along y stays an instance (no light); turned
+# or not, and scaled uniformly, it is baked: a light of twice the radius.
 cat >"$scratch/sphere-light.txt" <<SCENE
 set turn 30
+set stretch 2
 render size 16 9 spp 4 depth 4
 camera from 0 1 6 at 0 1 0 up 0 1 0 fov 40
 material glow emissive 1 1 1 strength 2
 group {
     rotate 0 1 0 \$turn
-    scale 2 2 2
+    scale 2 \$stretch 2
     sphere 0 0.5 0 0.25 glow
 }
 SCENE
+counts=$(lights_and_instances "$scratch/sphere-light.txt" -D stretch=3)
+if [ "$counts" = "1 instances, 0 lights" ]; then pass "a stretched emissive sphere stays instanced ($counts)"
+else fail "a stretched emissive sphere stays instanced" "got '$counts'"; fi
 counts=$(lights_and_instances "$scratch/sphere-light.txt")
-if [ "$counts" = "1 instances, 0 lights" ]; then pass "a turned emissive sphere stays instanced ($counts)"
-else fail "a turned emissive sphere stays instanced" "got '$counts'"; fi
+if [ "$counts" = "0 instances, 1 lights" ]; then pass "a turned, uniformly scaled emissive sphere is a light ($counts)"
+else fail "a turned, uniformly scaled emissive sphere is a light" "got '$counts'"; fi
 counts=$(lights_and_instances "$scratch/sphere-light.txt" -D turn=0)
 if [ "$counts" = "0 instances, 1 lights" ]; then pass "a uniformly scaled emissive sphere is a light ($counts)"
 else fail "a uniformly scaled emissive sphere is a light" "got '$counts'"; fi

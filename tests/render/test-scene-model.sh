@@ -63,13 +63,29 @@ instance unit {
 
 # A mesh placed twice by instances renders the same as the same triangles written out
 # twice (the second already moved): instancing changes the cost, not the image.
-cat >"$scratch/instanced.txt" <<'SCENE'
+# two_octahedra_scene: the scene both are placed in.
+two_octahedra_scene() {
+    cat <<'SCENE'
 render size 64 48 spp 16 depth 8 seed 2
 camera from 0 1 6 at 0 0 0 up 0 1 0 fov 40
 sky gradient 1 1 1  0.5 0.7 1
 material red lambertian 0.8 0.3 0.2
 material ground lambertian 0.5 0.5 0.5
 sphere 0 -1001 0 1000 ground
+SCENE
+}
+# octahedron_copy DX: a group of octahedron.obj's triangles written out one by one
+# (material red), moved DX in x.
+octahedron_copy() {
+    echo "group {"
+    echo "    translate $1 0 0"
+    awk '$1 == "v" { v[++n] = $2 " " $3 " " $4 }
+         $1 == "f" { print "    triangle " v[$2] "  " v[$3] "  " v[$4] "  red" }' "$scratch/octahedron.obj"
+    echo "}"
+}
+{
+    two_octahedra_scene
+    cat <<'SCENE'
 group left {
     translate -1.2 0 0
     mesh "octahedron.obj" red
@@ -78,36 +94,12 @@ instance left {
     translate 2.4 0 0
 }
 SCENE
-cat >"$scratch/copies.txt" <<'SCENE'
-render size 64 48 spp 16 depth 8 seed 2
-camera from 0 1 6 at 0 0 0 up 0 1 0 fov 40
-sky gradient 1 1 1  0.5 0.7 1
-material red lambertian 0.8 0.3 0.2
-material ground lambertian 0.5 0.5 0.5
-sphere 0 -1001 0 1000 ground
-group {
-    translate -1.2 0 0
-    triangle 1 0 0  0 1 0  0 0 1  red
-    triangle 0 1 0  -1 0 0  0 0 1  red
-    triangle -1 0 0  0 -1 0  0 0 1  red
-    triangle 0 -1 0  1 0 0  0 0 1  red
-    triangle 0 1 0  1 0 0  0 0 -1  red
-    triangle -1 0 0  0 1 0  0 0 -1  red
-    triangle 0 -1 0  -1 0 0  0 0 -1  red
-    triangle 1 0 0  0 -1 0  0 0 -1  red
-}
-group {
-    translate 1.2 0 0
-    triangle 1 0 0  0 1 0  0 0 1  red
-    triangle 0 1 0  -1 0 0  0 0 1  red
-    triangle -1 0 0  0 -1 0  0 0 1  red
-    triangle 0 -1 0  1 0 0  0 0 1  red
-    triangle 0 1 0  1 0 0  0 0 -1  red
-    triangle -1 0 0  0 1 0  0 0 -1  red
-    triangle 0 -1 0  -1 0 0  0 0 -1  red
-    triangle 1 0 0  0 -1 0  0 0 -1  red
-}
-SCENE
+} >"$scratch/instanced.txt"
+{
+    two_octahedra_scene
+    octahedron_copy -1.2
+    octahedron_copy 1.2
+} >"$scratch/copies.txt"
 if "$program" render "$scratch/instanced.txt" -o "$scratch/instanced.exr" --quiet &&
    "$program" render "$scratch/copies.txt" -o "$scratch/copies.exr" --quiet; then
     if "$program" diff "$scratch/instanced.exr" "$scratch/copies.exr" --fail 0 --failpercent 0 >"$scratch/d.txt"; then

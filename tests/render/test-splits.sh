@@ -7,11 +7,8 @@
 #   usage: sh tests/render/test-splits.sh PROGRAM SCRATCH_DIR
 . "$(dirname "$0")/lib.sh"
 
-scene=scenes/materials/metal.txt
-size="--size 48x27"
-# What every render of the test scene gets (render in lib.sh): the test size, 16 spp.
-render_options="$size --spp 16"
-full=$scratch/full.exr
+# The test scene and its whole render $full (lib.sh); nothing to compare without it.
+render_split_scene || { finish; exit; }
 
 # merged_equals NAME TOLERANCE PARTS...: merges PARTS (into $scratch/merged.exr) and compares the result with the
 # full render by `diff --fail TOLERANCE --failpercent 0`; every pixel must have 16 samples.
@@ -32,12 +29,6 @@ usage_error() {
     expect_refusal "$usage_name" "$usage_pattern" "$scratch/refused" \
         "$program" render "$scene" $render_options --quiet "$@"
 }
-
-if ! render "$full"; then
-    fail "full render" "rtspheres render failed"
-    finish
-    exit
-fi
 
 # (a) Crops. Three crops that tile the image (uneven, and meeting inside rows and columns)
 # merge by their data windows into exactly the full render.

@@ -7,9 +7,11 @@
  *   assert_relative(actual, expected, relative)    doubles within a fraction of expected
  *   assert_contains(haystack, needle)              a string holds a fixed substring
  *   make_image(width, height, channels, value)     an image with every sample = value
+ *   assert_merge_metadata_equal(actual, expected)  every field of two merge_metadata
  *   splitmix64_next(&state)                        reproducible 64-bit test data
  *   scratch: make_scratch / remove_scratch (a cmocka setup/teardown pair), in_scratch,
  *            write_file, scratch_write             a fresh directory per test
+ *   scratch_test(test)                             a test table entry with that pair
  *
  * The assertions fail the running test at the caller's file and line, as cmocka's own
  * assert_* do; the value printed is the expression as written in the test. */
@@ -33,6 +35,7 @@
 #include <sys/stat.h>
 
 #include "image_io.h"
+#include "merge.h"
 
 /* ---- float assertions -------------------------------------------------------------------- */
 
@@ -85,6 +88,28 @@ static inline rt_image make_image(int width, int height, int channels, float val
         image.pixels[i] = value;
     return image;
 }
+
+/* ---- merge metadata ---------------------------------------------------------------------- */
+
+/* Fails the test at file:line unless every field of *actual equals *expected's (the
+ * numbers exactly: they went through a file as text or as exact floats). */
+static inline void support_check_merge_metadata(const merge_metadata *actual, const merge_metadata *expected,
+                                                const char *file, int line)
+{
+    _assert_string_equal(actual->scene, expected->scene, file, line);
+    _assert_string_equal(actual->scene_hash, expected->scene_hash, file, line);
+    _assert_true(actual->seed == expected->seed, "seed", file, line);
+    _assert_int_equal(actual->max_depth, expected->max_depth, file, line);
+    _assert_int_equal(actual->frame, expected->frame, file, line);
+    _assert_true(actual->sample_start == expected->sample_start, "sample_start", file, line);
+    _assert_int_equal(actual->spp, expected->spp, file, line);
+    _assert_int_equal(actual->complete, expected->complete, file, line);
+    _assert_true(actual->render_seconds == expected->render_seconds, "render_seconds", file, line);
+    _assert_true(actual->path_segments == expected->path_segments, "path_segments", file, line);
+}
+
+#define assert_merge_metadata_equal(actual, expected) \
+    support_check_merge_metadata((actual), (expected), __FILE__, __LINE__)
 
 /* ---- random test data -------------------------------------------------------------------- */
 
@@ -140,6 +165,9 @@ static inline int remove_scratch(void **state)
     free(s);
     return result == 0 ? 0 : -1;
 }
+
+/* An entry of a cmocka test table: test, run in a scratch directory of its own. */
+#define scratch_test(test) cmocka_unit_test_setup_teardown(test, make_scratch, remove_scratch)
 
 /* Returns directory/name in the scratch's path buffer (overwritten by the next call). */
 static inline const char *in_scratch(scratch *s, const char *name)

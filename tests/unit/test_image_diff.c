@@ -20,6 +20,33 @@ static float *sample(rt_image *image, int x, int y, int c)
     return &image->pixels[(y * image->width + x) * image->channels + c];
 }
 
+/* Compares a with b under options (NULL: the defaults), failing the test unless image_diff()
+ * succeeds; returns the result. */
+static image_diff_result diff_ok(const rt_image *a, const rt_image *b, const image_diff_options *options)
+{
+    image_diff_result result;
+    rt_error error;
+    assert_int_equal(image_diff(a, b, options, &result, NULL, &error), RT_OK);
+    return result;
+}
+
+/* diff_ok() that also makes the difference image into *difference (the caller frees it). */
+static image_diff_result diff_ok_with_image(const rt_image *a, const rt_image *b,
+                                            const image_diff_options *options, rt_image *difference)
+{
+    image_diff_result result;
+    rt_error error;
+    assert_int_equal(image_diff(a, b, options, &result, difference, &error), RT_OK);
+    return result;
+}
+
+/* Frees both images of a comparison. */
+static void free_pair(rt_image *a, rt_image *b)
+{
+    image_free(a);
+    image_free(b);
+}
+
 /* A: 2x2 RGB, all 0. B: (1,0) = (0.5, 0.25, 0), (0,1) = (0, 0, 0.125), the rest 0.
  * 12 samples; |d| sums to 0.875, d^2 to 0.25 + 0.0625 + 0.015625 = 0.328125. */
 static void make_pair(rt_image *a, rt_image *b)
@@ -36,9 +63,7 @@ static void test_metrics(void **state)
     (void)state;
     rt_image a, b;
     make_pair(&a, &b);
-    image_diff_result result;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, NULL);
     assert_close(result.mean_error, 0.875 / 12, CLOSE);
     assert_close(result.rms_error, sqrt(0.328125 / 12), CLOSE);
     assert_close(result.psnr, 10 * log10(12 / 0.328125), CLOSE);  /* 15.6315 dB */
@@ -49,8 +74,7 @@ static void test_metrics(void **state)
     assert_int_equal(result.failing_pixels, 2);
     assert_close(result.failing_percent, 50.0, CLOSE);
     assert_false(result.passed);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 static void test_metrics_are_symmetric(void **state)
@@ -58,22 +82,16 @@ static void test_metrics_are_symmetric(void **state)
     (void)state;
     rt_image a, b;
     make_pair(&a, &b);
-    image_diff_result forward, backward;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &forward, NULL, &error), RT_OK);
-    assert_int_equal(image_diff(&b, &a, NULL, &backward, NULL, &error), RT_OK);
+    image_diff_result forward = diff_ok(&a, &b, NULL), backward = diff_ok(&b, &a, NULL);
     assert_memory_equal(&forward, &backward, sizeof forward);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 static void test_identical_images(void **state)
 {
     (void)state;
     rt_image a = make_image(3, 2, 4, 0.75f), b = make_image(3, 2, 4, 0.75f);
-    image_diff_result result;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, NULL);
     assert_close(result.mean_error, 0, 0);
     assert_close(result.rms_error, 0, 0);
     assert_true(isinf(result.psnr) && result.psnr > 0);
@@ -82,8 +100,7 @@ static void test_identical_images(void **state)
     assert_int_equal(result.max_y, 0);
     assert_int_equal(result.failing_pixels, 0);
     assert_true(result.passed);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* The first pixel in row order with the largest error is reported. */
@@ -94,14 +111,11 @@ static void test_max_location_first_of_ties(void **state)
     *sample(&b, 0, 2, 1) = 0.25f;
     *sample(&b, 2, 1, 2) = 0.25f;
     *sample(&b, 1, 0, 0) = 0.125f;
-    image_diff_result result;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, NULL);
     assert_close(result.max_error, 0.25, 0);
     assert_int_equal(result.max_x, 2);
     assert_int_equal(result.max_y, 1);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* A pixel fails when its error is strictly over the threshold. */
@@ -113,22 +127,20 @@ static void test_threshold_boundary(void **state)
     image_diff_options options = image_diff_options_defaults();
     options.fail_percent = 100;
     image_diff_result result;
-    rt_error error;
 
     options.fail_threshold = 0.125;  /* only the 0.5 pixel is over */
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, &options);
     assert_int_equal(result.failing_pixels, 1);
     assert_close(result.failing_percent, 25.0, CLOSE);
 
     options.fail_threshold = 0.124;
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, &options);
     assert_int_equal(result.failing_pixels, 2);
 
     options.fail_threshold = 0.5;
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, &options);
     assert_int_equal(result.failing_pixels, 0);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* The comparison passes when the failing share is at most fail_percent. */
@@ -140,17 +152,15 @@ static void test_fail_percent_boundary(void **state)
     image_diff_options options = image_diff_options_defaults();
     options.fail_threshold = 0.125;  /* 1 of 4 pixels fails: 25% */
     image_diff_result result;
-    rt_error error;
 
     options.fail_percent = 25;
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, &options);
     assert_true(result.passed);
 
     options.fail_percent = 24.99;
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, &options);
     assert_false(result.passed);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* The defaults: 0.016 and 1%. 100 pixels; 0.015625 (2^-6) is under 0.016, 0.02 over. */
@@ -161,19 +171,16 @@ static void test_default_tolerance(void **state)
     for (int x = 0; x < 10; x++)
         *sample(&b, x, 4, 1) = 0.5f + 0.015625f;
     *sample(&b, 7, 7, 0) = 0.52f;
-    image_diff_result result;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, NULL);
     assert_int_equal(result.failing_pixels, 1);
     assert_close(result.failing_percent, 1.0, CLOSE);
     assert_true(result.passed);  /* exactly 1% is allowed */
 
     *sample(&b, 8, 8, 2) = 0.48f;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, NULL);
     assert_int_equal(result.failing_pixels, 2);
     assert_false(result.passed);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* hard_fail fails the comparison when any pixel's error is strictly over it, whatever
@@ -185,21 +192,18 @@ static void test_hard_fail(void **state)
     make_pair(&a, &b);
     image_diff_options options = image_diff_options_defaults();
     options.fail_percent = 100;
-    image_diff_result result;
-    rt_error error;
 
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, &options);
     assert_true(result.passed);
 
     options.hard_fail = 0.5;
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, &options);
     assert_true(result.passed);
 
     options.hard_fail = 0.49;
-    assert_int_equal(image_diff(&a, &b, &options, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, &options);
     assert_false(result.passed);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 static void test_size_mismatch(void **state)
@@ -210,8 +214,7 @@ static void test_size_mismatch(void **state)
     rt_error error = {{0}};
     assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_ERROR_INPUT);
     assert_non_null(strstr(error.message, "sizes differ: 160x90 vs 80x45"));
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 static void test_nan_is_an_error_naming_image_and_pixel(void **state)
@@ -234,8 +237,7 @@ static void test_nan_is_an_error_naming_image_and_pixel(void **state)
     assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_ERROR_INPUT);
     assert_non_null(strstr(error.message, "image A"));
     assert_non_null(strstr(error.message, "(3, 2)"));
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* Equal infinities do not differ; an infinity against a number is an infinite error. */
@@ -244,21 +246,18 @@ static void test_infinities(void **state)
     (void)state;
     rt_image a = make_image(2, 1, 3, 0.0f), b = make_image(2, 1, 3, 0.0f);
     *sample(&a, 0, 0, 0) = *sample(&b, 0, 0, 0) = INFINITY;
-    image_diff_result result;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, NULL);
     assert_true(result.passed);
     assert_close(result.max_error, 0, 0);
     assert_close(result.mean_error, 0, 0);  /* not inf - inf = NaN */
     assert_close(result.rms_error, 0, 0);
 
     *sample(&b, 1, 0, 2) = INFINITY;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, NULL);
     assert_false(result.passed);
     assert_true(isinf(result.max_error));
     assert_int_equal(result.max_x, 1);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* +inf against -inf is an infinite error like any other, each counted once per pixel
@@ -273,10 +272,8 @@ static void test_infinities_of_both_signs(void **state)
     *sample(&b, 2, 0, 2) = INFINITY;
     image_diff_options options = image_diff_options_defaults();
     options.fail_percent = 100;
-    image_diff_result result;
     rt_image difference;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, &options, &result, &difference, &error), RT_OK);
+    image_diff_result result = diff_ok_with_image(&a, &b, &options, &difference);
     assert_true(isinf(result.max_error) && isinf(result.mean_error) && isinf(result.rms_error));
     assert_int_equal(result.max_x, 1);
     assert_int_equal(result.failing_pixels, 2);
@@ -286,8 +283,7 @@ static void test_infinities_of_both_signs(void **state)
     assert_true(isinf(*sample(&difference, 2, 0, 2)));
     assert_close(*sample(&difference, 2, 0, 0), 0, 0);
     image_free(&difference);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* Large images: the sums stay exact enough (OIIO sums in batches of pixels); 640x360,
@@ -300,9 +296,7 @@ static void test_large_image(void **state)
         for (int x = 0; x < 640; x++)
             *sample(&b, x, y, 1) = 0.25f + 1.0f / 256;
     *sample(&b, 600, 300, 0) = 1.0f;
-    image_diff_result result;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, NULL);
     double samples = 640.0 * 360 * 3;
     assert_close(result.mean_error, (640.0 * 360 / 256 + 0.75) / samples, 1e-15);
     assert_close(result.rms_error, sqrt((640.0 * 360 / 65536 + 0.5625) / samples), 1e-15);
@@ -310,8 +304,7 @@ static void test_large_image(void **state)
     assert_int_equal(result.max_x, 600);
     assert_int_equal(result.max_y, 300);
     assert_int_equal(result.failing_pixels, 1);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* Only the first three channels count: alpha and extra channels may differ freely, and
@@ -322,13 +315,10 @@ static void test_compares_at_most_three_channels(void **state)
     rt_image a = make_image(2, 2, 5, 0.25f), b = make_image(2, 2, 3, 0.25f);
     *sample(&a, 1, 1, 3) = 1.0f;
     *sample(&a, 0, 1, 4) = -7.0f;
-    image_diff_result result;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    image_diff_result result = diff_ok(&a, &b, NULL);
     assert_close(result.max_error, 0, 0);
     assert_true(result.passed);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 
     /* Both RGBA, alpha wholly different. */
     a = make_image(2, 2, 4, 0.25f);
@@ -336,12 +326,11 @@ static void test_compares_at_most_three_channels(void **state)
     for (int y = 0; y < 2; y++)
         for (int x = 0; x < 2; x++)
             *sample(&b, x, y, 3) = 1.0f;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, NULL, &error), RT_OK);
+    result = diff_ok(&a, &b, NULL);
     assert_close(result.max_error, 0, 0);
     assert_close(result.mean_error, 0, 0);
     assert_true(result.passed);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* A grey image against RGB compares just the one channel: the 0.5 in B's green is not
@@ -352,10 +341,8 @@ static void test_single_channel_against_rgb(void **state)
     rt_image a = make_image(2, 2, 1, 0.0f), b = make_image(2, 2, 3, 0.0f);
     *sample(&b, 1, 1, 0) = 0.25f;
     *sample(&b, 0, 0, 1) = 0.5f;
-    image_diff_result result;
     rt_image difference;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, &difference, &error), RT_OK);
+    image_diff_result result = diff_ok_with_image(&a, &b, NULL, &difference);
     assert_close(result.mean_error, 0.25 / 4, CLOSE);
     assert_close(result.max_error, 0.25, 0);
     assert_int_equal(result.max_x, 1);
@@ -367,8 +354,7 @@ static void test_single_channel_against_rgb(void **state)
         assert_close(*sample(&difference, 0, 0, c), 0.0, 0);
     }
     image_free(&difference);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 static void test_difference_image(void **state)
@@ -378,12 +364,10 @@ static void test_difference_image(void **state)
     make_pair(&a, &b);
     *sample(&a, 0, 0, 1) = 0.75f;
     *sample(&b, 0, 0, 1) = 0.625f;  /* |d| = 0.125, sign must not matter */
-    image_diff_result result;
     rt_image difference;
-    rt_error error;
 
     /* Default scale 16. */
-    assert_int_equal(image_diff(&a, &b, NULL, &result, &difference, &error), RT_OK);
+    diff_ok_with_image(&a, &b, NULL, &difference);
     assert_int_equal(difference.width, 2);
     assert_int_equal(difference.height, 2);
     assert_int_equal(difference.channels, 3);
@@ -399,12 +383,11 @@ static void test_difference_image(void **state)
 
     image_diff_options options = image_diff_options_defaults();
     options.diff_scale = 2;
-    assert_int_equal(image_diff(&a, &b, &options, &result, &difference, &error), RT_OK);
+    diff_ok_with_image(&a, &b, &options, &difference);
     assert_close(*sample(&difference, 1, 0, 0), 1.0, 0);
     assert_close(*sample(&difference, 0, 1, 2), 0.25, 0);
     image_free(&difference);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 /* The difference image is the size of the inputs and RGB even when they have alpha. */
@@ -414,16 +397,13 @@ static void test_difference_image_from_rgba(void **state)
     rt_image a = make_image(3, 1, 4, 0.5f), b = make_image(3, 1, 4, 0.5f);
     *sample(&b, 2, 0, 3) = 0.0f;
     *sample(&b, 2, 0, 2) = 0.25f;
-    image_diff_result result;
     rt_image difference;
-    rt_error error;
-    assert_int_equal(image_diff(&a, &b, NULL, &result, &difference, &error), RT_OK);
+    diff_ok_with_image(&a, &b, NULL, &difference);
     assert_int_equal(difference.channels, 3);
     assert_close(*sample(&difference, 2, 0, 2), 4.0, 0);
     assert_close(*sample(&difference, 2, 0, 0), 0.0, 0);
     image_free(&difference);
-    image_free(&a);
-    image_free(&b);
+    free_pair(&a, &b);
 }
 
 static void test_defaults_are_zero(void **state)

@@ -79,14 +79,6 @@ static unsigned char *read_file(const char *path, size_t *size)
     return bytes;
 }
 
-static void write_text_file(const char *path, const void *bytes, size_t size)
-{
-    FILE *file = fopen(path, "wb");
-    assert_non_null(file);
-    assert_int_equal(fwrite(bytes, 1, size, file), size);
-    assert_int_equal(fclose(file), 0);
-}
-
 /* Makes an image of pseudo-random values in [0, 1) that no compressor can shrink much. */
 static rt_image noise_image(int width, int height, int channels)
 {
@@ -108,6 +100,19 @@ static void write_ok(const char *path, const rt_image *image, const image_write_
     if (status != RT_OK)
         print_error("image_write: %s\n", error.message);
     assert_int_equal(status, RT_OK);
+}
+
+/* Reads path with image_read(), failing the test (with the message) unless it succeeds;
+ * the caller frees the image. */
+static rt_image read_ok(const char *path)
+{
+    rt_image image;
+    rt_error error = {{0}};
+    rt_status status = image_read(path, &image, &error);
+    if (status != RT_OK)
+        print_error("image_read: %s\n", error.message);
+    assert_int_equal(status, RT_OK);
+    return image;
 }
 
 static void test_create_and_free(void **state)
@@ -195,8 +200,7 @@ static void test_exr_round_trip_exact(void **state)
     memcpy(image.pixels, values, sizeof values);
     write_ok(in_scratch(s, "exact.exr"), &image, NULL);
 
-    rt_image back;
-    assert_int_equal(image_read(in_scratch(s, "exact.exr"), &back, &error), RT_OK);
+    rt_image back = read_ok(in_scratch(s, "exact.exr"));
     assert_int_equal(back.width, 3);
     assert_int_equal(back.height, 2);
     assert_int_equal(back.channels, 4);
@@ -235,9 +239,8 @@ static void test_exr_channel_names_and_attributes(void **state)
     options.attribute_count = 5;
     write_ok(in_scratch(s, "layers.exr"), &image, &options);
 
-    rt_image back;
     rt_error error = {{0}};
-    assert_int_equal(image_read(in_scratch(s, "layers.exr"), &back, &error), RT_OK);
+    rt_image back = read_ok(in_scratch(s, "layers.exr"));
     assert_int_equal(back.channels, 6);
     for (int c = 0; c < 6; c++)
         assert_string_equal(back.channel_names[c], names[c]);
@@ -309,8 +312,7 @@ static void test_png_exposure_clamp_srgb(void **state)
     options.exposure = 1.0f;
     write_ok(in_scratch(s, "exposed.png"), &image, &options);
 
-    rt_image back;
-    assert_int_equal(image_read(in_scratch(s, "exposed.png"), &back, &error), RT_OK);
+    rt_image back = read_ok(in_scratch(s, "exposed.png"));
     assert_int_equal(back.width, 3);
     assert_int_equal(back.height, 2);
     assert_int_equal(back.channels, 4);
@@ -355,14 +357,13 @@ static void test_eight_bit_default_and_negative_exposure(void **state)
     options.exposure = -1.0f;
     write_ok(in_scratch(s, "dark.png"), &image, &options);
 
-    rt_image back;
-    assert_int_equal(image_read(in_scratch(s, "plain.tif"), &back, &error), RT_OK);
+    rt_image back = read_ok(in_scratch(s, "plain.tif"));
     assert_int_equal(back.channels, 3);
     assert_true(fabs(back.pixels[0] * 255 - 188) < 0.5);  /* sRGB(0.5) */
     assert_true(fabs(back.pixels[1] * 255 - 255) < 0.5);
     assert_true(fabs(back.pixels[2] * 255 - 0) < 0.5);
     image_free(&back);
-    assert_int_equal(image_read(in_scratch(s, "dark.png"), &back, &error), RT_OK);
+    back = read_ok(in_scratch(s, "dark.png"));
     assert_true(fabs(back.pixels[0] * 255 - 137) < 0.5);  /* sRGB(0.25) = 0.5371 */
     assert_true(fabs(back.pixels[1] * 255 - 188) < 0.5);  /* sRGB(0.5) */
     image_free(&back);
@@ -386,15 +387,14 @@ static void test_jpeg_and_hdr(void **state)
     write_ok(in_scratch(s, "flat.jpeg"), &image, NULL);
     write_ok(in_scratch(s, "flat.hdr"), &image, NULL);
 
-    rt_image back;
-    assert_int_equal(image_read(in_scratch(s, "flat.jpg"), &back, &error), RT_OK);
+    rt_image back = read_ok(in_scratch(s, "flat.jpg"));
     assert_int_equal(back.channels, 3);
     assert_true(fabs(back.pixels[0] - srgb(0.5)) < 3.0 / 255);
     assert_true(fabs(back.pixels[1] - srgb(0.25)) < 3.0 / 255);
     assert_true(fabs(back.pixels[2] - 1.0) < 3.0 / 255);
     image_free(&back);
 
-    assert_int_equal(image_read(in_scratch(s, "flat.hdr"), &back, &error), RT_OK);
+    back = read_ok(in_scratch(s, "flat.hdr"));
     assert_int_equal(back.channels, 3);
     assert_true(fabs(back.pixels[0] - 0.5) < 0.01);
     assert_true(fabs(back.pixels[1] - 0.25) < 0.01);
@@ -434,9 +434,7 @@ static void test_extension_case(void **state)
     scratch *s = *state;
     rt_image image = noise_image(2, 2, 3);
     write_ok(in_scratch(s, "upper.EXR"), &image, NULL);
-    rt_image back;
-    rt_error error;
-    assert_int_equal(image_read(in_scratch(s, "upper.EXR"), &back, &error), RT_OK);
+    rt_image back = read_ok(in_scratch(s, "upper.EXR"));
     assert_memory_equal(back.pixels, image.pixels, sizeof(float) * 12);
     image_free(&back);
     image_free(&image);
@@ -456,7 +454,7 @@ static void test_unwritable_directory(void **state)
     assert_contains(error.message, "IMAGE: cannot write '");
     assert_contains(error.message, path);
 
-    write_text_file(in_scratch(s, "plain-file"), "x", 1);
+    scratch_write(s, "plain-file", "x", 1);
     snprintf(path, sizeof path, "%s/plain-file/out.exr", s->directory);
     assert_int_equal(image_write(path, &image, NULL, &error), RT_ERROR_RUNTIME);
     assert_contains(error.message, path);
@@ -472,9 +470,7 @@ static void test_overwrite(void **state)
     rt_image big = noise_image(16, 16, 4), small = noise_image(2, 1, 3);
     write_ok(in_scratch(s, "over.exr"), &big, NULL);
     write_ok(in_scratch(s, "over.exr"), &small, NULL);
-    rt_image back;
-    rt_error error;
-    assert_int_equal(image_read(in_scratch(s, "over.exr"), &back, &error), RT_OK);
+    rt_image back = read_ok(in_scratch(s, "over.exr"));
     assert_int_equal(back.width, 2);
     assert_int_equal(back.channels, 3);
     assert_memory_equal(back.pixels, small.pixels, sizeof(float) * 6);
@@ -610,7 +606,7 @@ static void test_read_missing_file(void **state)
 static void test_read_empty_file(void **state)
 {
     scratch *s = *state;
-    write_text_file(in_scratch(s, "empty.png"), "", 0);
+    scratch_write(s, "empty.png", "", 0);
     check_read_fails(in_scratch(s, "empty.png"));
 }
 
@@ -618,7 +614,7 @@ static void test_read_text_named_png(void **state)
 {
     scratch *s = *state;
     const char text[] = "this is not a PNG file, just some text\n";
-    write_text_file(in_scratch(s, "text.png"), text, sizeof text - 1);
+    scratch_write(s, "text.png", text, sizeof text - 1);
     check_read_fails(in_scratch(s, "text.png"));
 }
 
@@ -631,7 +627,7 @@ static void test_read_truncated_png(void **state)
     size_t size;
     unsigned char *bytes = read_file(in_scratch(s, "whole.png"), &size);
     assert_true(size > 1000);
-    write_text_file(in_scratch(s, "truncated.png"), bytes, size / 2);
+    scratch_write(s, "truncated.png", bytes, size / 2);
     check_read_fails(in_scratch(s, "truncated.png"));
     free(bytes);
     image_free(&image);
@@ -644,7 +640,7 @@ static void test_read_truncated_exr(void **state)
     write_ok(in_scratch(s, "whole.exr"), &image, NULL);
     size_t size;
     unsigned char *bytes = read_file(in_scratch(s, "whole.exr"), &size);
-    write_text_file(in_scratch(s, "truncated.exr"), bytes, size / 2);
+    scratch_write(s, "truncated.exr", bytes, size / 2);
     check_read_fails(in_scratch(s, "truncated.exr"));
     free(bytes);
     image_free(&image);
@@ -661,32 +657,26 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_create_and_free),
         cmocka_unit_test(test_append_channels),
-        cmocka_unit_test_setup_teardown(test_exr_round_trip_exact, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_exr_channel_names_and_attributes, make_scratch,
-                                        remove_scratch),
-        cmocka_unit_test_setup_teardown(test_png_exposure_clamp_srgb, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_eight_bit_default_and_negative_exposure, make_scratch,
-                                        remove_scratch),
-        cmocka_unit_test_setup_teardown(test_jpeg_and_hdr, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_unknown_extension, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_extension_case, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_unwritable_directory, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_overwrite, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_file_mode_follows_umask, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_invalid_image_keeps_existing_file, make_scratch,
-                                        remove_scratch),
-        cmocka_unit_test_setup_teardown(test_format_refusal_keeps_existing_file, make_scratch,
-                                        remove_scratch),
-        cmocka_unit_test_setup_teardown(test_disk_write_failure_keeps_existing_file, make_scratch,
-                                        remove_scratch),
-        cmocka_unit_test_setup_teardown(test_disk_write_failure_keeps_existing_tiff, make_scratch,
-                                        remove_scratch),
-        cmocka_unit_test_setup_teardown(test_read_missing_file, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_read_empty_file, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_read_text_named_png, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_read_truncated_png, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_read_truncated_exr, make_scratch, remove_scratch),
-        cmocka_unit_test_setup_teardown(test_read_directory, make_scratch, remove_scratch),
+        scratch_test(test_exr_round_trip_exact),
+        scratch_test(test_exr_channel_names_and_attributes),
+        scratch_test(test_png_exposure_clamp_srgb),
+        scratch_test(test_eight_bit_default_and_negative_exposure),
+        scratch_test(test_jpeg_and_hdr),
+        scratch_test(test_unknown_extension),
+        scratch_test(test_extension_case),
+        scratch_test(test_unwritable_directory),
+        scratch_test(test_overwrite),
+        scratch_test(test_file_mode_follows_umask),
+        scratch_test(test_invalid_image_keeps_existing_file),
+        scratch_test(test_format_refusal_keeps_existing_file),
+        scratch_test(test_disk_write_failure_keeps_existing_file),
+        scratch_test(test_disk_write_failure_keeps_existing_tiff),
+        scratch_test(test_read_missing_file),
+        scratch_test(test_read_empty_file),
+        scratch_test(test_read_text_named_png),
+        scratch_test(test_read_truncated_png),
+        scratch_test(test_read_truncated_exr),
+        scratch_test(test_read_directory),
     };
     return cmocka_run_group_tests_name("image_io", tests, NULL, NULL);
 }

@@ -445,16 +445,11 @@ static void test_read_part(void **state)
     assert_int_equal(image.y, 2);
     assert_int_equal(image.height, 2);
     assert_int_equal(image.full_height, 6);
-    assert_string_equal(metadata.scene, "scenes/x.txt");
-    assert_string_equal(metadata.scene_hash, "0123456789abcdef");
-    assert_int_equal(metadata.spp, 12);
-    assert_true(metadata.sample_start == 4000000000ull);
-    assert_true(metadata.seed == 4294967295ull);
-    assert_int_equal(metadata.max_depth, 50);
-    assert_int_equal(metadata.frame, -1);
-    assert_false(metadata.complete);
-    assert_true(metadata.render_seconds == 2.5);
-    assert_true(metadata.path_segments == 123456);
+    assert_merge_metadata_equal(&metadata, (&(merge_metadata){
+                                               .scene = "scenes/x.txt", .scene_hash = "0123456789abcdef",
+                                               .spp = 12, .sample_start = 4000000000ull, .seed = 4294967295ull,
+                                               .max_depth = 50, .frame = -1, .complete = false,
+                                               .render_seconds = 2.5, .path_segments = 123456}));
     image_free(&image);
 
     /* Without metadata: refused, naming the file and what is missing. */
@@ -492,7 +487,7 @@ int main(void)
         cmocka_unit_test(test_missing_pieces_described),
         cmocka_unit_test(test_mismatched_parts),
         cmocka_unit_test(test_malformed_parts),
-        cmocka_unit_test_setup_teardown(test_read_part, make_scratch, remove_scratch),
+        scratch_test(test_read_part),
     };
     return cmocka_run_group_tests_name("merge", tests, NULL, NULL);
 }

@@ -264,9 +264,9 @@ static void empty_scene_packs_and_misses(void **state)
 
 /* ---- two-level scenes: instances, triangles, quads, moving spheres, a mesh ---------- */
 
-static void random_rotation_scale(float m[3][4])
+/* A rotation about a random axis, a scale (non-uniform unless uniform), a translation. */
+static void random_placement(float m[3][4], bool uniform)
 {
-    /* A rotation about a random axis, a non-uniform scale, a translation. */
     double axis[3] = {random_unit() - 0.5, random_unit() - 0.5, random_unit() - 0.5};
     double length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
     for (int i = 0; i < 3; i++)
@@ -278,11 +278,18 @@ static void random_rotation_scale(float m[3][4])
         {axis[2] * axis[0] * k - axis[1] * s, axis[2] * axis[1] * k + axis[0] * s, c + axis[2] * axis[2] * k},
     };
     double scale[3] = {0.5 + random_unit(), 0.5 + random_unit(), 0.5 + random_unit()};
+    if (uniform)
+        scale[1] = scale[2] = scale[0];
     for (int row = 0; row < 3; row++) {
         for (int column = 0; column < 3; column++)
             m[row][column] = (float)(r[row][column] * scale[column]);
         m[row][3] = (float)(random_unit() * 16 - 8);
     }
+}
+
+static void random_rotation_scale(float m[3][4])
+{
+    random_placement(m, false);
 }
 
 /* Object-space hit of one scene shape, in double; direction need not be unit length. */
@@ -398,11 +405,13 @@ static scene_shape random_shape(int type)
     return shape;
 }
 
-static void instanced_scene(scene *s, uint64_t seed)
+/* similar: object 1's placements are similarities (its spheres can be baked), else
+ * stretched (they cannot). */
+static void instanced_scene_placed(scene *s, uint64_t seed, bool similar)
 {
     random_scene(s, 40, seed);
     /* Object 0: mixed shapes, placed with the identity (copied into the top level). */
-    /* Object 1: mixed shapes, placed three times with transforms. */
+    /* Object 1: mixed shapes, placed three times with transforms, the second glass. */
     /* Object 2: a mesh (a random triangle soup sharing vertices), placed twice. */
     for (int o = 0; o < 2; o++) {
         scene_object object = {.first_shape = s->shape_count, .mesh = -1};
@@ -429,7 +438,7 @@ static void instanced_scene(scene *s, uint64_t seed)
     assert_true(scene_add_instance(s, &identity) >= 0);
     for (int k = 0; k < 3; k++) {
         scene_instance placed = {.object = 1, .material = k % 2 ? 2 : -1};
-        random_rotation_scale(placed.object_to_world);
+        random_placement(placed.object_to_world, similar);
         assert_true(scene_add_instance(s, &placed) >= 0);
     }
     for (int k = 0; k < 2; k++) {
@@ -439,56 +448,83 @@ static void instanced_scene(scene *s, uint64_t seed)
     }
 }
 
+static void instanced_scene(scene *s, uint64_t seed)
+{
+    instanced_scene_placed(s, seed, false);
+}
+
+/* The packed traversal of one packed scene s finds the brute-force nearest hit (in
+ * double, every placed shape in its object's coordinates) for random rays. */
+static void traversal_matches_brute_force(const scene *s, const packed_scene *packed, uint64_t seed)
+{
+    int hits = 0, grazes = 0;
+    for (int r = 0; r < 3000; r++) {
+        double o[3], d[3], length = 0;
+        for (int i = 0; i < 3; i++) {
+            o[i] = random_unit() * 30 - 15;
+            d[i] = random_unit() * 2 - 1;
+            length += d[i] * d[i];
+        }
+        length = sqrt(length);
+        float of[3], df[3];
+        for (int i = 0; i < 3; i++) {
+            of[i] = (float)o[i];
+            df[i] = (float)(d[i] / length);
+            o[i] = of[i];
+            d[i] = df[i];
+        }
+        double time = random_unit();
+        double expected = brute_force(s, (float)time, o, d);
+        packed_hit hit;
+        bool found = packed_intersect_nearest(packed, of, df, (float)time, INFINITY, &hit);
+        if (expected == INFINITY) {
+            /* A miss by a hair in double may be a graze in float: rare, never more. */
+            if (found) {
+                assert_true(hit.t > 0);
+                grazes++;
+            }
+            continue;
+        }
+        hits++;
+        if (!found)
+            fail_msg("seed %llu ray %d: brute force hits at %g, packed traversal misses", (unsigned long long)seed, r,
+                     expected);
+        if (fabs(hit.t - expected) > 2e-4 * (1 + expected))
+            fail_msg("seed %llu ray %d: packed t %g, brute force %g", (unsigned long long)seed, r, hit.t, expected);
+    }
+    assert_true(hits > 300);
+    assert_true(grazes <= 3);   /* of 3000 rays */
+}
+
+/* Placements instanced or baked, the packed traversal agrees with brute force: every
+ * placement but the identity one instanced (keep_instances); the mesh's two placements
+ * baked and object 1 instanced (its spheres stretched); object 1 baked too (turned and
+ * scaled uniformly) but for its glass placement. */
 static void instanced_traversal_matches_brute_force(void **state)
 {
     (void)state;
-    for (uint64_t seed = 20; seed < 24; seed++) {
-        scene s;
-        instanced_scene(&s, seed);
-        packed_scene packed;
-        rt_error error;
-        assert_int_equal(pack_scene(&s, NULL, &packed, &error), RT_OK);
-        assert_int_equal(packed.instance_count, 5);     /* the identity placement is copied in */
-        assert_int_equal(packed.triangle_count, 6 + 6 + 40); /* 6 world + 6 object + mesh once */
-        int hits = 0, grazes = 0;
-        for (int r = 0; r < 3000; r++) {
-            double o[3], d[3], length = 0;
-            for (int i = 0; i < 3; i++) {
-                o[i] = random_unit() * 30 - 15;
-                d[i] = random_unit() * 2 - 1;
-                length += d[i] * d[i];
-            }
-            length = sqrt(length);
-            float of[3], df[3];
-            for (int i = 0; i < 3; i++) {
-                of[i] = (float)o[i];
-                df[i] = (float)(d[i] / length);
-                o[i] = of[i];
-                d[i] = df[i];
-            }
-            double time = random_unit();
-            double expected = brute_force(&s, (float)time, o, d);
-            packed_hit hit;
-            bool found = packed_intersect_nearest(&packed, of, df, (float)time, INFINITY, &hit);
-            if (expected == INFINITY) {
-                /* A miss by a hair in double may be a graze in float: rare, never more. */
-                if (found) {
-                    assert_true(hit.t > 0);
-                    grazes++;
-                }
-                continue;
-            }
-            hits++;
-            if (!found)
-                fail_msg("seed %llu ray %d: brute force hits at %g, packed traversal misses", (unsigned long long)seed,
-                         r, expected);
-            if (fabs(hit.t - expected) > 2e-4 * (1 + expected))
-                fail_msg("seed %llu ray %d: packed t %g, brute force %g", (unsigned long long)seed, r, hit.t, expected);
+    const struct {
+        bool similar, keep_instances;
+        uint32_t instances, triangles;
+    } modes[] = {
+        {false, true, 5, 6 + 6 + 40},              /* 6 world + 6 object + mesh once */
+        {false, false, 3, 6 + 6 + 2 * 40},         /* the mesh twice in the world */
+        {true, false, 1, 6 + 2 * 6 + 6 + 2 * 40},  /* object 1 twice in the world, and its BVH */
+    };
+    for (int mode = 0; mode < 3; mode++) {
+        for (uint64_t seed = 20; seed < 24; seed++) {
+            scene s;
+            instanced_scene_placed(&s, seed, modes[mode].similar);
+            packed_scene packed;
+            rt_error error;
+            pack_options options = {.keep_instances = modes[mode].keep_instances};
+            assert_int_equal(pack_scene(&s, &options, &packed, &error), RT_OK);
+            assert_int_equal(packed.instance_count, modes[mode].instances);
+            assert_int_equal(packed.triangle_count, modes[mode].triangles);
+            traversal_matches_brute_force(&s, &packed, seed);
+            packed_scene_free(&packed);
+            scene_free(&s);
         }
-        assert_true(hits > 300);
-        assert_true(grazes <= 3);   /* of 3000 rays */
-        packed_scene_free(&packed);
-        scene_free(&s);
     }
 }
 
@@ -586,9 +622,11 @@ static void instance_records_and_materials(void **state)
     scene s;
     instanced_scene(&s, 30);
     packed_scene packed;
-    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
-    /* Each instance points at a root inside the node array, and its matrix inverts the
-     * placement: world_to_object * object_to_world = identity. */
+    pack_options options = {.keep_instances = true};
+    assert_int_equal(pack_scene(&s, &options, &packed, NULL), RT_OK);
+    /* Each instance (every placement but the identity one) points at a root inside the
+     * node array, and its matrix inverts the placement: world_to_object *
+     * object_to_world = identity. */
     int packed_index = 0;
     for (int i = 0; i < s.instance_count; i++) {
         const scene_instance *instance = &s.instances[i];
@@ -681,8 +719,9 @@ static void emissive_spheres_become_lights(void **state)
 }
 
 /* Emitters of placed objects become lights: the placement is baked into the world (the
- * object's shapes moved by its transform) when something of it emits under it, except
- * spheres under more than a uniform scale, which stay instanced. */
+ * object's shapes moved by its transform) when something of it emits under it, even
+ * with keep_instances, except spheres under more than a similarity, which stay
+ * instanced. */
 static void placed_emitters_become_lights(void **state)
 {
     (void)state;
@@ -706,24 +745,29 @@ static void placed_emitters_become_lights(void **state)
     /* The quad's object stretched and turned: baked. */
     scene_instance stretched = {.object = 0, .material = -1,
                                 .object_to_world = {{0, -2, 0, 5}, {3, 0, 0, 6}, {0, 0, 1, 7}}};
-    /* The sphere turned: stays an instance. Moved and scaled by 2: baked. */
+    /* The sphere turned, and moved and scaled by 2: baked (a similarity keeps it a
+     * sphere). Stretched: stays an instance. */
     scene_instance turned = {.object = 1, .material = -1,
                              .object_to_world = {{0, -1, 0, 0}, {1, 0, 0, 0}, {0, 0, 1, 0}}};
     scene_instance scaled = {.object = 1, .material = -1,
                              .object_to_world = {{2, 0, 0, 10}, {0, 2, 0, 0}, {0, 0, 2, 0}}};
-    /* The bare triangle glows only under this placement's material: baked; grey: not. */
+    scene_instance oval = {.object = 1, .material = -1,
+                           .object_to_world = {{1, 0, 0, 0}, {0, 3, 0, 0}, {0, 0, 1, 0}}};
+    /* The bare triangle glows only under this placement's material: baked; grey: not,
+     * with keep_instances. */
     scene_instance glowing = {.object = 2, .material = 1,
                               .object_to_world = {{1, 0, 0, 0}, {0, 1, 0, 20}, {0, 0, 1, 0}}};
     scene_instance grey = {.object = 2, .material = 0,
                            .object_to_world = {{1, 0, 0, 0}, {0, 1, 0, 30}, {0, 0, 1, 0}}};
-    scene_instance placements[5] = {stretched, turned, scaled, glowing, grey};
-    for (int i = 0; i < 5; i++)
+    scene_instance placements[6] = {stretched, turned, scaled, oval, glowing, grey};
+    for (int i = 0; i < 6; i++)
         assert_true(scene_add_instance(&s, &placements[i]) >= 0);
     packed_scene packed;
-    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
-    assert_int_equal(packed.instance_count, 2);   /* turned and grey */
-    assert_int_equal(packed.light_count, 3);      /* the quad, the scaled sphere, the glowing triangle */
-    bool seen_quad = false, seen_sphere = false, seen_triangle = false;
+    pack_options options = {.keep_instances = true};
+    assert_int_equal(pack_scene(&s, &options, &packed, NULL), RT_OK);
+    assert_int_equal(packed.instance_count, 2);   /* oval and grey */
+    assert_int_equal(packed.light_count, 4);      /* the quad, both spheres, the glowing triangle */
+    bool seen_quad = false, seen_sphere = false, seen_turned = false, seen_triangle = false;
     for (uint32_t l = 0; l < packed.light_count; l++) {
         uint32_t base = packed.light_offset + l * PACKED_LIGHT_STRIDE;
         packed_primitive light = packed_primitive_at(&packed, packed_uint(&packed, base, 1));
@@ -735,19 +779,26 @@ static void placed_emitters_become_lights(void **state)
                 for (int i = 0; i < 3; i++)
                     assert_float_equal(light.data[k][i], expected[k][i], 1e-6);
             seen_quad = true;
-        } else if (light.type == PRIMITIVE_SPHERE) {
+        } else if (light.type == PRIMITIVE_SPHERE && light.data[0][3] == 1) {
+            /* Centre (1, 2, 3) scaled by 2 and moved by (10, 0, 0); radius 0.5 x 2. */
             assert_float_equal(light.data[0][0], 12, 1e-6);
             assert_float_equal(light.data[0][1], 4, 1e-6);
             assert_float_equal(light.data[0][2], 6, 1e-6);
-            assert_float_equal(light.data[0][3], 1, 1e-6);
             seen_sphere = true;
+        } else if (light.type == PRIMITIVE_SPHERE) {
+            /* Turned a quarter about z: (1, 2, 3) -> (-2, 1, 3), radius kept. */
+            assert_float_equal(light.data[0][0], -2, 1e-6);
+            assert_float_equal(light.data[0][1], 1, 1e-6);
+            assert_float_equal(light.data[0][2], 3, 1e-6);
+            assert_float_equal(light.data[0][3], 0.5, 1e-6);
+            seen_turned = true;
         } else {
             assert_int_equal(light.type, PRIMITIVE_TRIANGLE);
             assert_float_equal(light.data[0][1], 20, 1e-6);
             seen_triangle = true;
         }
     }
-    assert_true(seen_quad && seen_sphere && seen_triangle);
+    assert_true(seen_quad && seen_sphere && seen_turned && seen_triangle);
     /* The baked copies are hit where the placed shapes are: the quad's middle, (0.5, 0,
      * 0.5) in the object's coordinates, is (5, 7.5, 7.5) in the world, on the plane x = 5. */
     float origin[3] = {20, 7.5f, 7.5f}, direction[3] = {-1, 0, 0};
@@ -755,6 +806,12 @@ static void placed_emitters_become_lights(void **state)
     assert_true(packed_intersect_nearest(&packed, origin, direction, 0, INFINITY, &hit));
     assert_float_equal(hit.t, 15, 1e-4);
     assert_int_equal(hit.instance, PACKED_NONE);
+    packed_scene_free(&packed);
+    /* By default the grey triangle is baked too (placed once, it costs no memory), and is
+     * no light; the oval sphere stays an instance. */
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_int_equal(packed.instance_count, 1);
+    assert_int_equal(packed.light_count, 4);
     packed_scene_free(&packed);
     scene_free(&s);
 }
@@ -790,8 +847,10 @@ static void normals_survive_the_encoding(void **state)
 }
 
 /* Triangles are three vertex indices: a mesh placed with the identity (copied into the
- * top level) and with a transform (its own BVH) shares one set of vertices; records,
- * normals, uvs and the uvs flag decode to the mesh's. */
+ * top level) and with a transform (its own BVH, with keep_instances) shares one set of
+ * vertices; records, normals, uvs and the uvs flag decode to the mesh's. Baked (the
+ * default), the second placement has vertices of its own, moved, with the same normals
+ * (a uniform scale) and uvs. */
 static void mesh_vertices_are_stored_once(void **state)
 {
     (void)state;
@@ -823,39 +882,47 @@ static void mesh_vertices_are_stored_once(void **state)
     scene_instance there = {.object = 0, .material = 0,
                             .object_to_world = {{2, 0, 0, 5}, {0, 2, 0, 0}, {0, 0, 2, 0}}};
     assert_true(scene_add_instance(&s, &here) >= 0 && scene_add_instance(&s, &there) >= 0);
-    packed_scene packed;
-    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
-    assert_int_equal(packed.instance_count, 1);
-    assert_int_equal(packed.triangle_count, 8);
-    assert_int_equal(packed.vertex_count, 4);   /* once, for both placements */
-    int triangles = 0;
-    for (uint32_t slot = 0; slot < packed.primitive_count; slot++) {
-        packed_primitive primitive = packed_primitive_at(&packed, slot);
-        if (primitive.type != PRIMITIVE_TRIANGLE)
-            continue;
-        triangles++;
-        assert_true(primitive.has_uvs);
-        for (int k = 0; k < 3; k++) {
-            uint32_t v = primitive.vertices[k];
-            assert_true(v < packed.vertex_count);
-            /* Find the mesh vertex at that position: its normal and uv must match. */
-            float position[3], normal[3];
-            packed_vertex_position(&packed, v, position);
-            assert_true(packed_vertex_normal(&packed, v, normal));
-            int match = -1;
-            for (int m = 0; m < 4; m++)
-                if (memcmp(position, positions + 3 * m, sizeof position) == 0)
-                    match = m;
-            assert_true(match >= 0);
-            for (int c = 0; c < 3; c++)
-                assert_float_equal(normal[c], mesh.normals[3 * match + c], 1e-4);
-            uint32_t uv_texel = packed.uv_offset + v / 2;
-            assert_true(packed_float(&packed, uv_texel, (int)(2 * (v % 2))) == mesh.uvs[2 * match]);
-            assert_true(packed_float(&packed, uv_texel, (int)(2 * (v % 2) + 1)) == mesh.uvs[2 * match + 1]);
+    for (int baked = 0; baked < 2; baked++) {
+        packed_scene packed;
+        pack_options options = {.keep_instances = !baked};
+        assert_int_equal(pack_scene(&s, &options, &packed, NULL), RT_OK);
+        assert_int_equal(packed.instance_count, baked ? 0 : 1);
+        assert_int_equal(packed.triangle_count, 8);
+        assert_int_equal(packed.vertex_count, baked ? 8 : 4);   /* instanced: once, for both placements */
+        int triangles = 0;
+        for (uint32_t slot = 0; slot < packed.primitive_count; slot++) {
+            packed_primitive primitive = packed_primitive_at(&packed, slot);
+            if (primitive.type != PRIMITIVE_TRIANGLE)
+                continue;
+            triangles++;
+            assert_true(primitive.has_uvs);
+            for (int k = 0; k < 3; k++) {
+                uint32_t v = primitive.vertices[k];
+                assert_true(v < packed.vertex_count);
+                /* Find the mesh vertex at that position: its normal and uv must match. */
+                float position[3], normal[3];
+                packed_vertex_position(&packed, v, position);
+                assert_true(packed_vertex_normal(&packed, v, normal));
+                /* The baked copy's vertices: scaled by 2 and moved by (5, 0, 0). */
+                int match = -1;
+                for (int m = 0; m < 4; m++) {
+                    const float *p = positions + 3 * m;
+                    const float moved[3] = {2 * p[0] + 5, 2 * p[1], 2 * p[2]};
+                    if (memcmp(position, p, sizeof position) == 0
+                        || (baked && memcmp(position, moved, sizeof position) == 0))
+                        match = m;
+                }
+                assert_true(match >= 0);
+                for (int c = 0; c < 3; c++)
+                    assert_float_equal(normal[c], mesh.normals[3 * match + c], 1e-4);
+                uint32_t uv_texel = packed.uv_offset + v / 2;
+                assert_true(packed_float(&packed, uv_texel, (int)(2 * (v % 2))) == mesh.uvs[2 * match]);
+                assert_true(packed_float(&packed, uv_texel, (int)(2 * (v % 2) + 1)) == mesh.uvs[2 * match + 1]);
+            }
         }
+        assert_int_equal(triangles, 8);
+        packed_scene_free(&packed);
     }
-    assert_int_equal(triangles, 8);
-    packed_scene_free(&packed);
     scene_free(&s);
 }
 

@@ -48,8 +48,9 @@ static void assert_summary_matches_texels(const packed_scene *packed)
 }
 
 /* Parses camera_line followed by body, gives every image 2x1 grey pixels (nothing is
- * read from disk), packs it into *packed and checks its summary against its texels. */
-static void pack_text(const char *body, packed_scene *packed)
+ * read from disk), packs it into *packed with options (NULL: defaults) and checks its
+ * summary against its texels. */
+static void pack_text(const char *body, const pack_options *options, packed_scene *packed)
 {
     char text[4096];
     snprintf(text, sizeof text, "%s%s", camera_line, body);
@@ -66,7 +67,7 @@ static void pack_text(const char *body, packed_scene *packed)
         for (int k = 0; k < 8; k++)
             s.images[i].pixels[k] = 0.5f;
     }
-    status = pack_scene(&s, NULL, packed, &error);
+    status = pack_scene(&s, options, packed, &error);
     if (status != RT_OK)
         fail_msg("%s", error.message);
     scene_free(&s);
@@ -77,12 +78,19 @@ static void pack_text(const char *body, packed_scene *packed)
 typedef struct summary_case {
     const char *what;
     const char *body;            /* after camera_line */
+    bool keep_instances;         /* pack_options.keep_instances */
     uint32_t primitive_types, light_types;
     bool volumes, emitters, textures, normal_maps;
 } summary_case;
 
 #define GREY "material grey lambertian 0.5 0.5 0.5\n"
 #define LAMP "material lamp emissive 1 1 1 strength 4\n"
+/* A quad and a triangle in a group turned, and placed again moved. */
+#define PANELS                                                                                                         \
+    GREY "sphere 0 -10 0 1 grey\n"                                                                                     \
+         "group panel material grey {\n    rotate 0 1 0 30\n    quad 0 0 0  1 0 0  0 1 0\n"                            \
+         "    triangle 0 0 1  1 0 1  0 1 1\n}\n"                                                                       \
+         "instance panel {\n    translate 3 0 0\n}\n"
 
 static const summary_case cases[] = {
     {.what = "spheres only",
@@ -93,13 +101,24 @@ static const summary_case cases[] = {
                   "quad 0 0 -1  1 0 0  0 1 0 grey\n",
      .primitive_types = BIT(PRIMITIVE_MOVING_SPHERE) | BIT(PRIMITIVE_TRIANGLE) | BIT(PRIMITIVE_QUAD)},
     /* The quad and the triangle are only in the group's own BVH, placed twice with a
-     * rotation: they stay instanced, and count. */
+     * rotation and kept instanced: they count. */
     {.what = "kinds inside instances",
-     .body = GREY "sphere 0 -10 0 1 grey\n"
-                  "group panel material grey {\n    rotate 0 1 0 30\n    quad 0 0 0  1 0 0  0 1 0\n"
-                  "    triangle 0 0 1  1 0 1  0 1 1\n}\n"
-                  "instance panel {\n    translate 3 0 0\n}\n",
+     .body = PANELS,
+     .keep_instances = true,
      .primitive_types = BIT(PRIMITIVE_SPHERE) | BIT(PRIMITIVE_TRIANGLE) | BIT(PRIMITIVE_QUAD) | BIT(PRIMITIVE_INSTANCE)},
+    /* By default both placements are baked (core/pack_collect.c): one level. */
+    {.what = "placements baked",
+     .body = PANELS,
+     .primitive_types = BIT(PRIMITIVE_SPHERE) | BIT(PRIMITIVE_TRIANGLE) | BIT(PRIMITIVE_QUAD)},
+    /* The Cornell box's blocks: boxes turned and moved by groups, no instances left, so
+     * the tracer variant leaves the instance code out. */
+    {.what = "the Cornell box's blocks",
+     .body = GREY "quad 0 0 0  555 0 0  0 0 555 grey\n"
+                  "group tall_block material grey {\n    rotate 0 1 0 15\n    translate 265 0 295\n"
+                  "    box 0 0 0 165 330 165\n}\n"
+                  "group short_block material grey {\n    rotate 0 1 0 -18\n    translate 130 0 65\n"
+                  "    box 0 0 0 165 165 165\n}\n",
+     .primitive_types = BIT(PRIMITIVE_QUAD)},
     /* A group without transforms is copied into the top level: one level. */
     {.what = "identity placement",
      .body = GREY "group material grey {\n    quad 0 0 0  1 0 0  0 1 0\n}\n",
@@ -160,7 +179,8 @@ static void each_scene_is_summarised(void **state)
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         const summary_case *c = &cases[i];
         packed_scene packed;
-        pack_text(c->body, &packed);
+        pack_options options = {.keep_instances = c->keep_instances};
+        pack_text(c->body, &options, &packed);
         const pack_summary *got = &packed.summary;
         if (got->primitive_types != c->primitive_types || got->light_types != c->light_types)
             fail_msg("%s: primitive types %#x, light types %#x; expected %#x, %#x", c->what, got->primitive_types,
@@ -180,14 +200,14 @@ static void texel_hash_is_the_hash_of_the_texels(void **state)
     packed_scene packed;
     pack_text("material grey lambertian 0.5 0.5 0.5\n"
               "sphere 0 0 0 1 grey\n",
-              &packed);
+              NULL, &packed);
     assert_true(packed.texel_hash == hash_bytes(HASH_START, packed.texels, (size_t)packed.texel_count * 16u));
     uint64_t first = packed.texel_hash;
     packed_scene_free(&packed);
     /* Another radius: other texels, another hash. */
     pack_text("material grey lambertian 0.5 0.5 0.5\n"
               "sphere 0 0 0 2 grey\n",
-              &packed);
+              NULL, &packed);
     assert_true(packed.texel_hash != first);
     packed_scene_free(&packed);
 }

@@ -5,26 +5,18 @@
  * back; and running jobs up to the point where a GPU would be needed (a refused plan, a
  * bad scene, an empty shard, a wrong partial, a stop between frames), then one small job
  * rendered for real on the device. */
-#include <stdarg.h>
-#include <stddef.h>
-#include <stdint.h>
-#include <setjmp.h>
-#include <cmocka.h>
-
-#include <ftw.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
-
 #include "image_io.h"
 #include "merge.h"
 #include "metadata_keys.h"
 #include "render_job.h"
 #include "render_output.h"
+#include "support.h"
 
-/* The scratch directory of this run, with a scene file in it. */
-static char scratch[256];
+#include <unistd.h>
+
+/* The scratch directory of this run (support.h's, one for the whole group), with a scene
+ * file in it. */
+static scratch *work;
 static char scene_path[300];
 
 static const char *const scene_text = "camera from 0 0 3 at 0 0 0 up 0 1 0 fov 40\n"
@@ -32,32 +24,24 @@ static const char *const scene_text = "camera from 0 0 3 at 0 0 0 up 0 1 0 fov 4
                                       "sphere 0 0 0 1 m\n"
                                       "render size 8 6 spp 4 depth 3 seed 3\n";
 
-/* Returns scratch/name in a rotating buffer (four names may be in use at once). */
-static const char *in_scratch(const char *name)
+/* Returns scratch/name in a rotating buffer (four names may be in use at once, which
+ * support.h's in_scratch does not allow). */
+static const char *job_path(const char *name)
 {
     static char paths[4][512];
     static int next;
     char *path = paths[next++ % 4];
-    snprintf(path, sizeof paths[0], "%s/%s", scratch, name);
+    snprintf(path, sizeof paths[0], "%s/%s", work->directory, name);
     return path;
 }
 
-static void write_text(const char *path, const char *text)
+/* cmocka group setup: support.h's make_scratch, then the scene file; returns 0, or -1. */
+static int make_job_scratch(void **state)
 {
-    FILE *file = fopen(path, "w");
-    assert_non_null(file);
-    fputs(text, file);
-    fclose(file);
-}
-
-static int make_scratch(void **state)
-{
-    (void)state;
-    const char *tmp = getenv("TMPDIR");
-    snprintf(scratch, sizeof scratch, "%s/test_render_job.XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (mkdtemp(scratch) == NULL)
+    if (make_scratch(state) != 0)
         return -1;
-    snprintf(scene_path, sizeof scene_path, "%s/scene.txt", scratch);
+    work = *state;
+    snprintf(scene_path, sizeof scene_path, "%s/scene.txt", work->directory);
     FILE *file = fopen(scene_path, "w");
     if (file == NULL)
         return -1;
@@ -66,26 +50,12 @@ static int make_scratch(void **state)
     return 0;
 }
 
-static int remove_entry(const char *path, const struct stat *info, int kind, struct FTW *walk)
-{
-    (void)info;
-    (void)kind;
-    (void)walk;
-    return remove(path);
-}
-
-static int remove_scratch(void **state)
-{
-    (void)state;
-    return nftw(scratch, remove_entry, 8, FTW_DEPTH | FTW_PHYS);
-}
-
 /* A job rendering the scratch scene to scratch/name. */
 static render_job job_for(const char *name)
 {
     render_job job = render_job_defaults();
     job.scene_path = scene_path;
-    job.output = in_scratch(name);
+    job.output = job_path(name);
     return job;
 }
 
@@ -103,7 +73,7 @@ static void first_output_is(const render_job *job, const char *name)
 {
     render_job_plan plan;
     assert_int_equal(render_job_check(job, &plan, NULL), RT_OK);
-    assert_string_equal(plan.first_output, in_scratch(name));
+    assert_string_equal(plan.first_output, job_path(name));
 }
 
 /* Checks that render_job_check() refuses job with exactly message. */
@@ -169,7 +139,7 @@ static void output_names(void **state)
     assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
     char name[RENDER_JOB_PATH_MAX];
     assert_int_equal(render_job_output_name(&job, &plan, 5, name, sizeof name, NULL), RT_OK);
-    assert_string_equal(name, in_scratch("f-005.exr"));
+    assert_string_equal(name, job_path("f-005.exr"));
     /* One frame may go without a frame number in the name. */
     job = frames_job_for("still.png", frames, 1);
     first_output_is(&job, "still.png");
@@ -196,29 +166,28 @@ static void output_rules(void **state)
     job = frames_job_for("f.png", frames, 2);
     snprintf(message, sizeof message,
              "2 frames would all write '%s'; put a frame number pattern in the output, e.g. frame-%%04d.png",
-             in_scratch("f.png"));
+             job_path("f.png"));
     refused(&job, message);
     job = job_for("f-%d-%d.png");
     snprintf(message, sizeof message,
              "output '%s': use exactly one %%d-style conversion (e.g. frame-%%04d.png) and %%%% for a percent sign",
-             in_scratch("f-%d-%d.png"));
+             job_path("f-%d-%d.png"));
     refused(&job, message);
     job = job_for("f.bmp");
     snprintf(message, sizeof message, "cannot tell the format of '%s'; use .exr, .hdr, .png, .jpg or .tif",
-             in_scratch("f.bmp"));
+             job_path("f.bmp"));
     refused(&job, message);
     job = job_for("missing/f.png");
     snprintf(message, sizeof message, "cannot write '%s': its directory does not exist or is not writable",
-             in_scratch("missing/f.png"));
+             job_path("missing/f.png"));
     refused(&job, message);
     /* The scene file is never an output, however it is spelled. */
     char scene_png[512];
-    snprintf(scene_png, sizeof scene_png, "%s/scene.png", scratch);
-    write_text(scene_png, scene_text);
+    snprintf(scene_png, sizeof scene_png, "%s", write_file(work, "scene.png", scene_text));
     job = job_for("./scene.png");
     job.scene_path = scene_png;
     snprintf(message, sizeof message, "the output '%s' is the scene file; refusing to overwrite it",
-             in_scratch("./scene.png"));
+             job_path("./scene.png"));
     refused(&job, message);
     unlink(scene_png);
 }
@@ -236,7 +205,7 @@ static void part_rules(void **state)
     job = job_for("a.png");
     job.aovs = true;
     snprintf(message, sizeof message, "--aovs writes extra layers, which only .exr keeps; not '%s'",
-             in_scratch("a.png"));
+             job_path("a.png"));
     refused(&job, message);
     job = frames_job_for("a-%d.exr", frames, 2);
     job.resume_path = "x.exr";
@@ -449,20 +418,16 @@ static void metadata_round_trip(void **state)
         .seed = 4294967295ULL, .max_depth = 8, .frame = 12, .samples_finished = 24, .path_segments = 1e10,
         .complete = true, .render_seconds = 1.5,
     };
-    const char *path = in_scratch("part.exr");
+    const char *path = job_path("part.exr");
     assert_int_equal(render_output_write(path, &part, &layers, &metadata, 0, NULL), RT_OK);
     /* The merge reads back what was written, and the layers follow the four channels. */
     merge_metadata back;
     assert_int_equal(merge_read_part(path, &read, &back, NULL), RT_OK);
-    assert_string_equal(back.scene, "scenes/x.txt");
-    assert_string_equal(back.scene_hash, "00000000deadbeef");
-    assert_int_equal(back.spp, 4);
-    assert_true(back.sample_start == 3000000000ULL);
-    assert_true(back.seed == 4294967295ULL);
-    assert_int_equal(back.max_depth, 8);
-    assert_int_equal(back.frame, 12);
-    assert_true(back.complete);
-    assert_true(back.path_segments == 1e10);
+    assert_merge_metadata_equal(&back, (&(merge_metadata){
+                                           .scene = "scenes/x.txt", .scene_hash = "00000000deadbeef", .spp = 4,
+                                           .sample_start = 3000000000ULL, .seed = 4294967295ULL, .max_depth = 8,
+                                           .frame = 12, .complete = true, .render_seconds = 1.5,
+                                           .path_segments = 1e10}));
     assert_int_equal(read.channels, 5);
     assert_string_equal(read.channel_names[4], "depth.Z");
     assert_int_equal(read.x, 1);
@@ -478,7 +443,7 @@ static void metadata_round_trip(void **state)
     assert_int_equal(image_read_attribute(path, METADATA_KEY_MERGED_PARTS, text, sizeof text, NULL), RT_OK);
     assert_string_equal(text, "3");
     /* Formats without a sample count get the colour only. */
-    const char *png = in_scratch("part.png");
+    const char *png = job_path("part.png");
     assert_int_equal(render_output_write(png, &part, &layers, &metadata, 0, NULL), RT_OK);
     assert_int_equal(image_read(png, &read, NULL), RT_OK);
     assert_int_equal(read.channels, 3);
@@ -494,7 +459,7 @@ static void partials(void **state)
     make_part(&part);
     render_output_metadata metadata = {.scene = "s.txt", .scene_hash = "00000000000000ff", .spp = 4,
                                        .sample_start = 8, .seed = 7, .max_depth = 2, .frame = -1};
-    const char *path = in_scratch("resume.partial.exr");
+    const char *path = job_path("resume.partial.exr");
     assert_int_equal(render_output_write(path, &part, NULL, &metadata, 0, NULL), RT_OK);
     render_output_resume_check check = {.seed = 7, .sample_start = 8, .spp = 4, .region = {1, 1, 3, 4}};
     uint64_t hash = 0;
@@ -522,7 +487,7 @@ static void partials(void **state)
         assert_null(read.pixels);
     }
     rt_error error = {{0}};
-    assert_int_equal(render_output_read_partial(in_scratch("none.exr"), &check, &read, &hash, &error), RT_ERROR_INPUT);
+    assert_int_equal(render_output_read_partial(job_path("none.exr"), &check, &read, &hash, &error), RT_ERROR_INPUT);
     assert_true(strncmp(error.message, "--resume: IMAGE: cannot read", 28) == 0);
     image_free(&part);
 }
@@ -578,8 +543,7 @@ static void runs_that_stop_early(void **state)
     assert_int_equal(summary.failure, RENDER_JOB_FAILURE_PLAN);
     assert_int_equal(summary.images_started, 0);
     /* A scene that does not parse: the parser's message, with the file's position. */
-    const char *bad = in_scratch("bad.txt");
-    write_text(bad, "sphere 0 0 0 1\n");
+    const char *bad = write_file(work, "bad.txt", "sphere 0 0 0 1\n");
     job = job_for("a.exr");
     job.scene_path = bad;
     assert_int_equal(render_job_run(NULL, &job, &callbacks, &summary, &error), RT_ERROR_INPUT);
@@ -596,10 +560,10 @@ static void runs_that_stop_early(void **state)
     rt_image part;
     make_part(&part);
     render_output_metadata metadata = {.scene = "s.txt", .scene_hash = "1", .spp = 4, .seed = 99, .frame = -1};
-    assert_int_equal(render_output_write(in_scratch("other.exr"), &part, NULL, &metadata, 0, NULL), RT_OK);
+    assert_int_equal(render_output_write(job_path("other.exr"), &part, NULL, &metadata, 0, NULL), RT_OK);
     image_free(&part);
     job = job_for("a.exr");
-    job.resume_path = in_scratch("other.exr");
+    job.resume_path = job_path("other.exr");
     assert_int_equal(render_job_run(NULL, &job, &callbacks, &summary, &error), RT_ERROR_INPUT);
     assert_int_equal(summary.failure, RENDER_JOB_FAILURE_IMAGE);
     assert_non_null(strstr(error.message, "does not belong to this render: seed 99, this render 3"));
@@ -612,17 +576,16 @@ static void runs_that_stop_early(void **state)
     assert_int_equal(summary.failure, RENDER_JOB_FAILURE_STOPPED);
     assert_int_equal(summary.images_started, 0);
     assert_int_equal(seen.started, 0);
-    assert_int_equal(access(in_scratch("f-1.exr"), F_OK), -1);
+    assert_int_equal(access(job_path("f-1.exr"), F_OK), -1);
     /* A frame whose name is the scene file (the first name was checked by the plan). */
-    const char *scene_exr = in_scratch("scene-2.exr");
-    write_text(scene_exr, scene_text);
+    const char *scene_exr = write_file(work, "scene-2.exr", scene_text);
     job = frames_job_for("scene-%d.exr", frames, 2);
     job.scene_path = scene_exr;
     job.shard_index = 1;
     job.shard_count = 2;
     char expected[1024];
     snprintf(expected, sizeof expected, "frame 2's output '%s' is the scene file; refusing to overwrite it",
-             in_scratch("scene-2.exr"));
+             job_path("scene-2.exr"));
     assert_int_equal(render_job_run(NULL, &job, &callbacks, &summary, &error), RT_ERROR_INPUT);
     assert_string_equal(error.message, expected);
     assert_int_equal(summary.failure, RENDER_JOB_FAILURE_IMAGE);
@@ -655,11 +618,11 @@ static void a_job_renders(void **state)
     assert_int_equal(seen.written, 2);
     assert_int_equal(seen.frames[0], 4);
     assert_int_equal(seen.frames[1], 6);
-    assert_int_equal(access(in_scratch("f-5.exr"), F_OK), -1);
-    assert_int_equal(access(in_scratch("f-6.partial.exr"), F_OK), -1);
+    assert_int_equal(access(job_path("f-5.exr"), F_OK), -1);
+    assert_int_equal(access(job_path("f-6.partial.exr"), F_OK), -1);
     rt_image image;
     merge_metadata metadata;
-    assert_int_equal(merge_read_part(in_scratch("f-6.exr"), &image, &metadata, &error), RT_OK);
+    assert_int_equal(merge_read_part(job_path("f-6.exr"), &image, &metadata, &error), RT_OK);
     assert_int_equal(image.width, 8);
     assert_int_equal(image.height, 6);
     assert_int_equal(metadata.frame, 6);
@@ -687,5 +650,5 @@ int main(void)
         cmocka_unit_test(runs_that_stop_early),
         cmocka_unit_test(a_job_renders),
     };
-    return cmocka_run_group_tests(tests, make_scratch, remove_scratch);
+    return cmocka_run_group_tests(tests, make_job_scratch, remove_scratch);
 }

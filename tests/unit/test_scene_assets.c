@@ -76,6 +76,13 @@ static const char *load_fails(scratch *s, const char *name, const char *text, rt
     return error->message;
 }
 
+/* load_fails(), then checks that the message contains expected. */
+static void load_fails_saying(scratch *s, const char *name, const char *text, const char *expected)
+{
+    rt_error error;
+    assert_contains(load_fails(s, name, text, &error), expected);
+}
+
 static const float *vertex_of(const obj_mesh *mesh, int triangle, int corner)
 {
     return &mesh->positions[3 * mesh->indices[3 * triangle + corner]];
@@ -296,10 +303,9 @@ static void test_crlf_bom_comments_and_groups(void **state)
     assert_int_equal(mesh.vertex_count, 3);
     obj_mesh_free(&mesh);
 
-    rt_error error;
     /* line numbers (tinyobjloader's) count CRLF, CR and LF line endings alike */
-    load_fails(*state, "windows-bad.obj", "v 0 0 0\r\nv 1 0 0\rv 0 1 0\r\nf 1 2 0\r\n", &error);
-    assert_contains(error.message, "zero value for face index. line 4.");
+    load_fails_saying(*state, "windows-bad.obj", "v 0 0 0\r\nv 1 0 0\rv 0 1 0\r\nf 1 2 0\r\n",
+                      "zero value for face index. line 4.");
 }
 
 /* ---- obj_load: errors ---------------------------------------------------------------- */
@@ -308,17 +314,17 @@ static void test_crlf_bom_comments_and_groups(void **state)
 static void test_malformed_lines(void **state)
 {
     rt_error error;
-    load_fails(*state, "c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n", &error);
-    assert_contains(error.message, "': tinyobjloader: Failed parse `f' line(e.g. zero value for face index. line 4.)");
+    load_fails_saying(*state, "c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n",
+                      "': tinyobjloader: Failed parse `f' line(e.g. zero value for face index. line 4.)");
 
-    load_fails(*state, "d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", &error);
-    assert_contains(error.message, "': tinyobjloader: Failed parse `f' line(e.g. zero value for face index. line 4.)");
+    load_fails_saying(*state, "d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
+                      "': tinyobjloader: Failed parse `f' line(e.g. zero value for face index. line 4.)");
 
-    load_fails(*state, "f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x3\n", &error);
-    assert_contains(error.message, "zero value for face index. line 4.");
+    load_fails_saying(*state, "f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x3\n",
+                      "zero value for face index. line 4.");
 
-    load_fails(*state, "g.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2/ 3/\n", &error);
-    assert_contains(error.message, "zero value for face index. line 4.");
+    load_fails_saying(*state, "g.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2/ 3/\n",
+                      "zero value for face index. line 4.");
 
     load_fails(*state, "h.obj", "v 0 0 0\nv 1 0 0\nl 0 1\nv 0 1 0\nf 1 2 3\n", &error);
     assert_contains(error.message, "tinyobjloader: Failed parse `l' line");
@@ -326,8 +332,8 @@ static void test_malformed_lines(void **state)
 
     /* a face of two corners: tinyobjloader drops it with a warning; with no other face
      * the file has none */
-    load_fails(*state, "b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", &error);
-    assert_contains(error.message, "': has no faces (tinyobjloader made no triangles; it warned: Degenerated face found)");
+    load_fails_saying(*state, "b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n",
+                      "': has no faces (tinyobjloader made no triangles; it warned: Degenerated face found)");
     obj_mesh mesh = load_ok(*state, "b2.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\n");
     assert_int_equal(mesh.triangle_count, 1);
     assert_int_equal(mesh.warning_count, 1);
@@ -373,26 +379,25 @@ static void test_out_of_range_indices(void **state)
     rt_error error;
     /* tinyobjloader keeps no line numbers in its arrays: the triangle is named, counted
      * in file order */
-    load_fails(*state, "a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n", &error);
-    assert_contains(error.message, "': triangle 2: vertex index 9 is out of range: the file has 3 vertices");
+    load_fails_saying(*state, "a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n",
+                      "': triangle 2: vertex index 9 is out of range: the file has 3 vertices");
 
-    load_fails(*state, "b.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n", &error);
-    assert_contains(error.message, "': triangle 1: a relative vertex index points before the first vertex");
+    load_fails_saying(*state, "b.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n",
+                      "': triangle 1: a relative vertex index points before the first vertex");
 
-    load_fails(*state, "c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n", &error);
-    assert_contains(error.message, "': triangle 1: normal index 2 is out of range: the file has 1 normals");
+    load_fails_saying(*state, "c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n",
+                      "': triangle 1: normal index 2 is out of range: the file has 1 normals");
 
-    load_fails(*state, "d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n", &error);
-    assert_contains(error.message,
-                    "': triangle 1: texture coordinate index 1 is out of range: the file has 0 texture coordinates");
+    load_fails_saying(*state, "d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n",
+                      "': triangle 1: texture coordinate index 1 is out of range: the file has 0 texture coordinates");
 
     load_fails(*state, "e.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999\n", &error);
     assert_contains(error.message, "': triangle 1: vertex index ");
     assert_contains(error.message, "out of range");
 
     /* an n-gon with an index past the end: tinyobjloader triangulates it as it is */
-    load_fails(*state, "g.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 1 7\n", &error);
-    assert_contains(error.message, "': triangle 1: vertex index 7 is out of range");
+    load_fails_saying(*state, "g.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 1 7\n",
+                      "': triangle 1: vertex index 7 is out of range");
     /* a quad with one: tinyobjloader drops it with a warning */
     load_fails(*state, "f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n", &error);
     assert_contains(error.message, "': has no faces (tinyobjloader made no triangles; it warned: ");
@@ -407,28 +412,22 @@ static void test_out_of_range_indices(void **state)
 
 static void test_empty_files_have_no_faces(void **state)
 {
-    rt_error error;
-    load_fails(*state, "empty.obj", "", &error);
-    assert_contains(error.message, "': has no faces");
-    load_fails(*state, "points.obj", "# only vertices\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", &error);
-    assert_contains(error.message, "': has no faces");
-    load_fails(*state, "lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", &error);
-    assert_contains(error.message, "': has no faces");
+    load_fails_saying(*state, "empty.obj", "", "': has no faces");
+    load_fails_saying(*state, "points.obj", "# only vertices\nv 0 0 0\nv 1 0 0\nv 0 1 0\n",
+                      "': has no faces");
+    load_fails_saying(*state, "lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", "': has no faces");
 }
 
 static void test_non_finite_numbers(void **state)
 {
     /* tinyobjloader reads "nan" and "inf" as 0 (test_tinyobjloader_reads_leniently), but
      * numbers beyond the float range as infinities */
-    rt_error error;
-    load_fails(*state, "big.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n", &error);
-    assert_contains(error.message,
-                    "big.obj': vertex 2 has a coordinate that is not a finite number (beyond the range of a float)");
-    load_fails(*state, "bign.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 -1e39 1\nf 1//1 2//1 3//1\n",
-               &error);
-    assert_contains(error.message, "bign.obj': normal 2 has a coordinate that is not a finite number");
-    load_fails(*state, "bigt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 -1e40\nf 1/1 2/1 3/1\n", &error);
-    assert_contains(error.message, "bigt.obj': texture coordinate 1 has a coordinate that is not a finite number");
+    load_fails_saying(*state, "big.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n",
+                      "big.obj': vertex 2 has a coordinate that is not a finite number (beyond the range of a float)");
+    load_fails_saying(*state, "bign.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 -1e39 1\nf 1//1 2//1 3//1\n",
+                      "bign.obj': normal 2 has a coordinate that is not a finite number");
+    load_fails_saying(*state, "bigt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 -1e40\nf 1/1 2/1 3/1\n",
+                      "bigt.obj': texture coordinate 1 has a coordinate that is not a finite number");
 }
 
 static void test_missing_and_directory_files(void **state)
@@ -1059,7 +1058,7 @@ static void test_sky_box_unreadable_face_is_named(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-#define T(name) cmocka_unit_test_setup_teardown(name, make_scratch, remove_scratch)
+#define T(name) scratch_test(name)
         T(test_quad_becomes_two_triangles),
         T(test_ngons_are_triangulated),
         T(test_negative_indices),
