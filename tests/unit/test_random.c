@@ -12,38 +12,20 @@
 #include <string.h>
 
 #include "gpu.h"
+#include "support.h"
 
 #define WIDTH 256
 #define HEIGHT 128
 #define COUNT ((size_t)WIDTH * HEIGHT * 4)
 
-static gpu_context *context;
-
-static int set_up(void **state)
-{
-    (void)state;
-    rt_error error;
-    if (gpu_create(NULL, &context, &error) != RT_OK) {
-        print_error("%s\n", error.message);
-        return -1;
-    }
-    return 0;
-}
-
-static int tear_down(void **state)
-{
-    (void)state;
-    gpu_destroy(context);
-    return 0;
-}
 
 static float *draw(uint32_t sample_index, uint32_t seed, uint32_t dimension)
 {
     float *numbers = malloc(COUNT * sizeof(float));
     assert_non_null(numbers);
     rt_error error;
-    assert_int_equal(gpu_random_numbers(context, WIDTH, HEIGHT, sample_index, seed, dimension, numbers, &error),
-                     RT_OK);
+    assert_int_equal(
+        gpu_random_numbers(gpu_fixture_context, WIDTH, HEIGHT, sample_index, seed, dimension, numbers, &error), RT_OK);
     return numbers;
 }
 
@@ -130,5 +112,5 @@ int main(void)
         cmocka_unit_test(components_and_neighbours_uncorrelated),
         cmocka_unit_test(samples_dimensions_and_seeds_are_independent),
     };
-    return cmocka_run_group_tests_name("random numbers (on the device)", tests, set_up, tear_down);
+    return cmocka_run_group_tests_name("random numbers (on the device)", tests, gpu_fixture_set_up, gpu_fixture_tear_down);
 }

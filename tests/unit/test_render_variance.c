@@ -7,25 +7,6 @@
 #include "scene_parse.h"
 #include "support.h"
 
-static gpu_context *context;
-
-static int set_up(void **state)
-{
-    (void)state;
-    rt_error error;
-    if (gpu_create(NULL, &context, &error) != RT_OK) {
-        print_error("%s\n", error.message);
-        return -1;
-    }
-    return 0;
-}
-
-static int tear_down(void **state)
-{
-    (void)state;
-    gpu_destroy(context);
-    return 0;
-}
 
 /* Renders text with the given seed and options into *result (asserting success). */
 static void render_text(const char *text, uint32_t seed, bool aovs, render_result *result)
@@ -39,7 +20,7 @@ static void render_text(const char *text, uint32_t seed, bool aovs, render_resul
     render_options options = render_options_defaults();
     options.variance = true;
     options.aovs = aovs;
-    if (render_scene(context, &s, &options, result, &error) != RT_OK)
+    if (render_scene(gpu_fixture_context, &s, &options, result, &error) != RT_OK)
         fail_msg("%s", error.message);
     scene_free(&s);
 }
@@ -173,5 +154,5 @@ int main(void)
         cmocka_unit_test(grey_channels_agree),
         cmocka_unit_test(predicts_the_spread_of_seeds),
     };
-    return cmocka_run_group_tests(tests, set_up, tear_down);
+    return cmocka_run_group_tests(tests, gpu_fixture_set_up, gpu_fixture_tear_down);
 }
