@@ -169,7 +169,9 @@ static void run_case(gpu_context *context, const suite *s, int index, const suit
     render_job_summary summary;
     rt_status status = render_job_run(context, &job, NULL, &summary, &error);
     result->render_seconds = summary.seconds;
-    if (status != RT_OK)
+    if (status == RT_ERROR_INTERRUPTED)
+        conclude(result, SUITE_ERROR, "interrupted: the run was stopped during this render");
+    else if (status != RT_OK)
         conclude(result, SUITE_ERROR, "the render failed: %s", error.message);
     else
         compare_case(c, plan, options, folder, result);

@@ -235,5 +235,26 @@ else fail "check --update-all" "exit $code: $(tr '\n' '|' <"$scratch/out")"; fi
 ls -A "$work/copy" | grep -v '\.exr$' >"$scratch/left"
 if [ -s "$scratch/left" ]; then fail "check --update leaves no temporary file" "$(cat "$scratch/left")"
 else pass "check --update leaves no temporary file beside the goldens"; fi
+# ---- a stop: SIGINT ends the render in flight, the rest is not run ------------------------
+{
+    echo "render --size 160x90 --spp 128"
+    for i in 1 2 3 4 5 6; do echo "case slow-$i $root/scenes/weekend.txt golden/none.exr"; done
+} >"$work/slow.txt"
+(cd "$work" && exec "$program" check slow.txt --junit "$scratch/slow.xml") >"$scratch/slow.out" 2>&1 &
+checker=$!
+waited=0
+while ! grep -q '^FAIL  slow-1 ' "$scratch/slow.out" && [ "$waited" -lt 600 ]; do
+    sleep 0.1
+    waited=$((waited + 1))
+done
+kill -INT "$checker"
+wait "$checker"
+code=$?
+not_run=$(sed -n 's/^check: .* errors, \([0-9]*\) not run of 6 cases.*/\1/p' "$scratch/slow.out")
+skipped=$(grep -c '<skipped ' "$scratch/slow.xml" 2>/dev/null)
+if [ "$code" = 1 ] && [ "${not_run:-0}" -ge 1 ] && [ "$skipped" = "$not_run" ] \
+    && grep -q '^ERROR slow-2 (.*interrupted: the run was stopped during this render' "$scratch/slow.out"; then
+    pass "check: SIGINT stops the render in flight (an error), leaves $not_run cases not run (<skipped/> in JUnit), exit 1"
+else fail "check interrupted" "exit $code, skipped $skipped: $(tr '\n' '|' <"$scratch/slow.out")"; fi
 cd "$root" || exit 1
 finish
