@@ -209,6 +209,11 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
 rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
                           rt_error *error);
 
+/* Reads the per-channel sums of squares: squares receives width*height*4 floats, rows top
+ * to bottom, (sum of finished samples' squared radiance r^2, g^2, b^2, 0), from which
+ * render.c makes the variance layers. */
+rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error);
+
 /* Renders the first-hit AOVs with samples jittered camera rays per pixel (the same camera
  * rays as the render's first samples): albedo_depth receives width*height*4 floats (albedo
  * r, g, b; distance to the first hit, 0 where nothing was hit), normal_coverage

@@ -546,6 +546,13 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
     return check_gl("reading the result", error);
 }
 
+rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error)
+{
+    glActiveTexture(GL_TEXTURE0);
+    read_state(tracer, TRACER_STATE_SQUARES, squares);
+    return check_gl("reading the sums of squares", error);
+}
+
 rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_depth, float *normal_coverage,
                                  rt_error *error)
 {

@@ -204,6 +204,58 @@ static rt_status render_aovs(gpu_tracer *tracer, int width, int height, const rt
     return status;
 }
 
+/* Builds the variance layers variance.R/G/B: each pixel's sample variance of each colour
+ * channel, E[c^2] - E[c]^2 over its finished samples (as variance.Y is of luminance), from
+ * the means in colour and the tracer's sums of squares (width*height*4). Float rounding
+ * can make a constant pixel's difference slightly negative: it is 0 then. The caller
+ * frees layers. */
+static rt_status variance_layers(int width, int height, const rt_image *colour, const float *squares,
+                                 rt_image *layers, rt_error *error)
+{
+    rt_status status = image_create(layers, width, height, 3, error);
+    if (status != RT_OK)
+        return status;
+    static const char *const names[3] = {"variance.R", "variance.G", "variance.B"};
+    for (int c = 0; c < 3; c++)
+        snprintf(layers->channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", names[c]);
+    size_t pixel_count = (size_t)width * height;
+    for (size_t i = 0; i < pixel_count; i++) {
+        const float *pixel = colour->pixels + 4 * i;
+        float count = pixel[3];
+        for (int c = 0; c < 3; c++)
+            layers->pixels[3 * i + c] =
+                count > 0 ? fmaxf(0.0f, squares[4 * i + c] / count - pixel[c] * pixel[c]) : 0.0f;
+    }
+    return RT_OK;
+}
+
+/* Reads the tracer's sums of squares and adds the variance layers to result->aovs (after
+ * the AOVs when there are any). */
+static rt_status add_variance_layers(gpu_tracer *tracer, int width, int height, render_result *result,
+                                     rt_error *error)
+{
+    float *squares = malloc((size_t)width * height * 4 * sizeof *squares);
+    if (squares == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
+    rt_image layers = {0};
+    rt_status status = gpu_tracer_read_squares(tracer, squares, error);
+    if (status == RT_OK)
+        status = variance_layers(width, height, &result->image, squares, &layers, error);
+    free(squares);
+    if (status == RT_OK && result->aovs.pixels != NULL) {
+        rt_image joined;
+        status = image_append_channels(&result->aovs, &layers, &joined, error);
+        if (status == RT_OK) {
+            image_free(&result->aovs);
+            result->aovs = joined;
+        }
+        image_free(&layers);
+    } else if (status == RT_OK) {
+        result->aovs = layers;
+    }
+    return status;
+}
+
 /* Turns a partial result (R, G, B means and a samples channel, region-sized) back into the
  * tracer's sums. Returns an allocated width*height*4 array or NULL with error set. */
 static float *resume_sums(const rt_image *partial, int width, int height, uint32_t samples_per_pixel,
@@ -394,7 +446,7 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
     }
 }
 
-/* The read-back of render_scene: the image (and with options->aovs the AOVs) into
+/* The read-back of render_scene: the image (and the AOVs and variance layers asked for) into
  * *result, with the path segments; an error, with nothing allocated, when a path
  * reached the work cap. */
 static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const render_options *options, int width,
@@ -412,6 +464,8 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const ren
         status = read_image(tracer, width, height, &result->image, luminance_squares, &totals, &result->samples, error);
     if (status == RT_OK && options->aovs)
         status = render_aovs(tracer, width, height, &result->image, luminance_squares, &result->aovs, error);
+    if (status == RT_OK && options->variance)
+        status = add_variance_layers(tracer, width, height, result, error);
     free(luminance_squares);
     if (status != RT_OK) {
         image_free(&result->image);
@@ -422,6 +476,7 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const ren
         gpu_info device;
         gpu_get_info(context, &device);
         image_free(&result->image);
+        image_free(&result->aovs);
         return rt_error_set(error, RT_ERROR_RUNTIME,
                             "RENDER: %.0f paths reached the shader's work cap (%d loop iterations per pass, "
                             "`rtspheres info`) or the traversal stack and were cut short; the image would be "

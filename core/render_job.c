@@ -223,6 +223,7 @@ static void image_render_options(job_image *image, render_options *options)
     options->sample_start = image->plan.sample_start;
     memcpy(options->region, image->plan.region, sizeof options->region);
     options->aovs = job->aovs || job->denoise;
+    options->variance = job->variance;
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;
     options->stop_requested = job->stop_requested;
