@@ -13,6 +13,7 @@
 #   golden   re-render the golden images in golden/ (never run by the tests; say why in
 #            the commit when you commit new ones)
 #   deps     install the Debian packages listed in .ci/debian-packages that are missing
+#   test-deps  the same for .ci/test-packages, what only the tests need (a browser)
 #   bench-deps  the same for .ci/bench-packages, the bench's peers (never the tests')
 #   fuzz     build the libFuzzer harnesses (tests/fuzz/) with clang into build-fuzz/ and
 #            fuzz each for FUZZ_SECONDS; the corpus found grows in build-fuzz/corpus/
@@ -35,7 +36,7 @@
 #              tests/bench/peers.sh say what each does)
 
 all: rtspheres
-.PHONY: all demo test bench bench-deps golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
+.PHONY: all demo test bench bench-deps test-deps golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
 
 CC ?= cc
 CXX ?= c++
@@ -117,8 +118,8 @@ $(BUILD)/tests/%: tests/unit/%.c $(LIBRARY)
 unit-tests: $(UNIT_TESTS)
 
 # Installs what the list $(1) names and dpkg says is missing (sudo when not root); $(2)
-# is the target, for the message. deps: what rtspheres and its tests need; bench-deps:
-# the bench's peers.
+# is the target, for the message. deps: what rtspheres and its tests need; test-deps:
+# what only the tests need; bench-deps: the bench's peers.
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 define install_missing
 	@missing=$$(grep -v '^\s*#' $(1) | while read -r p; do \
@@ -133,6 +134,9 @@ define install_missing
 endef
 deps:
 	$(call install_missing,.ci/debian-packages,deps)
+
+test-deps: deps
+	$(call install_missing,.ci/test-packages,test-deps)
 
 bench-deps:
 	$(call install_missing,.ci/bench-packages,bench-deps)
@@ -169,7 +173,7 @@ $(BUILD)/keep-libraries-loaded.so: tests/sanitizers/keep_libraries_loaded.c
 	@mkdir -p $(dir $@)
 	$(Q)$(CC) -shared -fPIC -O2 -Wall -Wextra $< -o $@
 
-test: deps
+test: test-deps
 	$(Q)$(MAKE) --no-print-directory $(PROGRAM) unit-tests $(SAN_TEST_SHIM)
 	$(Q)$(if $(SAN_TEST_ENV),rm -rf $(SAN_REPORTS) && mkdir -p $(SAN_REPORTS) && )$(SAN_TEST_ENV) V=$(V) sh tests/run.sh \
 		$(BUILD) ./$(PROGRAM) $(TESTS)

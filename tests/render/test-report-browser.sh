@@ -1,8 +1,7 @@
 #!/bin/sh
 # test-report-browser.sh: the HTML report of `rtspheres check --report` in a real browser,
-# headless Chromium (Debian's `chromium`; installed here when missing and this runs as root,
-# as CI does: it is too big for .ci/debian-packages; skipped, with the reason, when it
-# cannot be had or cannot start). The report is copied to another folder first, as a CI
+# headless Chromium (Debian's `chromium`, listed in .ci/test-packages, which `make test`
+# installs when missing; skipped, with the reason, when it is not there or cannot start). The report is copied to another folder first, as a CI
 # artefact is, and opened from there: every image must load (the page's own script counts
 # the images with a natural width into #image-check, read back with --dump-dom), a
 # screenshot must show a page, nothing may come from the network, and the failing case
@@ -48,20 +47,8 @@ else fail "report order" "first section: $first"; fi
 
 # ---- the browser -----------------------------------------------------------------------
 browser=$(command -v chromium || command -v chromium-browser || true)
-if [ -z "$browser" ] && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-    echo "test-report-browser: installing Debian's chromium (once; about 100 MB)"
-    if ! DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium \
-        >"$scratch/apt.log" 2>&1; then
-        apt-get update -q >>"$scratch/apt.log" 2>&1
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium \
-            >>"$scratch/apt.log" 2>&1
-    fi
-    browser=$(command -v chromium || true)
-fi
 if [ -z "$browser" ]; then
-    why="chromium is not installed"
-    [ "$(id -u)" = 0 ] || why="$why and this is not root (apt-get install chromium)"
-    [ -s "$scratch/apt.log" ] && why="$why; apt-get: $(tail -n 1 "$scratch/apt.log")"
+    why="chromium is not installed (make test-deps installs .ci/test-packages)"
     echo "SKIP report in a browser: $why"
     finish
     exit
