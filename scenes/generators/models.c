@@ -1,5 +1,7 @@
 /* models.c: writes the glTF, PLY and OBJ files the importers' tests and the benchmark use
- * (never committed: the tests write them into their scratch directories).
+ * (the tests write them into their scratch directories; only model.glb is committed, as
+ * scenes/assets/model.glb, the golden suite's glTF scene, which test-importers.sh checks
+ * is this generator's output byte for byte).
  *
  * Build and run from the repository root:
  *   cc -std=c11 -O2 scenes/generators/models.c -lm -o /tmp/models && /tmp/models DIR

@@ -22,6 +22,11 @@ if ! cc -std=c11 -O2 scenes/generators/models.c -lm -o "$scratch/models-generato
 fi
 options="--size 64x32 --spp 4 --max-depth 6 --quiet"
 
+# The golden suite's glTF scene is this generator's model.glb, committed.
+if cmp -s "$models/model.glb" scenes/assets/model.glb; then
+    pass "scenes/assets/model.glb is scenes/generators/models.c's model.glb byte for byte"
+else fail "scenes/assets/model.glb" "differs from the generator's model.glb (regenerate and commit it)"; fi
+
 # render_ok NAME OUTPUT SCENE [OPTIONS...]: renders SCENE to OUTPUT, a failure is one check.
 render_ok() {
     lib_name=$1 lib_output=$2 lib_scene=$3
