@@ -475,26 +475,34 @@ static void instanced_scene(scene *s, uint64_t seed)
     instanced_scene_placed(s, seed, false);
 }
 
+/* A random ray for the brute-force tests: an origin in the 30-unit cube around the scene
+ * and a unit direction, in float (of, df) and the same values in double (o, d). */
+static void random_test_ray(double o[3], double d[3], float of[3], float df[3])
+{
+    double length = 0;
+    for (int i = 0; i < 3; i++) {
+        o[i] = random_unit() * 30 - 15;
+        d[i] = random_unit() * 2 - 1;
+        length += d[i] * d[i];
+    }
+    length = sqrt(length);
+    for (int i = 0; i < 3; i++) {
+        of[i] = (float)o[i];
+        df[i] = (float)(d[i] / length);
+        o[i] = of[i];
+        d[i] = df[i];
+    }
+}
+
 /* The packed traversal of one packed scene s finds the brute-force nearest hit (in
  * double, every placed shape in its object's coordinates) for random rays. */
 static void traversal_matches_brute_force(const scene *s, const packed_scene *packed, uint64_t seed)
 {
     int hits = 0, grazes = 0;
     for (int r = 0; r < 3000; r++) {
-        double o[3], d[3], length = 0;
-        for (int i = 0; i < 3; i++) {
-            o[i] = random_unit() * 30 - 15;
-            d[i] = random_unit() * 2 - 1;
-            length += d[i] * d[i];
-        }
-        length = sqrt(length);
+        double o[3], d[3];
         float of[3], df[3];
-        for (int i = 0; i < 3; i++) {
-            of[i] = (float)o[i];
-            df[i] = (float)(d[i] / length);
-            o[i] = of[i];
-            d[i] = df[i];
-        }
+        random_test_ray(o, d, of, df);
         double time = random_unit();
         double expected = brute_force(s, (float)time, o, d);
         packed_hit hit;
@@ -571,20 +579,9 @@ static void shadow_rays_match_brute_force(void **state)
         assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
         int blocked_count = 0, through = 0, to_volume = 0;
         for (int r = 0; r < 3000; r++) {
-            double o[3], d[3], length = 0;
-            for (int i = 0; i < 3; i++) {
-                o[i] = random_unit() * 30 - 15;
-                d[i] = random_unit() * 2 - 1;
-                length += d[i] * d[i];
-            }
-            length = sqrt(length);
+            double o[3], d[3];
             float of[3], df[3];
-            for (int i = 0; i < 3; i++) {
-                of[i] = (float)o[i];
-                df[i] = (float)(d[i] / length);
-                o[i] = of[i];
-                d[i] = df[i];
-            }
+            random_test_ray(o, d, of, df);
             float t_max = (float)(random_unit() * 40);
             /* The light: a world sphere (world primitives keep the scene's order first). */
             int light = r % 2 ? (int)(random_unit() * s.sphere_count) : -1;
