@@ -9,6 +9,10 @@
 #include "hash.h"
 #include "pack_internal.h"
 
+/* The shader's traversal stack keeps a leaf's primitive count in the 32 - PACKED_FIRST_BITS
+ * top bits of a word, beside the counts 6 and 7 that mark instances (glsl/traverse.glsl). */
+_Static_assert(BVH_MAX_LEAF_SIZE < 6 && 32 - PACKED_FIRST_BITS >= 3, "a leaf's count must fit below the instance marks");
+
 pack_options pack_options_defaults(void)
 {
     return (pack_options){0};
