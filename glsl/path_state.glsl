@@ -25,13 +25,17 @@ struct PixelState {
     uint finished_here;     // samples finished in this pass
 };
 
+// The samples this pixel may start in this pass at most (glsl/main.glsl sets it:
+// samples_per_pixel, or less where adaptive sampling holds the pixel back).
+uint sample_limit;
+
 // Prepares the next segment: starts a sample (its camera ray) when no path is in flight,
 // and counts the segment's work. False when the pixel stops for this pass: no samples
 // left, or its work budget spent.
 bool begin_segment(inout PixelState s)
 {
     if (s.bounce == 0u) {
-        if (s.samples_started >= samples_per_pixel || work >= pass_work_budget)
+        if (s.samples_started >= sample_limit || work >= pass_work_budget)
             return false;
         rng_sample = sample_start + s.samples_started;
         s.samples_started++;
