@@ -205,8 +205,8 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
  * without EXR; resume with several frames; shard_by without shard; a shard by frames
  * without frames, or with no frame; a shard by samples with a sample range; a shard by
- * tiles with crop or tile; a noise threshold with a shard by samples, a sample range or
- * resume. */
+ * tiles with crop or tile; a minimum spp without a noise threshold; a noise threshold
+ * with a shard by samples, a sample range or resume. */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 
 /* True when the frame at position index of job->frames is this job's to render (always,

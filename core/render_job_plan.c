@@ -135,6 +135,8 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--resume continues one image; render the frames one at a time");
     status = plan_shard(job, plan, error);
+    if (status == RT_OK && job->tracer.min_spp && !(job->tracer.noise_threshold > 0))
+        return rt_error_set(error, RT_ERROR_INPUT, "--min-spp does nothing without --noise-threshold");
     if (status != RT_OK || !(job->tracer.noise_threshold > 0))
         return status;
     /* Each part would stop its pixels on its own samples, so parts would not add up. */
