@@ -46,6 +46,8 @@ static void print_help(FILE *stream)
             "      --time-limit SECS  end within about one pass of SECS seconds after the command\n"
             "                         started (per image with --frames), writing what it has\n"
             "                         (continue it with --resume OUTPUT.exr)\n"
+            "      --samples-map FILE also write each pixel's samples / spp as a grey image\n"
+            "                         (white: --spp): where the time went\n"
             "      --checkpoint SECS  every SECS seconds, write the image so far to\n"
             "                         OUTPUT-without-extension.partial.exr\n"
             "      --resume PARTIAL   continue a partial render (a checkpoint, or what Ctrl-C\n"
@@ -84,7 +86,7 @@ enum {
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
     OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER, OPTION_NOISE_THRESHOLD,
-    OPTION_MIN_SPP, OPTION_TIME_LIMIT,
+    OPTION_MIN_SPP, OPTION_TIME_LIMIT, OPTION_SAMPLES_MAP,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -341,6 +343,7 @@ static int take_option(int option, const char *value, render_arguments *argument
     switch (option) {
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
+    case OPTION_SAMPLES_MAP: job->samples_map = value; break;
     case OPTION_AOVS: job->aovs = true; break;
     case OPTION_DENOISE: job->denoise = true; break;
     case OPTION_FULL_TRACER: job->tracer.full_tracer = true; break;
@@ -400,6 +403,7 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
         {"noise-threshold", required_argument, NULL, OPTION_NOISE_THRESHOLD},
         {"min-spp", required_argument, NULL, OPTION_MIN_SPP},
         {"time-limit", required_argument, NULL, OPTION_TIME_LIMIT},
+        {"samples-map", required_argument, NULL, OPTION_SAMPLES_MAP},
         {"resume", required_argument, NULL, OPTION_RESUME},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
         {"sampler", required_argument, NULL, OPTION_SAMPLER},

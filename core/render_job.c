@@ -187,6 +187,22 @@ static rt_status postprocess_result(const render_job *job, const char *output, r
     return status;
 }
 
+/* Writes the samples channel of image (R, G, B, samples) to path as grey samples / spp. */
+static rt_status write_samples_map(const char *path, const rt_image *image, int samples_per_pixel, rt_error *error)
+{
+    rt_image map;
+    rt_status status = image_create(&map, image->width, image->height, 3, error);
+    if (status != RT_OK)
+        return status;
+    for (size_t i = 0; i < (size_t)image->width * image->height; i++)
+        for (int c = 0; c < 3; c++)
+            map.pixels[3 * i + c] = image->pixels[4 * i + 3] / (float)samples_per_pixel;
+    image_write_options options = image_write_options_defaults();
+    status = image_write(path, &map, &options, error);
+    image_free(&map);
+    return status;
+}
+
 /* After the passes: writes the result, post-processed, to the output when the render
  * finished, else (render_status RT_ERROR_INTERRUPTED) as it is to the partial file, which
  * the message then names. */
@@ -211,6 +227,10 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
         return status;
     status = write_image(image, &result->image, plan->output, result->samples,
                          result->stop_reason != RENDER_STOP_TIME, false, result, error);
+    if (status != RT_OK)
+        return status;
+    if (image->run->job->samples_map != NULL)
+        status = write_samples_map(image->run->job->samples_map, &result->image, plan->samples_per_pixel, error);
     if (status != RT_OK)
         return status;
     /* The checkpoint is ours and now superseded by the complete image. */

@@ -34,6 +34,11 @@
  *                           colour as noisy.R/G/B
  *   blur_sigma, blur_passes sigma 0: no blur; passes 0: 1
  *   tonemap, exposure       for 8-bit outputs: TONEMAP_CLAMP and 0 stops
+ *   samples_map             NULL: none; else also write each pixel's samples / spp as a
+ *                           grey image there (any format: white is spp samples; an
+ *                           8-bit format's sRGB curve brightens the few): where the
+ *                           time went with adaptive sampling or a time limit; one image
+ *                           only (not with several frames)
  *   time_limit_seconds      0: none; else each image ends within about one pass of this
  *                           many seconds after its start (render_options.deadline), and
  *                           is written with what it has (rtspheres:stop_reason time)
@@ -121,6 +126,7 @@ typedef struct render_job {
     int blur_passes;
     postprocess_tonemap_operator tonemap;
     double exposure;
+    const char *samples_map;
     double time_limit_seconds;
     double time_limit_start;
     render_options tracer;
@@ -205,7 +211,8 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
  * without EXR; resume with several frames; shard_by without shard; a shard by frames
  * without frames, or with no frame; a shard by samples with a sample range; a shard by
- * tiles with crop or tile; a minimum spp without a noise threshold; a noise threshold
+ * tiles with crop or tile; a samples map with several frames or of an unknown format;
+ * a minimum spp without a noise threshold; a noise threshold
  * with a shard by samples, a sample range or resume. */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 

@@ -134,6 +134,12 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
     if (job->resume_path != NULL && job->frame_count > 1)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--resume continues one image; render the frames one at a time");
+    if (job->samples_map != NULL && job->frame_count > 1)
+        return rt_error_set(error, RT_ERROR_INPUT, "--samples-map writes one image; not with several frames");
+    if (job->samples_map != NULL && image_format_of(job->samples_map) == IMAGE_FORMAT_UNKNOWN)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "cannot tell the format of --samples-map '%s'; use .png, .exr, .hdr, .jpg or .tif",
+                            job->samples_map);
     status = plan_shard(job, plan, error);
     if (status == RT_OK && job->tracer.min_spp && !(job->tracer.noise_threshold > 0))
         return rt_error_set(error, RT_ERROR_INPUT, "--min-spp does nothing without --noise-threshold");
