@@ -39,7 +39,8 @@ uint32_t adaptive_next_check(uint32_t samples, uint32_t min_spp, uint32_t max_sp
 int adaptive_reach(uint32_t min_spp, uint32_t max_spp)
 {
     int checks = 0;
-    for (uint32_t n = adaptive_next_check(0, min_spp, max_spp); n < max_spp; n = adaptive_next_check(n, min_spp, max_spp))
+    uint32_t n = adaptive_next_check(0, min_spp, max_spp);
+    for (; n < max_spp; n = adaptive_next_check(n, min_spp, max_spp))
         checks++;
     return checks;
 }
@@ -184,8 +185,9 @@ int adaptive_pass_rectangles(const adaptive_sampler *sampler, bool settle, int *
                 int *r = rectangles + 4 * count++;
                 r[0] = run_start * ADAPTIVE_TILE_SIZE;
                 r[1] = ty * ADAPTIVE_TILE_SIZE;
-                r[2] = tx * ADAPTIVE_TILE_SIZE < sampler->width ? tx * ADAPTIVE_TILE_SIZE : sampler->width;
-                r[3] = (ty + 1) * ADAPTIVE_TILE_SIZE < sampler->height ? (ty + 1) * ADAPTIVE_TILE_SIZE : sampler->height;
+                int x1 = tx * ADAPTIVE_TILE_SIZE, y1 = (ty + 1) * ADAPTIVE_TILE_SIZE;
+                r[2] = x1 < sampler->width ? x1 : sampler->width;
+                r[3] = y1 < sampler->height ? y1 : sampler->height;
                 run_start = -1;
             }
         }

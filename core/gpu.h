@@ -203,9 +203,10 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
 rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limits, rt_error *error);
 
 /* Makes the following passes run only the pixels of count rectangles (4 ints each: x0, y0,
- * x1, y1 of the image, rows from the top, x1/y1 exclusive; copied): the pixels outside
- * keep their state in the set the pass reads, not in the one it writes, so a pixel may be
- * left out only when a pass has run it without it changing (core/adaptive.h, "Tiles").
+ * x1, y1 of the image, rows from the top, x1/y1 exclusive; copied). A pixel outside is
+ * not written, so the state set the pass writes keeps what it held two passes before:
+ * leave a pixel out only once a pass has run it without changing it, so that both sets
+ * hold its state (core/adaptive.h, "Tiles").
  * rectangles NULL: every pixel again (the default). */
 rt_status gpu_tracer_set_pass_rectangles(gpu_tracer *tracer, const int *rectangles, int count, rt_error *error);
 

@@ -251,8 +251,8 @@ static float *resume_sums(const rt_image *partial, int width, int height, uint32
  * checks the resumed partial against the hash and creates the tracer (*tracer, which the
  * caller destroys) with the partial's sums. *region is the region of the result, *traced
  * the region the tracer renders (region, and with adaptive sampling the pixels around it
- * whose decisions reach into it), *samples_resumed the samples the partial brought and *pass_work_budget the first pass's
- * budget. On failure nothing is left to free. */
+ * whose decisions reach into it), *samples_resumed the samples the partial brought and
+ * *pass_work_budget the first pass's budget. On failure nothing is left to free. */
 static rt_status set_up_tracer(gpu_context *context, const scene *s, const render_options *options,
                                render_result *result, int region[4], int traced[4], uint64_t *samples_resumed,
                                gpu_tracer **tracer, uint32_t *pass_work_budget, rt_error *error)
@@ -349,6 +349,15 @@ static void adapt_pass_budget(gpu_tracer *tracer, double pass_seconds, double ta
     *budget *= scale;
     *budget = *budget < MINIMUM_ADAPTIVE_BUDGET ? MINIMUM_ADAPTIVE_BUDGET : *budget > most_budget ? most_budget : *budget;
     gpu_tracer_set_pass_work_budget(tracer, (uint32_t)*budget);
+}
+
+/* Returns the sum of image's samples channel (the fourth of R, G, B, samples). */
+static uint64_t sample_total(const rt_image *image)
+{
+    uint64_t total = 0;
+    for (size_t i = 0; i < (size_t)image->width * image->height; i++)
+        total += (uint64_t)image->pixels[4 * i + 3];
+    return total;
 }
 
 /* Cuts *image (of the traced region) down to region, in place; nothing when they are the
@@ -461,9 +470,7 @@ static rt_status write_checkpoint(gpu_tracer *tracer, const render_options *opti
                                   &partial_samples, error);
     if (status == RT_OK && memcmp(traced, region, 4 * sizeof *traced) != 0) {
         status = crop_to_region(&partial, traced, region, error);
-        partial_samples = 0;
-        for (size_t i = 0; status == RT_OK && i < (size_t)partial.width * partial.height; i++)
-            partial_samples += (uint64_t)partial.pixels[4 * i + 3];
+        partial_samples = status == RT_OK ? sample_total(&partial) : 0;
     }
     if (status == RT_OK)
         status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, scene_hash, error);
@@ -623,9 +630,8 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         status = crop_to_region(&result->image, traced, region, error);
         if (status == RT_OK)
             status = crop_to_region(&result->aovs, traced, region, error);
-        result->samples = 0;
-        for (size_t i = 0; status == RT_OK && i < (size_t)result->image.width * result->image.height; i++)
-            result->samples += (uint64_t)result->image.pixels[4 * i + 3];
+        if (status == RT_OK)
+            result->samples = sample_total(&result->image);
         if (status != RT_OK) {
             image_free(&result->image);
             image_free(&result->aovs);

@@ -215,7 +215,8 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
          * raw means and sample counts: --resume adds samples to them, so denoised, blurred
          * or tone-mapped colour there would be processed twice. */
         rt_error write_error = {{0}};
-        if (write_image(image, &result->image, plan->partial, result->samples, false, false, result, &write_error) != RT_OK)
+        if (write_image(image, &result->image, plan->partial, result->samples, false, false, result, &write_error)
+            != RT_OK)
             return rt_error_set(error, RT_ERROR_INTERRUPTED, "interrupted, and the partial could not be written: %s",
                                 write_error.message);
         return rt_error_set(error, RT_ERROR_INTERRUPTED,
