@@ -7,10 +7,14 @@
  *
  * ## The job
  * A plain struct; zero means default (render_job_defaults() returns it all zero):
- *   scene_path, output      required; output is a name pattern (batch.h): with frames each
+ *   scene_path, output      required; scene_path a scene file, or a glTF file (.gltf, .glb:
+ *                           a scene by itself, scene_gltf.h); output is a name pattern (batch.h): with frames each
  *                           frame formats it, without them it is formatted once with the
  *                           value of the last define of `frame`, else with 0
- *   defines                 scene variables (scene_parse.h) for every image; none
+ *   defines                 scene variables (scene_parse.h) for every image; none (a glTF
+ *                           scene has no variables: a define is refused)
+ *   camera                  NULL: the scene's camera; a glTF scene's camera (or camera
+ *                           node) of that name; only for a glTF scene
  *   frames                  frame numbers to render (batch.h frame_list); none: one image
  *                           without $frame and $time. Each frame sets $frame and $time =
  *                           frame / frames_per_second (default 24) as optional variables.
@@ -30,6 +34,7 @@
  *   resume_path             NULL: start afresh; else continue that partial file
  *   checkpoint_seconds      0: never; else write the partial file that often
  *   aovs                    add the AOV layers (render.h) to an EXR
+ *   variance                add the variance layers variance.R/G/B (render.h) to an EXR
  *   denoise                 postprocess_denoise() guided by the AOVs; an EXR keeps the noisy
  *                           colour as noisy.R/G/B
  *   blur_sigma, blur_passes sigma 0: no blur; passes 0: 1
@@ -48,8 +53,8 @@
  *                           per image, so a job of F frames ends within about F times it
  *   tracer                  how each image is traced (render.h; zero = its defaults; its
  *                           noise_threshold and min_spp: adaptive sampling). The job sets
- *                           its sample_start, region, aovs, progress, stop_requested,
- *                           deadline, resume and checkpoint fields itself.
+ *                           its sample_start, region, aovs, variance, progress,
+ *                           stop_requested, deadline, resume and checkpoint fields itself.
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
  *
@@ -105,6 +110,7 @@ typedef enum render_job_shard_kind {
 typedef struct render_job {
     const char *scene_path;
     const char *output;
+    const char *camera;
     const scene_define *defines;
     int define_count;
     const int *frames;
@@ -121,6 +127,7 @@ typedef struct render_job {
     const char *resume_path;
     double checkpoint_seconds;
     bool aovs;
+    bool variance;
     bool denoise;
     float blur_sigma;
     int blur_passes;
@@ -209,7 +216,7 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * with the first rule broken, in this order: a define of frame or time with frames; the
  * first output name (batch.h's errors; several frames and no frame number in the
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
- * without EXR; resume with several frames; shard_by without shard; a shard by frames
+ * without EXR; variance without EXR; variance with resume; resume with several frames; shard_by without shard; a shard by frames
  * without frames, or with no frame; a shard by samples with a sample range; a shard by
  * tiles with crop or tile; a samples map with several frames or of an unknown format;
  * a minimum spp without a noise threshold; a noise threshold
