@@ -44,7 +44,7 @@
 #include "status.h"
 
 #define ADAPTIVE_DEFAULT_MIN_SPP 16
-#define ADAPTIVE_LUMINANCE_FLOOR 0.05f
+#define ADAPTIVE_LUMINANCE_FLOOR 0.2f
 #define ADAPTIVE_TILE_SIZE 8
 
 typedef struct adaptive_sampler adaptive_sampler;
