@@ -120,6 +120,12 @@ static void show_summary(void *user, const render_job_image *image, const render
                 shown->arguments->job.scene_path, image->output, result->image.width, result->image.height,
                 image->samples_per_pixel, result->seconds, result->samples / result->seconds,
                 result->path_segments / result->seconds, result->passes, result->passes == 1 ? "" : "es");
+    if (!shown->arguments->quiet && result->stop_reason != RENDER_STOP_SAMPLES) {
+        double pixels = (double)result->image.width * result->image.height;
+        fprintf(stderr, "rtspheres: stopped by %s with %.1f samples per pixel on average\n",
+                result->stop_reason == RENDER_STOP_NOISE ? "the noise threshold" : "the time limit",
+                pixels > 0 ? (double)result->samples / pixels : 0.0);
+    }
 }
 
 /* gpu_options.log: the GPU's set-up details and debug messages (--verbose). */
@@ -212,6 +218,7 @@ int command_render(int argc, char **argv)
     signal(SIGINT, on_stop_signal);
     signal(SIGTERM, on_stop_signal);
     arguments.job.stop_requested = &stop_requested;
+    arguments.job.time_limit_start = command_start;  /* --time-limit counts from here */
     gpu_context *context = NULL;
     exit_code = open_gpu(&arguments, &context);
     if (exit_code == EXIT_OK) {

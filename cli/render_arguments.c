@@ -42,6 +42,15 @@ static void print_help(FILE *stream)
             "      --shard I/N        part I of N of the work (see --shard-by); for job arrays\n"
             "      --shard-by KIND    frames, samples or tiles (default: frames when --frames\n"
             "                         lists several, otherwise samples)\n"
+            "      --noise-threshold T  adaptive sampling: a pixel stops once the relative standard\n"
+            "                         error of its mean luminance is under T (e.g. 0.05) and its\n"
+            "                         3x3 neighbours' is too; --spp is the most it takes\n"
+            "      --min-spp N        samples every pixel takes before that check (default 16)\n"
+            "      --time-limit SECS  end within about one pass of SECS seconds after the command\n"
+            "                         started (per image with --frames), writing what it has\n"
+            "                         (continue it with --resume OUTPUT.exr)\n"
+            "      --samples-map FILE also write each pixel's samples / spp as a grey image\n"
+            "                         (white: --spp): where the time went\n"
             "      --checkpoint SECS  every SECS seconds, write the image so far to\n"
             "                         OUTPUT-without-extension.partial.exr\n"
             "      --resume PARTIAL   continue a partial render (a checkpoint, or what Ctrl-C\n"
@@ -83,6 +92,7 @@ enum {
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
     OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER, OPTION_CAMERA,
+    OPTION_NOISE_THRESHOLD, OPTION_MIN_SPP, OPTION_TIME_LIMIT, OPTION_SAMPLES_MAP,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -157,6 +167,11 @@ static const char *take_whole_number(int option, const char *value, render_argum
             return "--roulette-depth wants a whole number from 1 to 100000";
         job->tracer.russian_roulette_depth = (uint32_t)number;
         return NULL;
+    case OPTION_MIN_SPP:
+        if (command_parse_integer(value, 2, 1 << 30, &number))
+            return "--min-spp wants a whole number from 2 to 1073741824";
+        job->tracer.min_spp = (uint32_t)number;
+        return NULL;
     case OPTION_DEVICE:
         if (command_parse_integer(value, 0, 255, &number))
             return "--device wants a device number (0, 1, ...)";
@@ -204,6 +219,18 @@ static const char *take_value(int option, const char *value, render_job *job)
         if (!parse_real(value, &job->checkpoint_seconds) || !(job->checkpoint_seconds > 0)
             || job->checkpoint_seconds > 1e7)
             return "--checkpoint wants a positive number of seconds";
+        return NULL;
+    case OPTION_NOISE_THRESHOLD: {
+        double threshold = 0;
+        if (!parse_real(value, &threshold) || !(threshold > 0) || threshold > 1e6)
+            return "--noise-threshold wants a positive number, e.g. 0.05 (a relative standard error)";
+        job->tracer.noise_threshold = (float)threshold;
+        return NULL;
+    }
+    case OPTION_TIME_LIMIT:
+        if (!parse_real(value, &job->time_limit_seconds) || !(job->time_limit_seconds > 0)
+            || job->time_limit_seconds > 1e7)
+            return "--time-limit wants a positive number of seconds";
         return NULL;
     case OPTION_BLUR: {
         char extra;
@@ -323,6 +350,7 @@ static int take_option(int option, const char *value, render_arguments *argument
     switch (option) {
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
+    case OPTION_SAMPLES_MAP: job->samples_map = value; break;
     case OPTION_CAMERA: job->camera = value; break;
     case OPTION_AOVS: job->aovs = true; break;
     case OPTION_VARIANCE: job->variance = true; break;
@@ -335,6 +363,7 @@ static int take_option(int option, const char *value, render_arguments *argument
     case OPTION_SEED:
     case OPTION_PASS_BUDGET:
     case OPTION_ROULETTE_DEPTH:
+    case OPTION_MIN_SPP:
     case OPTION_DEVICE:
         complaint = take_whole_number(option, value, arguments);
         break;
@@ -386,6 +415,10 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
         {"shard", required_argument, NULL, OPTION_SHARD},
         {"shard-by", required_argument, NULL, OPTION_SHARD_BY},
         {"checkpoint", required_argument, NULL, OPTION_CHECKPOINT},
+        {"noise-threshold", required_argument, NULL, OPTION_NOISE_THRESHOLD},
+        {"min-spp", required_argument, NULL, OPTION_MIN_SPP},
+        {"time-limit", required_argument, NULL, OPTION_TIME_LIMIT},
+        {"samples-map", required_argument, NULL, OPTION_SAMPLES_MAP},
         {"resume", required_argument, NULL, OPTION_RESUME},
         {"camera", required_argument, NULL, OPTION_CAMERA},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},

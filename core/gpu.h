@@ -202,6 +202,20 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
  * random numbers belong to samples, not passes); only the time per pass does. */
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
 
+/* Sets each pixel's sample limit: limits holds width*height counts, rows top to bottom; a
+ * pixel starts no sample at or past min(its limit, samples_per_pixel) (a path in flight
+ * finishes). Until called, only samples_per_pixel limits. For adaptive sampling
+ * (core/adaptive.h). */
+rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limits, rt_error *error);
+
+/* Makes the following passes run only the pixels of count rectangles (4 ints each: x0, y0,
+ * x1, y1 of the image, rows from the top, x1/y1 exclusive; copied). A pixel outside is
+ * not written, so the state set the pass writes keeps what it held two passes before:
+ * leave a pixel out only once a pass has run it without changing it, so that both sets
+ * hold its state (core/adaptive.h, "Tiles").
+ * rectangles NULL: every pixel again (the default). */
+rt_status gpu_tracer_set_pass_rectangles(gpu_tracer *tracer, const int *rectangles, int count, rt_error *error);
+
 /* Reads the accumulated result: rgba receives width*height*4 floats, rows top to bottom,
  * (sum of finished samples' radiance r, g, b, number of finished samples);
  * luminance_squares (may be NULL) width*height floats: the sum of each finished sample's

@@ -20,6 +20,9 @@ struct gpu_tracer {
     GLuint framebuffers[2];
     GLuint counter_buffer;
     GLuint parameter_buffer;     /* the parameter block (tracer_parameter_block) */
+    GLuint sample_limits;        /* R32UI per-pixel sample limits (TRACER_SAMPLE_LIMITS_UNIT) */
+    int *pass_rectangles;        /* 4 ints each (gpu_tracer_set_pass_rectangles); NULL: all */
+    int pass_rectangle_count;
     int current;                 /* which state set holds the latest pass */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
     bool reused_scene;           /* the packed scene was already on the device */
@@ -342,6 +345,14 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
                 glClearBufferfv(GL_COLOR, target, zero);
         }
     }
+    /* No limit but samples_per_pixel until gpu_tracer_set_sample_limits says otherwise. */
+    glGenTextures(1, &tracer->sample_limits);
+    glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32UI, tracer->width, tracer->height);
+    const GLuint no_limit[4] = {UINT32_MAX, 0, 0, 0};
+    glClearTexImage(tracer->sample_limits, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, no_limit);
     rt_status status = check_gl("creating the state textures", error);
     if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
         return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for a %dx%d image's state (%d MB)",
@@ -487,8 +498,21 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     }
     glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
     glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
+    glActiveTexture(GL_TEXTURE0 + TRACER_SAMPLE_LIMITS_UNIT);
+    glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
     glBindVertexArray(tracer->vertex_array);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (tracer->pass_rectangles == NULL) {
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    } else {
+        /* One scissored full-screen triangle per rectangle: only its pixels run. */
+        glEnable(GL_SCISSOR_TEST);
+        for (int i = 0; i < tracer->pass_rectangle_count; i++) {
+            const int *r = tracer->pass_rectangles + 4 * i;
+            glScissor(r[0], tracer->height - r[3], r[2] - r[0], r[3] - r[1]);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        }
+        glDisable(GL_SCISSOR_TEST);
+    }
     glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     GLuint counters[2] = {0, 0};
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof counters, counters);
@@ -503,6 +527,36 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
     tracer->parameters.shader.pass_work_budget = (int32_t)clamp_budget(&tracer->context->info, budget);
     update_parameter(tracer, offsetof(tracer_parameter_block, pass_work_budget),
                      tracer->parameters.shader.pass_work_budget);
+}
+
+rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limits, rt_error *error)
+{
+    size_t row = (size_t)tracer->width;
+    uint32_t *bottom_up = malloc(row * tracer->height * sizeof *bottom_up);
+    if (bottom_up == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the sample limits");
+    for (int y = 0; y < tracer->height; y++)
+        memcpy(bottom_up + (size_t)y * row, limits + (size_t)(tracer->height - 1 - y) * row, row * sizeof *limits);
+    glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RED_INTEGER, GL_UNSIGNED_INT, bottom_up);
+    free(bottom_up);
+    return check_gl("setting the sample limits", error);
+}
+
+rt_status gpu_tracer_set_pass_rectangles(gpu_tracer *tracer, const int *rectangles, int count, rt_error *error)
+{
+    free(tracer->pass_rectangles);
+    tracer->pass_rectangles = NULL;
+    tracer->pass_rectangle_count = 0;
+    if (rectangles == NULL)
+        return RT_OK;
+    tracer->pass_rectangles = malloc((count > 0 ? (size_t)count : 1) * 4 * sizeof *rectangles);
+    if (tracer->pass_rectangles == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the pass rectangles");
+    memcpy(tracer->pass_rectangles, rectangles, (size_t)count * 4 * sizeof *rectangles);
+    tracer->pass_rectangle_count = count;
+    return RT_OK;
 }
 
 /* Reads one state texture of the latest set into rows top to bottom. */
@@ -632,6 +686,8 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
     glDeleteBuffers(1, &tracer->counter_buffer);
     glDeleteBuffers(1, &tracer->parameter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);
+    glDeleteTextures(1, &tracer->sample_limits);
+    free(tracer->pass_rectangles);
     free(tracer);
 }
 

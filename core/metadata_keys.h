@@ -15,7 +15,13 @@
  *   frame             int       the frame number, -1 without --frames
  *   samples_finished  text      samples finished over all pixels (decimal)
  *   path_segments     text      rays traced (decimal)
- *   complete          int       1 when every sample asked for ran, else 0
+ *   complete          int       1 when the render ended by its own rule (every sample asked
+ *                               for ran, or adaptive sampling stopped every pixel), else 0
+ *   stop_reason       string    why the passes ended (render.h render_stop_reason): spp,
+ *                               noise (adaptive sampling), time (--time-limit) or
+ *                               interrupted; renders and partials only, not merges
+ *   noise_threshold   float     --noise-threshold (0: no adaptive sampling); renders only
+ *   min_spp           int       --min-spp as used (0 without adaptive sampling); renders only
  *   render_seconds    float     the render's time (a merge: summed over its parts)
  *   merged_parts      int       only in a merge's output: how many parts it merged
  * "text" values are whole numbers stored as decimal text, since an OpenEXR int attribute
@@ -37,15 +43,19 @@
 #define METADATA_KEY_COMPLETE "rtspheres:complete"
 #define METADATA_KEY_RENDER_SECONDS "rtspheres:render_seconds"
 #define METADATA_KEY_MERGED_PARTS "rtspheres:merged_parts"
+#define METADATA_KEY_STOP_REASON "rtspheres:stop_reason"
+#define METADATA_KEY_NOISE_THRESHOLD "rtspheres:noise_threshold"
+#define METADATA_KEY_MIN_SPP "rtspheres:min_spp"
 
 /* Every key, in the order `rtspheres stats` prints them: an initializer for an array of
  * METADATA_KEY_COUNT strings. */
-#define METADATA_KEY_COUNT 13
+#define METADATA_KEY_COUNT 16
 #define METADATA_KEYS_IN_STATS_ORDER                                                                         \
     {                                                                                                        \
         METADATA_KEY_VERSION, METADATA_KEY_SCENE, METADATA_KEY_SCENE_HASH, METADATA_KEY_FRAME, METADATA_KEY_SPP, \
             METADATA_KEY_SEED, METADATA_KEY_MAX_DEPTH, METADATA_KEY_SAMPLE_START, METADATA_KEY_SAMPLES_FINISHED, \
-            METADATA_KEY_PATH_SEGMENTS, METADATA_KEY_COMPLETE, METADATA_KEY_RENDER_SECONDS,                   \
+            METADATA_KEY_PATH_SEGMENTS, METADATA_KEY_COMPLETE, METADATA_KEY_STOP_REASON,                      \
+            METADATA_KEY_NOISE_THRESHOLD, METADATA_KEY_MIN_SPP, METADATA_KEY_RENDER_SECONDS,                 \
             METADATA_KEY_MERGED_PARTS,                                                                       \
     }
 

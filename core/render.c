@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "adaptive.h"
 #include "camera.h"
 #include "clock.h"
 #include "hash.h"
@@ -25,6 +26,16 @@
 render_options render_options_defaults(void)
 {
     return (render_options){0};
+}
+
+const char *render_stop_reason_name(render_stop_reason reason)
+{
+    switch (reason) {
+    case RENDER_STOP_NOISE: return "noise";
+    case RENDER_STOP_TIME: return "time";
+    case RENDER_STOP_INTERRUPTED: return "interrupted";
+    default: return "spp";
+    }
 }
 
 /* Fills the tracer's parameters from the scene, its camera frame and the options
@@ -297,12 +308,13 @@ static float *resume_sums(const rt_image *partial, int width, int height, uint32
 /* The part of render_scene before the passes: checks the region, frames the camera,
  * packs the scene (its figures go into *result, with the region and the scene hash),
  * checks the resumed partial against the hash and creates the tracer (*tracer, which the
- * caller destroys) with the partial's sums. *region is the region rendered,
- * *samples_resumed the samples the partial brought and *pass_work_budget the first pass's
- * budget. On failure nothing is left to free. */
+ * caller destroys) with the partial's sums. *region is the region of the result, *traced
+ * the region the tracer renders (region, and with adaptive sampling the pixels around it
+ * whose decisions reach into it), *samples_resumed the samples the partial brought and
+ * *pass_work_budget the first pass's budget. On failure nothing is left to free. */
 static rt_status set_up_tracer(gpu_context *context, const scene *s, const render_options *options,
-                               render_result *result, int region[4], uint64_t *samples_resumed, gpu_tracer **tracer,
-                               uint32_t *pass_work_budget, rt_error *error)
+                               render_result *result, int region[4], int traced[4], uint64_t *samples_resumed,
+                               gpu_tracer **tracer, uint32_t *pass_work_budget, rt_error *error)
 {
     region[0] = 0;
     region[1] = 0;
@@ -317,6 +329,21 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
         memcpy(region, r, 4 * sizeof *region);
     }
     memcpy(result->region, region, sizeof result->region);
+    if (options->noise_threshold > 0 && options->resume != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "RENDER: an adaptive render (noise threshold) cannot resume a partial render: the "
+                            "partial keeps no per-pixel variance");
+    /* Adaptive decisions reach adaptive_reach() pixels: the tracer renders that much around
+     * the region, so that the region's pixels are the full render's (render.h). */
+    memcpy(traced, region, 4 * sizeof *traced);
+    if (options->noise_threshold > 0) {
+        int reach = adaptive_reach(options->min_spp ? options->min_spp : ADAPTIVE_DEFAULT_MIN_SPP,
+                                   (uint32_t)s->render.samples_per_pixel);
+        traced[0] = region[0] - reach > 0 ? region[0] - reach : 0;
+        traced[1] = region[1] - reach > 0 ? region[1] - reach : 0;
+        traced[2] = region[2] + reach < s->render.width ? region[2] + reach : s->render.width;
+        traced[3] = region[3] + reach < s->render.height ? region[3] + reach : s->render.height;
+    }
     int width = region[2] - region[0], height = region[3] - region[1];
 
     camera_frame frame;
@@ -347,7 +374,7 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     }
 
     gpu_tracer_parameters parameters;
-    tracer_parameters(s, &frame, options, region, &parameters);
+    tracer_parameters(s, &frame, options, traced, &parameters);
     parameters.shader.camera_media = packed_media_at(&packed, s->camera.look_from);
     parameters.omitted_features = omitted_features(&packed, options, parameters.shader.camera_media);
     *pass_work_budget = parameters.shader.pass_work_budget;
@@ -383,17 +410,147 @@ static void adapt_pass_budget(gpu_tracer *tracer, double pass_seconds, double ta
     gpu_tracer_set_pass_work_budget(tracer, (uint32_t)*budget);
 }
 
-/* The passes of render_scene: runs them until every pixel has its samples or a stop is
- * requested (*interrupted), adapting the budget (from initial_budget) unless the options
- * fix it, reporting progress (*progress, whose samples_done starts at the resumed samples)
- * and writing checkpoints; fills the result's pass timings. start is the render's start. */
-static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const render_options *options, int width,
-                            int height, uint32_t initial_budget, double start, render_progress *progress,
-                            bool *interrupted, render_result *result, rt_error *error)
+/* Returns the sum of image's samples channel (the fourth of R, G, B, samples). */
+static uint64_t sample_total(const rt_image *image)
+{
+    uint64_t total = 0;
+    for (size_t i = 0; i < (size_t)image->width * image->height; i++)
+        total += (uint64_t)image->pixels[4 * i + 3];
+    return total;
+}
+
+/* Cuts *image (of the traced region) down to region, in place; nothing when they are the
+ * same. Both are x0, y0, x1, y1 of the full image, region inside traced. */
+static rt_status crop_to_region(rt_image *image, const int traced[4], const int region[4], rt_error *error)
+{
+    if (memcmp(traced, region, 4 * sizeof *traced) == 0 || image->pixels == NULL)
+        return RT_OK;
+    rt_image cropped;
+    rt_status status = image_create(&cropped, region[2] - region[0], region[3] - region[1], image->channels, error);
+    if (status != RT_OK)
+        return status;
+    memcpy(cropped.channel_names, image->channel_names, sizeof cropped.channel_names);
+    size_t row_floats = (size_t)cropped.width * image->channels;
+    for (int y = 0; y < cropped.height; y++) {
+        size_t from = ((size_t)(y + region[1] - traced[1]) * image->width + (region[0] - traced[0])) * image->channels;
+        memcpy(cropped.pixels + y * row_floats, image->pixels + from, row_floats * sizeof(float));
+    }
+    image_free(image);
+    *image = cropped;
+    return RT_OK;
+}
+
+/* Adaptive sampling in the pass loop: the sampler (NULL: none) and what its checks read. */
+typedef struct adaptive_run {
+    adaptive_sampler *sampler;
+    float *rgba, *luminance_squares;
+    int *rectangles;
+    bool settle;                 /* the next pass is the first after a check (adaptive.h) */
+} adaptive_run;
+
+static void end_adaptive(adaptive_run *run)
+{
+    adaptive_free(run->sampler);
+    free(run->rgba);
+    free(run->luminance_squares);
+    free(run->rectangles);
+    memset(run, 0, sizeof *run);
+}
+
+/* Starts adaptive sampling for a width x height tracer when the options ask for it: the
+ * sampler, its buffers and the first limits on the tracer. Nothing to free on failure. */
+static rt_status start_adaptive(gpu_tracer *tracer, const render_options *options, uint32_t samples_per_pixel,
+                                int width, int height, adaptive_run *run, rt_error *error)
+{
+    memset(run, 0, sizeof *run);
+    if (!(options->noise_threshold > 0))
+        return RT_OK;
+    rt_status status = adaptive_create(width, height, options->noise_threshold, options->min_spp, samples_per_pixel,
+                                       &run->sampler, error);
+    if (status != RT_OK)
+        return status;
+    size_t pixels = (size_t)width * height;
+    run->rgba = malloc(pixels * 4 * sizeof *run->rgba);
+    run->luminance_squares = malloc(pixels * sizeof *run->luminance_squares);
+    run->rectangles = malloc((size_t)adaptive_rectangle_capacity(run->sampler) * 4 * sizeof *run->rectangles);
+    status = run->rgba && run->luminance_squares && run->rectangles
+                 ? gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error)
+                 : rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for adaptive sampling");
+    if (status != RT_OK)
+        end_adaptive(run);
+    return status;
+}
+
+/* The check once every pixel going has reached its limit: new limits and pass rectangles
+ * on the tracer; *done when no pixel goes on. */
+static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, bool *done, rt_error *error)
+{
+    rt_status status = gpu_tracer_read(tracer, run->rgba, run->luminance_squares, NULL, error);
+    if (status != RT_OK)
+        return status;
+    *done = adaptive_check(run->sampler, run->rgba, run->luminance_squares) == 0;
+    if (*done)
+        return RT_OK;
+    status = gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error);
+    if (status != RT_OK)
+        return status;
+    run->settle = true;
+    return gpu_tracer_set_pass_rectangles(tracer, run->rectangles,
+                                          adaptive_pass_rectangles(run->sampler, true, run->rectangles), error);
+}
+
+/* Before a pass: whether it may run under options->deadline, predicting its time from
+ * the last pass (last_pass_seconds 0: the first pass, which always runs). With an adaptive
+ * budget a pass that would end late is shortened to fit (*budget, on the tracer), if it
+ * can be, within the smallest budget. */
+static bool pass_fits_deadline(gpu_tracer *tracer, const render_options *options, double last_pass_seconds,
+                               bool adaptive_budget, double *budget)
+{
+    if (options->deadline <= 0 || last_pass_seconds <= 0)
+        return true;
+    double remaining = options->deadline - clock_seconds();
+    if (remaining >= last_pass_seconds)
+        return true;
+    double shortened = *budget * remaining / last_pass_seconds;
+    if (!adaptive_budget || !(shortened >= MINIMUM_ADAPTIVE_BUDGET))
+        return false;
+    *budget = shortened;
+    gpu_tracer_set_pass_work_budget(tracer, (uint32_t)shortened);
+    return true;
+}
+
+/* Writes a checkpoint of the image so far (cut to region) through options->checkpoint. */
+static rt_status write_checkpoint(gpu_tracer *tracer, const render_options *options, const int traced[4],
+                                  const int region[4], uint64_t scene_hash, rt_error *error)
+{
+    rt_image partial;
+    uint64_t partial_samples;
+    rt_status status = read_image(tracer, traced[2] - traced[0], traced[3] - traced[1], &partial, NULL, NULL,
+                                  &partial_samples, error);
+    if (status == RT_OK && memcmp(traced, region, 4 * sizeof *traced) != 0) {
+        status = crop_to_region(&partial, traced, region, error);
+        partial_samples = status == RT_OK ? sample_total(&partial) : 0;
+    }
+    if (status == RT_OK)
+        status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, scene_hash, error);
+    image_free(&partial);
+    return status;
+}
+
+/* The passes of render_scene over the traced region: runs them until every pixel has its
+ * samples, adaptive sampling stops every pixel, the deadline comes or a stop is requested
+ * (*stop says which), adapting the budget (from initial_budget) unless the options fix
+ * it, reporting progress (*progress, whose samples_done starts at the resumed samples) and
+ * writing checkpoints (of region); fills the result's pass timings. start is the
+ * render's start. */
+static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const render_options *options,
+                            uint32_t samples_per_pixel, const int traced[4], const int region[4],
+                            uint32_t initial_budget, double start, render_progress *progress,
+                            render_stop_reason *stop, render_result *result, rt_error *error)
 {
     double last_checkpoint = clock_seconds();
-    double first_pass_end = 0;
-    bool adaptive = options->pass_work_budget == 0;
+    double first_pass_end = 0, last_pass_seconds = 0;
+    bool adaptive_budget = options->pass_work_budget == 0;
     gpu_info device;
     gpu_get_info(context, &device);
     double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
@@ -402,15 +559,23 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
     double budget = initial_budget;
     double most_budget = device.max_pass_work_budget < MAXIMUM_ADAPTIVE_BUDGET ? device.max_pass_work_budget
                                                                                : MAXIMUM_ADAPTIVE_BUDGET;
-    *interrupted = false;
-    for (;;) {
+    adaptive_run adaptive;
+    rt_status status = start_adaptive(tracer, options, samples_per_pixel, traced[2] - traced[0],
+                                      traced[3] - traced[1], &adaptive, error);
+    *stop = RENDER_STOP_SAMPLES;
+    for (bool done = false; status == RT_OK && !done;) {
+        if (!pass_fits_deadline(tracer, options, last_pass_seconds, adaptive_budget, &budget)) {
+            *stop = RENDER_STOP_TIME;
+            break;
+        }
         gpu_pass_report report;
         double pass_start = clock_seconds();
-        rt_status status = gpu_tracer_run_pass(tracer, &report, error);
+        status = gpu_tracer_run_pass(tracer, &report, error);
         if (status != RT_OK)
-            return status;
-        if (adaptive)
-            adapt_pass_budget(tracer, clock_seconds() - pass_start, target_seconds, most_budget, &budget);
+            break;
+        last_pass_seconds = clock_seconds() - pass_start;
+        if (adaptive_budget)
+            adapt_pass_budget(tracer, last_pass_seconds, target_seconds, most_budget, &budget);
         progress->passes++;
         progress->samples_done += report.samples_finished;
         progress->elapsed_seconds = clock_seconds() - start;
@@ -423,27 +588,32 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
         }
         if (options->progress != NULL)
             options->progress(options->progress_context, progress);
-        if (report.unfinished_pixels == 0)
-            return RT_OK;
-        if (options->stop_requested != NULL && *options->stop_requested) {
-            *interrupted = true;
-            return RT_OK;
+        if (adaptive.settle) {
+            adaptive.settle = false;
+            status = gpu_tracer_set_pass_rectangles(
+                tracer, adaptive.rectangles, adaptive_pass_rectangles(adaptive.sampler, false, adaptive.rectangles),
+                error);
         }
-        if (options->checkpoint != NULL && options->checkpoint_seconds > 0
+        if (status == RT_OK && report.unfinished_pixels == 0) {
+            done = true;
+            if (adaptive.sampler != NULL)
+                status = check_adaptive(tracer, &adaptive, &done, error);
+            if (done && adaptive.sampler != NULL && adaptive_stopped_early(adaptive.sampler))
+                *stop = RENDER_STOP_NOISE;
+            continue;
+        }
+        if (options->stop_requested != NULL && *options->stop_requested) {
+            *stop = RENDER_STOP_INTERRUPTED;
+            break;
+        }
+        if (status == RT_OK && options->checkpoint != NULL && options->checkpoint_seconds > 0
             && clock_seconds() - last_checkpoint >= options->checkpoint_seconds) {
-            rt_image partial;
-            uint64_t partial_samples;
-            status = read_image(tracer, width, height, &partial, NULL, NULL, &partial_samples, error);
-            if (status != RT_OK)
-                return status;
-            status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, result->scene_hash,
-                                         error);
-            image_free(&partial);
-            if (status != RT_OK)
-                return status;
+            status = write_checkpoint(tracer, options, traced, region, result->scene_hash, error);
             last_checkpoint = clock_seconds();
         }
     }
+    end_adaptive(&adaptive);
+    return status;
 }
 
 /* The read-back of render_scene: the image (and the AOVs and variance layers asked for) into
@@ -497,32 +667,48 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (options == NULL)
         options = &defaults;
 
-    int region[4];
+    int region[4], traced[4];
     uint64_t samples_resumed = 0;
     uint32_t budget = 0;
     gpu_tracer *tracer = NULL;
-    rt_status status = set_up_tracer(context, s, options, result, region, &samples_resumed, &tracer, &budget, error);
+    rt_status status =
+        set_up_tracer(context, s, options, result, region, traced, &samples_resumed, &tracer, &budget, error);
     if (status != RT_OK)
         return status;
     result->reused_scene = gpu_tracer_reused_scene(tracer);
-    int width = region[2] - region[0], height = region[3] - region[1];
+    int traced_width = traced[2] - traced[0], traced_height = traced[3] - traced[1];
 
     render_progress progress = {
-        .samples_total = (uint64_t)width * height * s->render.samples_per_pixel,
+        .samples_total = (uint64_t)traced_width * traced_height * s->render.samples_per_pixel,
         .samples_done = samples_resumed,
     };
-    bool interrupted = false;
-    status = run_passes(context, tracer, options, width, height, budget, start, &progress, &interrupted, result, error);
+    render_stop_reason stop = RENDER_STOP_SAMPLES;
+    status = run_passes(context, tracer, options, (uint32_t)s->render.samples_per_pixel, traced, region, budget,
+                        start, &progress, &stop, result, error);
     if (status == RT_OK)
-        status = read_result(context, tracer, options, width, height, result, error);
+        status = read_result(context, tracer, options, traced_width, traced_height, result, error);
     gpu_tracer_destroy(tracer);
+    if (status == RT_OK && memcmp(traced, region, sizeof traced) != 0) {
+        status = crop_to_region(&result->image, traced, region, error);
+        if (status == RT_OK)
+            status = crop_to_region(&result->aovs, traced, region, error);
+        if (status == RT_OK)
+            result->samples = sample_total(&result->image);
+        if (status != RT_OK) {
+            image_free(&result->image);
+            image_free(&result->aovs);
+        }
+    }
     if (status != RT_OK)
         return status;
 
     result->passes = progress.passes;
+    result->stop_reason = stop;
     result->seconds = clock_seconds() - start;
-    if (interrupted)
+    if (stop == RENDER_STOP_INTERRUPTED)
         return rt_error_set(error, RT_ERROR_INTERRUPTED, "RENDER: interrupted after %llu of %llu samples",
-                            (unsigned long long)result->samples, (unsigned long long)progress.samples_total);
+                            (unsigned long long)result->samples,
+                            (unsigned long long)(region[2] - region[0]) * (region[3] - region[1])
+                                * s->render.samples_per_pixel);
     return RT_OK;
 }

@@ -2,9 +2,11 @@
  *
  * A render is a sequence of bounded passes (see gpu.h and glsl/work.glsl for why:
  * llvmpipe's 65,535-iteration loop cap and GPU watchdogs). Passes repeat until every
- * pixel has run all its samples, or until *stop_requested becomes non-zero (checked
- * between passes), in which case the samples finished so far are returned with their
- * per-pixel counts and the status is RT_ERROR_INTERRUPTED.
+ * pixel has run all its samples, or (with a noise threshold) every pixel has stopped as
+ * core/adaptive.h decides, or the next pass would end past the deadline, or until
+ * *stop_requested becomes non-zero (checked between passes), in which case the samples
+ * finished so far are returned with their per-pixel counts and the status is
+ * RT_ERROR_INTERRUPTED. render_result.stop_reason says which ended it.
  *
  * The result image has 4 channels: R, G, B (the mean radiance of the finished samples,
  * linear) and "samples" (how many samples each pixel finished), rows top to bottom.
@@ -22,7 +24,21 @@
  *   russian_roulette_depth 4 (paths may end at random from the 5th segment on),
  *   full_tracer false: the tracer is compiled without the features the scene cannot
  *     reach (gpu.h, GPU_OMIT_*),
- *   sample_start 0, the whole image, no progress callback, no stop flag.
+ *   sample_start 0, the whole image, no progress callback, no stop flag,
+ *   noise_threshold 0: no adaptive sampling (every pixel takes samples_per_pixel),
+ *   min_spp ADAPTIVE_DEFAULT_MIN_SPP (16, core/adaptive.h) with a threshold,
+ *   deadline 0: none.
+ *
+ * Adaptive sampling (noise_threshold > 0): pixels stop as core/adaptive.h says, each
+ * pass runs only the tiles with pixels still going, and the samples channel holds each
+ * pixel's count. With a region, the tracer renders the pixels within adaptive_reach() of
+ * it too (and drops them), so a region's decisions, and so its pixels, are exactly the
+ * full render's. resume is refused with a threshold (the partial keeps no squares).
+ *
+ * The deadline (a clock_seconds() time, core/clock.h): before each pass after the first
+ * the render predicts its end from the last pass; a pass that would end past the deadline
+ * is shortened (an adaptive budget) or not run, so the render ends within about one pass
+ * of the deadline with RT_OK and stop_reason RENDER_STOP_TIME. The first pass always runs.
  *
  * With a region, result->image covers only the region (its pixels are exactly those of
  * the full render: camera and random numbers use full-image pixel coordinates).
@@ -49,6 +65,17 @@ typedef struct render_progress {
     int passes;
 } render_progress;
 
+/* Why the passes ended. */
+typedef enum render_stop_reason {
+    RENDER_STOP_SAMPLES = 0,     /* every pixel ran samples_per_pixel ("spp") */
+    RENDER_STOP_NOISE,           /* adaptive sampling stopped some pixels earlier ("noise") */
+    RENDER_STOP_TIME,            /* the deadline ("time") */
+    RENDER_STOP_INTERRUPTED,     /* *stop_requested ("interrupted") */
+} render_stop_reason;
+
+/* Returns "spp", "noise", "time" or "interrupted": the words of rtspheres:stop_reason. */
+const char *render_stop_reason_name(render_stop_reason reason);
+
 typedef struct render_options {
     uint32_t pass_work_budget;
     double target_pass_seconds;
@@ -68,6 +95,9 @@ typedef struct render_options {
     void (*progress)(void *progress_context, const render_progress *progress);
     void *progress_context;
     const volatile sig_atomic_t *stop_requested;
+    float noise_threshold;       /* > 0: adaptive sampling to this error (core/adaptive.h) */
+    uint32_t min_spp;            /* samples every pixel takes before a check (0: 16) */
+    double deadline;             /* clock_seconds() time to end by (0: none) */
     /* Continue a partial render: an image of the region with R, G, B means and a
      * "samples" channel (as render_scene returns and an EXR keeps). A pixel with n
      * samples goes on from sample index sample_start + n, so the result equals an
@@ -102,6 +132,7 @@ typedef struct render_result {
                                   * cost of a sample, whatever the set-up cost */
     double path_segments;        /* rays traced, counted by the shader */
     int passes;
+    render_stop_reason stop_reason;
     int bvh_depth;
     double bvh_build_seconds;
     uint64_t packed_bytes;       /* the whole packed scene, images included */

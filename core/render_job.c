@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "adaptive.h"
 #include "clock.h"
 #include "image_io.h"
 #include "paths.h"
@@ -21,6 +22,7 @@ typedef struct job_run {
     render_job_plan plan;
     render_job_callbacks callbacks;      /* the caller's, or all NULL */
     render_job_failure failure;          /* where the run stopped short */
+    bool image_begun;                    /* an image has begun (its limit counted from then) */
 } job_run;
 
 /* One image being rendered: its scene (render settings after the job's overrides and
@@ -29,6 +31,7 @@ typedef struct job_image {
     job_run *run;
     scene scene;
     render_job_image plan;
+    double start;                        /* clock_seconds() its time limit counts from */
 } job_image;
 
 /* Loads the scene with the variables of frame (-1: none) and its assets into *s. On
@@ -59,10 +62,11 @@ static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
 }
 
 /* Writes pixels (R, G, B means, samples, of the image's region) to path with the
- * metadata of image; complete says whether every sample ran. result gives the AOV
- * layers, region, path segments, scene hash and time. */
+ * metadata of image; complete says whether the render ended by its own rule. result gives
+ * the AOV layers, region, path segments, scene hash, time and (but for a checkpoint, whose
+ * passes have not ended) the stop reason. */
 static rt_status write_image(const job_image *image, const rt_image *pixels, const char *path, uint64_t samples,
-                             bool complete, const render_result *result, rt_error *error)
+                             bool complete, bool checkpoint, const render_result *result, rt_error *error)
 {
     const render_job *job = image->run->job;
     const scene_render_settings *settings = &image->scene.render;
@@ -86,6 +90,14 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
         .complete = complete,
         .render_seconds = result->seconds,
     };
+    if (!checkpoint) {
+        bool adaptive = job->tracer.noise_threshold > 0;
+        uint32_t min_spp = job->tracer.min_spp ? job->tracer.min_spp : ADAPTIVE_DEFAULT_MIN_SPP;
+        metadata.stop_reason = render_stop_reason_name(result->stop_reason);
+        metadata.noise_threshold = adaptive ? job->tracer.noise_threshold : 0.0f;
+        metadata.min_spp = !adaptive ? 0 : min_spp < (uint32_t)settings->samples_per_pixel ? (int)min_spp
+                                                                                         : settings->samples_per_pixel;
+    }
     /* With a tone-mapping operator the exposure was applied before it (postprocess). */
     float exposure = job->tonemap != TONEMAP_CLAMP ? 0.0f : (float)job->exposure;
     return render_output_write(path, &placed, &result->aovs, &metadata, exposure, error);
@@ -98,7 +110,7 @@ static rt_status write_checkpoint(void *context, const rt_image *partial, uint64
     const job_image *image = context;
     render_result result = {.scene_hash = scene_hash};
     memcpy(result.region, image->plan.window, sizeof result.region);
-    rt_status status = write_image(image, partial, image->plan.partial, samples, false, &result, error);
+    rt_status status = write_image(image, partial, image->plan.partial, samples, false, true, &result, error);
     const render_job_callbacks *callbacks = &image->run->callbacks;
     if (status == RT_OK && callbacks->checkpoint_written != NULL)
         callbacks->checkpoint_written(callbacks->user, &image->plan, samples);
@@ -180,6 +192,22 @@ static rt_status postprocess_result(const render_job *job, const char *output, r
     return status;
 }
 
+/* Writes the samples channel of image (R, G, B, samples) to path as grey samples / spp. */
+static rt_status write_samples_map(const char *path, const rt_image *image, int samples_per_pixel, rt_error *error)
+{
+    rt_image map;
+    rt_status status = image_create(&map, image->width, image->height, 3, error);
+    if (status != RT_OK)
+        return status;
+    for (size_t i = 0; i < (size_t)image->width * image->height; i++)
+        for (int c = 0; c < 3; c++)
+            map.pixels[3 * i + c] = image->pixels[4 * i + 3] / (float)samples_per_pixel;
+    image_write_options options = image_write_options_defaults();
+    status = image_write(path, &map, &options, error);
+    image_free(&map);
+    return status;
+}
+
 /* After the passes: writes the result, post-processed, to the output when the render
  * finished, else (render_status RT_ERROR_INTERRUPTED) as it is to the partial file, which
  * the message then names. */
@@ -192,7 +220,8 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
          * raw means and sample counts: --resume adds samples to them, so denoised, blurred
          * or tone-mapped colour there would be processed twice. */
         rt_error write_error = {{0}};
-        if (write_image(image, &result->image, plan->partial, result->samples, false, result, &write_error) != RT_OK)
+        if (write_image(image, &result->image, plan->partial, result->samples, false, false, result, &write_error)
+            != RT_OK)
             return rt_error_set(error, RT_ERROR_INTERRUPTED, "interrupted, and the partial could not be written: %s",
                                 write_error.message);
         return rt_error_set(error, RT_ERROR_INTERRUPTED,
@@ -202,7 +231,12 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
     rt_status status = postprocess_result(image->run->job, plan->output, result, error);
     if (status != RT_OK)
         return status;
-    status = write_image(image, &result->image, plan->output, result->samples, true, result, error);
+    status = write_image(image, &result->image, plan->output, result->samples,
+                         result->stop_reason != RENDER_STOP_TIME, false, result, error);
+    if (status != RT_OK)
+        return status;
+    if (image->run->job->samples_map != NULL)
+        status = write_samples_map(image->run->job->samples_map, &result->image, plan->samples_per_pixel, error);
     if (status != RT_OK)
         return status;
     /* The checkpoint is ours and now superseded by the complete image. */
@@ -227,6 +261,7 @@ static void image_render_options(job_image *image, render_options *options)
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;
     options->stop_requested = job->stop_requested;
+    options->deadline = job->time_limit_seconds > 0 ? image->start + job->time_limit_seconds : 0;
     options->resume = NULL;
     options->resume_scene_hash = 0;
     options->checkpoint_seconds = 0;
@@ -282,6 +317,8 @@ static rt_status run_image(job_run *run, int frame, const char *output, rt_error
     if (image == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory");
     image->run = run;
+    image->start = !run->image_begun && job->time_limit_start > 0 ? job->time_limit_start : clock_seconds();
+    run->image_begun = true;
     rt_status status = load_scene(run, frame, &image->scene, error);
     if (status != RT_OK) {
         free(image);

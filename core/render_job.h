@@ -39,9 +39,22 @@
  *                           colour as noisy.R/G/B
  *   blur_sigma, blur_passes sigma 0: no blur; passes 0: 1
  *   tonemap, exposure       for 8-bit outputs: TONEMAP_CLAMP and 0 stops
- *   tracer                  how each image is traced (render.h; zero = its defaults). The
- *                           job sets its sample_start, region, aovs, variance, progress,
- *                           stop_requested, resume and checkpoint fields itself.
+ *   samples_map             NULL: none; else also write each pixel's samples / spp as a
+ *                           grey image there (any format: white is spp samples; an
+ *                           8-bit format's sRGB curve brightens the few): where the
+ *                           time went with adaptive sampling or a time limit; one image
+ *                           only (not with several frames)
+ *   time_limit_seconds      0: none; else each image ends within about one pass of this
+ *                           many seconds after its start (render_options.deadline), and
+ *                           is written with what it has (rtspheres:stop_reason time)
+ *   time_limit_start        the clock_seconds() time the first image's limit counts from
+ *                           (`rtspheres render`: its command's start); 0: the job's start.
+ *                           Every later frame's counts from when it begins: the limit is
+ *                           per image, so a job of F frames ends within about F times it
+ *   tracer                  how each image is traced (render.h; zero = its defaults; its
+ *                           noise_threshold and min_spp: adaptive sampling). The job sets
+ *                           its sample_start, region, aovs, variance, progress,
+ *                           stop_requested, deadline, resume and checkpoint fields itself.
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
  *
@@ -120,6 +133,9 @@ typedef struct render_job {
     int blur_passes;
     postprocess_tonemap_operator tonemap;
     double exposure;
+    const char *samples_map;
+    double time_limit_seconds;
+    double time_limit_start;
     render_options tracer;
     const volatile sig_atomic_t *stop_requested;
 } render_job;
@@ -202,7 +218,9 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
  * without EXR; variance without EXR; variance with resume; resume with several frames; shard_by without shard; a shard by frames
  * without frames, or with no frame; a shard by samples with a sample range; a shard by
- * tiles with crop or tile. */
+ * tiles with crop or tile; a samples map with several frames or of an unknown format;
+ * a minimum spp without a noise threshold; a noise threshold
+ * with a shard by samples, a sample range or resume. */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 
 /* True when the frame at position index of job->frames is this job's to render (always,

@@ -150,7 +150,31 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
     if (job->resume_path != NULL && job->frame_count > 1)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--resume continues one image; render the frames one at a time");
-    return plan_shard(job, plan, error);
+    if (job->samples_map != NULL && job->frame_count > 1)
+        return rt_error_set(error, RT_ERROR_INPUT, "--samples-map writes one image; not with several frames");
+    if (job->samples_map != NULL && image_format_of(job->samples_map) == IMAGE_FORMAT_UNKNOWN)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "cannot tell the format of --samples-map '%s'; use .png, .exr, .hdr, .jpg or .tif",
+                            job->samples_map);
+    status = plan_shard(job, plan, error);
+    if (status == RT_OK && job->tracer.min_spp && !(job->tracer.noise_threshold > 0))
+        return rt_error_set(error, RT_ERROR_INPUT, "--min-spp does nothing without --noise-threshold");
+    if (status != RT_OK || !(job->tracer.noise_threshold > 0))
+        return status;
+    /* Each part would stop its pixels on its own samples, so parts would not add up. */
+    if (job->shard_count && plan->shard_by == RENDER_SHARD_SAMPLES)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--noise-threshold cannot be combined with --shard-by samples: each part would stop "
+                            "its pixels on its own samples; shard by tiles or frames");
+    if (job->sample_count > 0 || job->sample_start > 0)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--noise-threshold cannot be combined with --samples: each part would stop its "
+                            "pixels on its own samples; render all samples, or split by --tile or --crop");
+    if (job->resume_path != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--noise-threshold cannot --resume: the partial file keeps no per-pixel variance "
+                            "for the threshold; resume without it");
+    return RT_OK;
 }
 
 bool render_job_includes_frame(const render_job *job, const render_job_plan *plan, int index)

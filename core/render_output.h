@@ -35,6 +35,10 @@ typedef struct render_output_metadata {
     bool complete;
     double render_seconds;
     int merged_parts;                    /* 0: no rtspheres:merged_parts key (not a merge) */
+    const char *stop_reason;             /* NULL: no stop_reason, noise_threshold and min_spp
+                                          * keys (a merge) */
+    float noise_threshold;
+    int min_spp;
 } render_output_metadata;
 
 /* What a partial file must match to continue a render: its seed, first sample, samples

@@ -69,8 +69,11 @@
 #define MATERIAL_TEST_OUTPUTS 4
 
 /* ---- bindings: texture unit of the packed scene, uniform buffer of the parameter block,
- * atomic counter buffer (unfinished pixels at offset 0, finished samples at offset 4) */
+ * atomic counter buffer (unfinished pixels at offset 0, finished samples at offset 4),
+ * texture unit of the per-pixel sample limits (R32UI: a pixel starts no sample at or past
+ * min(its limit, samples_per_pixel); adaptive sampling, core/adaptive.h) */
 #define TRACER_PACKED_SCENE_UNIT 8   /* after the state textures' units */
+#define TRACER_SAMPLE_LIMITS_UNIT 9
 #define TRACER_PARAMETER_BINDING 0
 #define TRACER_COUNTER_BINDING 0
 

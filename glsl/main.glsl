@@ -11,6 +11,8 @@ layout(binding = TRACER_STATE_COUNTERS) uniform usampler2D state_counters;
 layout(binding = TRACER_STATE_ACCUMULATED) uniform sampler2D state_accumulated;
 layout(binding = TRACER_STATE_STATISTICS) uniform sampler2D state_statistics;
 layout(binding = TRACER_STATE_SQUARES) uniform sampler2D state_squares;
+// The pixel's sample limit (core/adaptive.h; all at most samples_per_pixel without it).
+layout(binding = TRACER_SAMPLE_LIMITS_UNIT) uniform usampler2D sample_limits;
 
 layout(location = TRACER_STATE_ORIGIN) out vec4 out_origin;            // xyz: origin, w: since_vertex
 layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction, w: light_total
@@ -64,6 +66,7 @@ void write_state(PixelState s)
 void main()
 {
     PixelState s = read_state(ivec2(gl_FragCoord.xy));
+    sample_limit = min(samples_per_pixel, texelFetch(sample_limits, ivec2(gl_FragCoord.xy), 0).x);
     read_header();
     begin_pixel();
     rng_sample = sample_start + s.samples_started - 1u;   // the sample of the path in flight
@@ -74,7 +77,7 @@ void main()
         s.statistics.y += 1.0;
         s.bounce = 0u;     // drop the broken path; the host reports the overflow as an error
     }
-    if (s.samples_started < samples_per_pixel || s.bounce != 0u)
+    if (s.samples_started < sample_limit || s.bounce != 0u)
         atomicCounterIncrement(unfinished_pixels);
     for (uint i = 0u; i < s.finished_here; i++)
         atomicCounterIncrement(samples_finished);

@@ -26,6 +26,10 @@ struct PixelState {
     uint finished_here;     // samples finished in this pass
 };
 
+// The samples this pixel may start in this pass at most (glsl/main.glsl sets it:
+// samples_per_pixel, or less where adaptive sampling holds the pixel back).
+uint sample_limit;
+
 // Prepares the next iteration of the segment loop: starts a sample (its camera ray) when
 // no path is in flight and may_start, and counts the iteration's work. trace_path is set
 // when the path's next segment is to be traced now. False when the pixel stops for this
@@ -38,7 +42,7 @@ bool begin_segment(inout PixelState s, bool busy, bool may_start, out bool trace
     trace_path = false;
     if (!busy && !budget_left)
         return false;
-    if (s.bounce == 0u && may_start && budget_left && s.samples_started < samples_per_pixel) {
+    if (s.bounce == 0u && may_start && budget_left && s.samples_started < sample_limit) {
         rng_sample = sample_start + s.samples_started;
         s.samples_started++;
         camera_ray(s.origin, s.direction);

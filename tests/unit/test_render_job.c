@@ -255,6 +255,27 @@ static void part_rules(void **state)
     memset(job.crop, 0, sizeof job.crop);
     job.tile_count = 2;
     refused(&job, "--shard by tiles and --crop/--tile both choose the region; give one");
+
+    /* Adaptive sampling: parts of the samples would each stop on their own samples. */
+    job = job_for("a.exr");
+    job.tracer.min_spp = 8;
+    refused(&job, "--min-spp does nothing without --noise-threshold");
+    job.tracer.noise_threshold = 0.05f;
+    job.shard_count = 2;
+    refused(&job, "--noise-threshold cannot be combined with --shard-by samples: each part would stop its pixels "
+                  "on its own samples; shard by tiles or frames");
+    job.shard_by = RENDER_SHARD_TILES;
+    render_job_plan plan;
+    assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
+    job.shard_count = 0;
+    job.shard_by = RENDER_SHARD_AUTO;
+    job.sample_count = 8;
+    refused(&job, "--noise-threshold cannot be combined with --samples: each part would stop its pixels on its "
+                  "own samples; render all samples, or split by --tile or --crop");
+    job.sample_count = 0;
+    job.resume_path = "a.partial.exr";
+    refused(&job, "--noise-threshold cannot --resume: the partial file keeps no per-pixel variance for the "
+                  "threshold; resume without it");
 }
 
 static void shards(void **state)

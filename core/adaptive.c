@@ -1,0 +1,196 @@
+/* adaptive.c: see adaptive.h. */
+#include "adaptive.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct adaptive_sampler {
+    int width, height;
+    float threshold;
+    uint32_t min_spp, max_spp;
+    uint32_t *limits;            /* per pixel, rows top to bottom */
+    uint8_t *going;              /* 1: the pixel still takes samples */
+    uint8_t *unconverged;        /* scratch of adaptive_check */
+    int tiles_x, tiles_y;
+    uint8_t *tile_going;         /* per tile: a pixel of it is going */
+    uint8_t *tile_stopped_now;   /* per tile: the last check stopped its last pixel */
+    bool stopped_early;
+};
+
+float adaptive_pixel_error(float luminance_sum, float luminance_squares, uint32_t n)
+{
+    if (n < 2)
+        return INFINITY;
+    double mean = (double)luminance_sum / n;
+    double variance = ((double)luminance_squares - n * mean * mean) / (n - 1);
+    if (variance < 0)
+        variance = 0;  /* float rounding of the sums */
+    double floor = mean > ADAPTIVE_LUMINANCE_FLOOR ? mean : ADAPTIVE_LUMINANCE_FLOOR;
+    return (float)(sqrt(variance / n) / floor);
+}
+
+uint32_t adaptive_next_check(uint32_t samples, uint32_t min_spp, uint32_t max_spp)
+{
+    uint64_t next = samples < min_spp ? min_spp : (uint64_t)samples + (min_spp > samples / 4 ? min_spp : samples / 4);
+    return next > max_spp ? max_spp : (uint32_t)next;
+}
+
+int adaptive_reach(uint32_t min_spp, uint32_t max_spp)
+{
+    int checks = 0;
+    uint32_t n = adaptive_next_check(0, min_spp, max_spp);
+    for (; n < max_spp; n = adaptive_next_check(n, min_spp, max_spp))
+        checks++;
+    return checks;
+}
+
+void adaptive_free(adaptive_sampler *sampler)
+{
+    if (sampler == NULL)
+        return;
+    free(sampler->limits);
+    free(sampler->going);
+    free(sampler->unconverged);
+    free(sampler->tile_going);
+    free(sampler->tile_stopped_now);
+    free(sampler);
+}
+
+rt_status adaptive_create(int width, int height, float threshold, uint32_t min_spp, uint32_t max_spp,
+                          adaptive_sampler **out, rt_error *error)
+{
+    *out = NULL;
+    adaptive_sampler *sampler = calloc(1, sizeof *sampler);
+    size_t pixels = (size_t)width * height;
+    if (sampler != NULL) {
+        sampler->tiles_x = (width + ADAPTIVE_TILE_SIZE - 1) / ADAPTIVE_TILE_SIZE;
+        sampler->tiles_y = (height + ADAPTIVE_TILE_SIZE - 1) / ADAPTIVE_TILE_SIZE;
+        size_t tiles = (size_t)sampler->tiles_x * sampler->tiles_y;
+        sampler->limits = malloc(pixels * sizeof *sampler->limits);
+        sampler->going = malloc(pixels);
+        sampler->unconverged = malloc(pixels);
+        sampler->tile_going = malloc(tiles);
+        sampler->tile_stopped_now = calloc(tiles, 1);
+    }
+    if (sampler == NULL || !sampler->limits || !sampler->going || !sampler->unconverged || !sampler->tile_going
+        || !sampler->tile_stopped_now) {
+        adaptive_free(sampler);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for adaptive sampling");
+    }
+    sampler->width = width;
+    sampler->height = height;
+    sampler->threshold = threshold;
+    sampler->max_spp = max_spp;
+    sampler->min_spp = min_spp == 0 ? ADAPTIVE_DEFAULT_MIN_SPP : min_spp > max_spp ? max_spp : min_spp;
+    uint32_t first = adaptive_next_check(0, sampler->min_spp, max_spp);
+    for (size_t i = 0; i < pixels; i++)
+        sampler->limits[i] = first;
+    memset(sampler->going, 1, pixels);
+    memset(sampler->tile_going, 1, (size_t)sampler->tiles_x * sampler->tiles_y);
+    *out = sampler;
+    return RT_OK;
+}
+
+const uint32_t *adaptive_limits(const adaptive_sampler *sampler)
+{
+    return sampler->limits;
+}
+
+bool adaptive_stopped_early(const adaptive_sampler *sampler)
+{
+    return sampler->stopped_early;
+}
+
+/* True when a pixel of the 3x3 neighbourhood of (x, y) inside the image is unconverged. */
+static bool neighbourhood_unconverged(const adaptive_sampler *sampler, int x, int y)
+{
+    for (int dy = -1; dy <= 1; dy++) {
+        int row = y + dy;
+        if (row < 0 || row >= sampler->height)
+            continue;
+        for (int dx = -1; dx <= 1; dx++) {
+            int column = x + dx;
+            if (column >= 0 && column < sampler->width && sampler->unconverged[(size_t)row * sampler->width + column])
+                return true;
+        }
+    }
+    return false;
+}
+
+/* Marks the tiles with a pixel going, and those whose last pixel just stopped. */
+static void update_tiles(adaptive_sampler *sampler)
+{
+    size_t tiles = (size_t)sampler->tiles_x * sampler->tiles_y;
+    uint8_t *was_going = sampler->tile_stopped_now;
+    memcpy(was_going, sampler->tile_going, tiles);
+    memset(sampler->tile_going, 0, tiles);
+    for (int y = 0; y < sampler->height; y++)
+        for (int x = 0; x < sampler->width; x++)
+            if (sampler->going[(size_t)y * sampler->width + x])
+                sampler->tile_going[(size_t)(y / ADAPTIVE_TILE_SIZE) * sampler->tiles_x + x / ADAPTIVE_TILE_SIZE] = 1;
+    for (size_t i = 0; i < tiles; i++)
+        was_going[i] = was_going[i] && !sampler->tile_going[i];
+}
+
+int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *luminance_squares)
+{
+    size_t pixels = (size_t)sampler->width * sampler->height;
+    for (size_t i = 0; i < pixels; i++) {
+        const float *pixel = rgba + 4 * i;
+        float luminance = 0.2126f * pixel[0] + 0.7152f * pixel[1] + 0.0722f * pixel[2];
+        sampler->unconverged[i] = sampler->going[i] && adaptive_pixel_error(luminance, luminance_squares[i],
+                                                                             (uint32_t)pixel[3]) >= sampler->threshold;
+    }
+    int going = 0;
+    for (int y = 0; y < sampler->height; y++)
+        for (int x = 0; x < sampler->width; x++) {
+            size_t i = (size_t)y * sampler->width + x;
+            if (!sampler->going[i])
+                continue;
+            uint32_t samples = (uint32_t)rgba[4 * i + 3];
+            if (samples >= sampler->max_spp) {
+                sampler->going[i] = 0;
+            } else if (!neighbourhood_unconverged(sampler, x, y)) {
+                sampler->going[i] = 0;
+                sampler->stopped_early = true;
+            }
+            if (sampler->going[i]) {
+                sampler->limits[i] = adaptive_next_check(samples, sampler->min_spp, sampler->max_spp);
+                going++;
+            } else {
+                sampler->limits[i] = samples;
+            }
+        }
+    update_tiles(sampler);
+    return going;
+}
+
+int adaptive_rectangle_capacity(const adaptive_sampler *sampler)
+{
+    return sampler->tiles_x * sampler->tiles_y;
+}
+
+int adaptive_pass_rectangles(const adaptive_sampler *sampler, bool settle, int *rectangles)
+{
+    int count = 0;
+    for (int ty = 0; ty < sampler->tiles_y; ty++) {
+        int run_start = -1;
+        for (int tx = 0; tx <= sampler->tiles_x; tx++) {
+            size_t t = (size_t)ty * sampler->tiles_x + tx;
+            bool drawn = tx < sampler->tiles_x && (sampler->tile_going[t] || (settle && sampler->tile_stopped_now[t]));
+            if (drawn && run_start < 0)
+                run_start = tx;
+            if (!drawn && run_start >= 0) {
+                int *r = rectangles + 4 * count++;
+                r[0] = run_start * ADAPTIVE_TILE_SIZE;
+                r[1] = ty * ADAPTIVE_TILE_SIZE;
+                int x1 = tx * ADAPTIVE_TILE_SIZE, y1 = (ty + 1) * ADAPTIVE_TILE_SIZE;
+                r[2] = x1 < sampler->width ? x1 : sampler->width;
+                r[3] = y1 < sampler->height ? y1 : sampler->height;
+                run_start = -1;
+            }
+        }
+    }
+    return count;
+}

@@ -1,0 +1,95 @@
+/* adaptive.h: adaptive sampling's decisions (render_options.noise_threshold): which pixels
+ * go on taking samples, how far, and which tiles of the image a pass must draw. Plain C on
+ * the sums the tracer accumulates; core/render.c runs it between passes, the GPU never
+ * sees it. docs/sampling.md ("Adaptive sampling") says the same for users.
+ *
+ * ## The estimator
+ * A pixel's error after n samples is the relative standard error of its mean luminance
+ * (Y = 0.2126 R + 0.7152 G + 0.0722 B, as glsl/path_state.glsl finish_sample squares it):
+ *     s^2   = (sum Y^2 - n * mean^2) / (n - 1)          (the sample variance)
+ *     error = sqrt(s^2 / n) / max(mean, ADAPTIVE_LUMINANCE_FLOOR)
+ * so above the floor the threshold is relative (LuxCore's and Cycles' halt thresholds are
+ * relative too), below it absolute: a nearly black pixel need not reach a relative error
+ * that no display shows. The Sobol samples of one pixel are stratified, so s^2 / n
+ * overestimates the variance of their mean: pixels stop later than they could, never
+ * earlier. A pixel with fewer than 2 samples has an infinite error.
+ *
+ * ## The schedule (checks happen at fixed sample counts, so the result is a pure function
+ * of the samples: the pass budget and the machine's speed decide nothing)
+ * Every pixel first takes min_spp samples; then checks happen when every pixel still
+ * going has reached the next count, n -> n + max(min_spp, n / 4) (at most a quarter more
+ * samples than the check before needed), and max_spp (--spp) is always the last.
+ *
+ * ## The decision (at a check, Cycles' filtered convergence mask)
+ * A pixel going on is unconverged when its error is >= threshold. A pixel stops when no
+ * pixel of its 3x3 neighbourhood (itself included) is both still going and unconverged:
+ * a noisy neighbour keeps it going, so an edge is sampled on both sides, and a pixel that
+ * has seen no light after min_spp samples (error 0 at mean 0) only stops when its
+ * neighbours agree. A stopped pixel never restarts. At max_spp every pixel stops.
+ * Since a pixel's decision at check k depends on its neighbours' at check k - 1, it
+ * depends on the pixels within k of it: adaptive_reach() says how far, which is how far
+ * core/render.c renders around a region so that tiles merge into the full render exactly.
+ *
+ * ## Tiles (for the passes, see core/gpu_tracer.c gpu_tracer_set_pass_rectangles)
+ * The image is cut into ADAPTIVE_TILE_SIZE squares; a pass draws only tiles with a pixel
+ * still going, and, for one pass after a check, the tiles that just stopped (the tracer's
+ * ping-pong state sets must both hold a stopped tile's state before it is left alone).
+ */
+#ifndef RT_ADAPTIVE_H
+#define RT_ADAPTIVE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "status.h"
+
+#define ADAPTIVE_DEFAULT_MIN_SPP 16
+#define ADAPTIVE_LUMINANCE_FLOOR 0.2f
+#define ADAPTIVE_TILE_SIZE 8
+
+typedef struct adaptive_sampler adaptive_sampler;
+
+/* Returns the error above of a pixel with n samples whose luminances sum to
+ * luminance_sum and whose squares sum to luminance_squares. */
+float adaptive_pixel_error(float luminance_sum, float luminance_squares, uint32_t n);
+
+/* Returns the check after one at samples (0: before any): min_spp, then
+ * samples + max(min_spp, samples / 4), never more than max_spp. */
+uint32_t adaptive_next_check(uint32_t samples, uint32_t min_spp, uint32_t max_spp);
+
+/* Returns how many checks a render from 0 to max_spp makes before its last one: the
+ * distance in pixels over which a decision can reach. */
+int adaptive_reach(uint32_t min_spp, uint32_t max_spp);
+
+/* Creates the sampler of a width x height image (every pixel going, its first limit the
+ * first check) into *out; free with adaptive_free(). min_spp 0 means
+ * ADAPTIVE_DEFAULT_MIN_SPP; min_spp above max_spp is max_spp. RT_ERROR_RUNTIME when memory
+ * runs out. */
+rt_status adaptive_create(int width, int height, float threshold, uint32_t min_spp, uint32_t max_spp,
+                          adaptive_sampler **out, rt_error *error);
+
+void adaptive_free(adaptive_sampler *sampler);
+
+/* The per-pixel sample limits to give the tracer: width * height counts, rows top to
+ * bottom (a stopped pixel's limit is the samples it has). */
+const uint32_t *adaptive_limits(const adaptive_sampler *sampler);
+
+/* Makes the check once every pixel going has reached its limit: rgba holds each pixel's
+ * (sum R, G, B, samples) and luminance_squares its sum of squared luminance, rows top to
+ * bottom. Stops the pixels the decision above stops and raises the others' limit to the
+ * next check. Returns the pixels still going (0: the render is done). */
+int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *luminance_squares);
+
+/* True when some pixel stopped below max_spp (the threshold, not --spp, ended it). */
+bool adaptive_stopped_early(const adaptive_sampler *sampler);
+
+/* Writes the rectangles the next pass draws (x0, y0, x1, y1 of the image, rows from the
+ * top, x1/y1 exclusive; horizontal runs of tiles joined) into rectangles (room for
+ * adaptive_rectangle_capacity()) and returns their count. settle: the first pass after
+ * a check, which also draws the tiles that check stopped. */
+int adaptive_pass_rectangles(const adaptive_sampler *sampler, bool settle, int *rectangles);
+
+/* The most rectangles adaptive_pass_rectangles() can write (4 ints each). */
+int adaptive_rectangle_capacity(const adaptive_sampler *sampler);
+
+#endif

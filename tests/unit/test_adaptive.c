@@ -1,0 +1,151 @@
+/* test_adaptive.c: adaptive sampling's estimator, schedule, decisions and pass tiles
+ * (adaptive.h), on sums made up here, without a GPU. */
+#include "adaptive.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+
+/* The error of known samples, worked by hand. */
+static void pixel_error(void **state)
+{
+    (void)state;
+    /* Luminances 0, 1, 0, 1: mean 0.5, sample variance (2 - 4 * 0.25) / 3 = 1/3, standard
+     * error sqrt(1/12) = 0.288675, relative to the mean 0.57735. */
+    assert_close(adaptive_pixel_error(2.0f, 2.0f, 4), sqrt(1.0 / 12.0) / 0.5, 1e-6);
+    /* Equal samples: no error, whatever their value (also 0: a black pixel). */
+    assert_close(adaptive_pixel_error(16 * 0.3f, 16 * 0.09f, 16), 0.0, 1e-3);
+    assert_close(adaptive_pixel_error(0.0f, 0.0f, 16), 0.0, 0.0);
+    /* Below the floor the error is absolute: samples 0 and 0.02 (mean 0.01) over the floor. */
+    float sum = 8 * 0.02f, squares = 8 * 0.02f * 0.02f;
+    double variance = (squares - 16 * 0.01 * 0.01) / 15;
+    assert_close(adaptive_pixel_error(sum, squares, 16), sqrt(variance / 16) / ADAPTIVE_LUMINANCE_FLOOR, 1e-5);
+    /* One sample tells nothing about the noise. */
+    assert_true(isinf(adaptive_pixel_error(0.5f, 0.25f, 1)));
+}
+
+static void schedule(void **state)
+{
+    (void)state;
+    assert_int_equal(adaptive_next_check(0, 16, 1024), 16);
+    assert_int_equal(adaptive_next_check(16, 16, 1024), 32);
+    assert_int_equal(adaptive_next_check(64, 16, 1024), 80);
+    assert_int_equal(adaptive_next_check(100, 16, 1024), 125);
+    assert_int_equal(adaptive_next_check(1000, 16, 1024), 1024);
+    assert_int_equal(adaptive_next_check(0, 16, 8), 8);
+    /* Checks before the last: 16 32 48 64 80 100 125 156 195 243 303 378 472 590 737 921. */
+    assert_int_equal(adaptive_reach(16, 1024), 16);
+    assert_int_equal(adaptive_reach(16, 16), 0);
+    assert_int_equal(adaptive_reach(16, 32), 1);
+}
+
+/* An 8x8 image of pixels with n samples each of luminance value (R = G = B = value), all
+ * with no noise but pixel (noisy_x, noisy_y), whose samples alternate 0 and 2 * value. */
+static void make_sums(float *rgba, float *squares, int n, float value, int noisy_x, int noisy_y)
+{
+    for (int i = 0; i < 64; i++) {
+        for (int c = 0; c < 3; c++)
+            rgba[4 * i + c] = n * value;
+        rgba[4 * i + 3] = (float)n;
+        squares[i] = n * value * value;
+    }
+    squares[noisy_y * 8 + noisy_x] = (n / 2) * (2 * value) * (2 * value);
+}
+
+/* A noisy pixel keeps its 3x3 neighbourhood going, the rest stop at min_spp. */
+static void neighbourhood(void **state)
+{
+    (void)state;
+    adaptive_sampler *sampler = NULL;
+    assert_int_equal(adaptive_create(8, 8, 0.05f, 16, 256, &sampler, NULL), RT_OK);
+    for (int i = 0; i < 64; i++)
+        assert_int_equal(adaptive_limits(sampler)[i], 16);
+    float rgba[64 * 4], squares[64];
+    make_sums(rgba, squares, 16, 0.5f, 4, 4);
+    assert_int_equal(adaptive_check(sampler, rgba, squares), 9);
+    assert_true(adaptive_stopped_early(sampler));
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++) {
+            bool near = abs(x - 4) <= 1 && abs(y - 4) <= 1;
+            assert_int_equal(adaptive_limits(sampler)[y * 8 + x], near ? 32 : 16);
+        }
+    /* Next check: the noisy pixel is quiet now; all stop, the stopped ones stay at 16. */
+    make_sums(rgba, squares, 32, 0.5f, 0, 0);
+    squares[0] = 32 * 0.25f;  /* pixel (0, 0) stopped at 16: its sums are not looked at */
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++)
+            if (!(abs(x - 4) <= 1 && abs(y - 4) <= 1))
+                rgba[4 * (y * 8 + x) + 3] = 16;
+    assert_int_equal(adaptive_check(sampler, rgba, squares), 0);
+    assert_int_equal(adaptive_limits(sampler)[0], 16);
+    assert_int_equal(adaptive_limits(sampler)[4 * 8 + 4], 32);
+    adaptive_free(sampler);
+}
+
+/* A pixel that saw no light (0 with no noise) stops only when its neighbours agree; at
+ * max_spp everything stops, and that is not an early stop. */
+static void dark_pixels_and_max(void **state)
+{
+    (void)state;
+    adaptive_sampler *sampler = NULL;
+    assert_int_equal(adaptive_create(8, 8, 0.05f, 16, 32, &sampler, NULL), RT_OK);
+    float rgba[64 * 4], squares[64];
+    make_sums(rgba, squares, 16, 0.5f, 2, 2);
+    for (int c = 0; c < 4; c++)
+        rgba[4 * (2 * 8 + 3) + c] = c == 3 ? 16 : 0;   /* pixel (3, 2): black so far */
+    squares[2 * 8 + 3] = 0;
+    assert_int_equal(adaptive_check(sampler, rgba, squares), 9);
+    assert_int_equal(adaptive_limits(sampler)[2 * 8 + 3], 32);
+    make_sums(rgba, squares, 32, 0.5f, 2, 2);
+    assert_int_equal(adaptive_check(sampler, rgba, squares), 0);
+    adaptive_free(sampler);
+
+    assert_int_equal(adaptive_create(8, 8, 0.05f, 16, 16, &sampler, NULL), RT_OK);
+    make_sums(rgba, squares, 16, 0.5f, 2, 2);
+    assert_int_equal(adaptive_check(sampler, rgba, squares), 0);
+    assert_false(adaptive_stopped_early(sampler));
+    adaptive_free(sampler);
+}
+
+/* The tiles a pass draws: those going, and for the first pass after a check also those
+ * that check stopped; runs along a row are joined; edges are cut to the image. */
+static void pass_rectangles(void **state)
+{
+    (void)state;
+    adaptive_sampler *sampler = NULL;
+    assert_int_equal(adaptive_create(20, 10, 0.05f, 16, 256, &sampler, NULL), RT_OK);
+    int rectangles[4 * 6];
+    assert_int_equal(adaptive_rectangle_capacity(sampler), 6);
+    assert_int_equal(adaptive_pass_rectangles(sampler, false, rectangles), 2);
+    int all[8] = {0, 0, 20, 8, 0, 8, 20, 10};
+    assert_memory_equal(rectangles, all, sizeof all);
+    float rgba[200 * 4], squares[200];
+    for (int i = 0; i < 200; i++) {
+        for (int c = 0; c < 3; c++)
+            rgba[4 * i + c] = 16 * 0.5f;
+        rgba[4 * i + 3] = 16;
+        squares[i] = 16 * 0.25f;
+    }
+    squares[9 * 20 + 19] = 8 * 1.0f;   /* pixel (19, 9): noisy, in the last tile */
+    assert_int_equal(adaptive_check(sampler, rgba, squares), 4);
+    assert_int_equal(adaptive_pass_rectangles(sampler, true, rectangles), 2);
+    assert_memory_equal(rectangles, all, sizeof all);
+    assert_int_equal(adaptive_pass_rectangles(sampler, false, rectangles), 1);
+    int last[4] = {16, 8, 20, 10};
+    assert_memory_equal(rectangles, last, sizeof last);
+    adaptive_free(sampler);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(pixel_error),
+        cmocka_unit_test(schedule),
+        cmocka_unit_test(neighbourhood),
+        cmocka_unit_test(dark_pixels_and_max),
+        cmocka_unit_test(pass_rectangles),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
