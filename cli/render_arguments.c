@@ -49,6 +49,9 @@ static void print_help(FILE *stream)
             "                         soft shadows from area lights: fast, nearly noise-free\n"
             "      --aovs             add layers to the EXR: albedo, normal, depth (first hit) and\n"
             "                         per-pixel variance of luminance, next to R, G, B, samples\n"
+            "      --light-groups     add a layer per light group to the EXR (NAME.R/G/B; `group`\n"
+            "                         clauses of the scene, the rest in 'default'): the layers\n"
+            "                         sum to the image; rtspheres relight reweighs them\n"
             "      --denoise          edge-aware a-trous denoiser guided by albedo, normal and depth\n"
             "                         (an EXR keeps the noisy image as noisy.R/G/B)\n"
             "      --blur SIGMA[:N]   Gaussian blur of SIGMA pixels, N times (the seed's blurNum);\n"
@@ -75,7 +78,7 @@ static void print_help(FILE *stream)
 enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
-    OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
+    OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS, OPTION_LIGHT_GROUPS,
     OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
 };
 
@@ -317,6 +320,7 @@ static int take_option(int option, const char *value, render_arguments *argument
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
     case OPTION_AOVS: job->aovs = true; break;
+    case OPTION_LIGHT_GROUPS: job->light_groups = true; break;
     case OPTION_DENOISE: job->denoise = true; break;
     case OPTION_FULL_TRACER: job->tracer.full_tracer = true; break;
     case 'q': arguments->quiet = true; break;
@@ -377,6 +381,7 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
         {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
         {"aovs", no_argument, NULL, OPTION_AOVS},
+        {"light-groups", no_argument, NULL, OPTION_LIGHT_GROUPS},
         {"denoise", no_argument, NULL, OPTION_DENOISE},
         {"blur", required_argument, NULL, OPTION_BLUR},
         {"tonemap", required_argument, NULL, OPTION_TONEMAP},

@@ -110,6 +110,7 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *                            LIGHT_LOCAL_CHOICE_MAX of core/tracer_interface.h), never by
  *                            their estimated irradiance at the point (glsl/lights.glsl)
  *   GPU_OMIT_RECTANGLE_LIGHTS  no quad light, so no sampling by spherical rectangles
+ *   GPU_OMIT_LIGHT_GROUPS    no light group layers asked for (render_options.light_groups)
  *   GPU_FIX_UNIFORMS         the integrator, the sky type and the sampler compiled in as constants
  *                            (the values in the parameters), not read from the
  *                            parameter block
@@ -126,7 +127,8 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_FIX_UNIFORMS (1u << 9)
 #define GPU_OMIT_LIGHT_CHOICE (1u << 10)
 #define GPU_OMIT_RECTANGLE_LIGHTS (1u << 11)
-#define GPU_VARIANT_BITS 12
+#define GPU_OMIT_LIGHT_GROUPS (1u << 12)
+#define GPU_VARIANT_BITS 13
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct
@@ -202,6 +204,13 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
  * squared luminance (for the variance). totals may be NULL. */
 rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
                           rt_error *error);
+
+/* Reads the light group layers (glsl/light_groups.glsl) of a tracer created with
+ * shader.light_group_count > 0 and without GPU_OMIT_LIGHT_GROUPS: layers receives
+ * light_group_count * width * height * 4 floats, layer after layer, rows top to bottom,
+ * (sum of the group's radiance over the samples gathered r, g, b, 0). Other tracers:
+ * RT_ERROR_RUNTIME. */
+rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error);
 
 /* Renders the first-hit AOVs with samples jittered camera rays per pixel (the same camera
  * rays as the render's first samples): albedo_depth receives width*height*4 floats (albedo

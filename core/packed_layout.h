@@ -40,7 +40,7 @@
 #define RT_PACKED_LAYOUT_H
 
 /* Bumped whenever a record below changes meaning. */
-#define PACKED_LAYOUT_VERSION 3
+#define PACKED_LAYOUT_VERSION 4
 #define PACKED_NONE 4294967295u
 
 /* ---- header (6 texels), field i is component i % 4 of texel i / 4 */
@@ -76,7 +76,8 @@
  *   texel 1 = (emission.r, emission.g, emission.b, fuzz)        emission is colour x strength
  *   texel 2 = (index of refraction, albedo texture, emission texture, normal map image)
  *             (texture and image indices, or PACKED_NONE)
- *   texel 3 = (Phong exponent, Phong specular colour.rgb)      Whitted integrator only */
+ *   texel 3 = (Phong exponent, Phong specular colour.rgb)      Whitted integrator only
+ *   emissive: texel 1 .w = its light group (scene.h light_groups; fuzz is metal's) */
 #define PACKED_MATERIAL_STRIDE 4
 #define MATERIAL_LAMBERTIAN 0
 #define MATERIAL_METAL 1
@@ -156,13 +157,14 @@
  * float bits, one texel each, rows top to bottom, after all the records */
 #define PACKED_IMAGE_STRIDE 1
 
-/* ---- lights: 4 texels (what next-event estimation samples: see glsl/lights.glsl for how
+/* ---- lights: 5 texels (what next-event estimation samples: see glsl/lights.glsl for how
  * one is chosen: by power, or by its estimated irradiance at the point)
  *   texel 0 = (type tag, primitive slot (area lights), 0, 0) -- see below for the others
  *   texel 1 = (position.xyz (point, spot) or direction towards the light (sun), cdf)
  *             cdf: the probability of choosing this light or any before it
  *   texel 2 = (intensity colour.rgb (point, spot: per steradian; sun: irradiance), 0)
  *   texel 3 = (spot direction.xyz, cos of the spot's inner half-angle)
+ *   texel 4 = (light group (scene.h light_groups; the environment: the sky's), 0, 0, 0)
  *   point, spot, sun: texel 0 .yzw = polynomial attenuation c, l, q (all 0: inverse square),
  *   texel 1 .xyz = position (point, spot) or the direction towards the sun, texel 2 .w = cos
  *   of the spot's outer half-angle or of the sun's angular radius.
@@ -175,7 +177,7 @@
  * intensity); it is importance-sampled by the environment section: one float per texel
  * (in .x): the cumulative distribution over rows (height values), then for each row the
  * cumulative distribution over its pixels (width values), of luminance x sin(latitude). */
-#define PACKED_LIGHT_STRIDE 4
+#define PACKED_LIGHT_STRIDE 5
 #define LIGHT_SPHERE 0
 #define LIGHT_QUAD 1
 #define LIGHT_TRIANGLE 2

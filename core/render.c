@@ -69,6 +69,8 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     p->integrator = options->integrator;
     p->light_sampling = !options->no_light_sampling;
     memcpy(p->ambient, s->ambient, sizeof p->ambient);
+    p->light_group_count = options->light_groups ? (uint32_t)s->light_group_count : 0;
+    p->sky_light_group = (uint32_t)s->sky.light_group;
     p->pass_work_budget = (int32_t)(options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET);
 }
 
@@ -107,6 +109,8 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_LIGHT_CHOICE;
     if (!(contents->light_types & 1u << LIGHT_QUAD))
         omitted |= GPU_OMIT_RECTANGLE_LIGHTS;
+    if (!options->light_groups)
+        omitted |= GPU_OMIT_LIGHT_GROUPS;
     return omitted;
 }
 
@@ -155,6 +159,42 @@ static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image 
             pixels[4 * i + c] = count > 0 ? pixels[4 * i + c] / count : 0.0f;
     }
     snprintf(image->channel_names[3], IMAGE_CHANNEL_NAME_MAX, "samples");
+    return RT_OK;
+}
+
+/* Reads the light group layers into a new image of the colour's size: NAME.R/G/B per group
+ * of s, each the group's sum over a pixel's finished samples divided by their count (the
+ * fourth channel of colour), as read_image makes the beauty's means. The caller frees
+ * groups. */
+static rt_status read_light_groups(gpu_tracer *tracer, const scene *s, const rt_image *colour, rt_image *groups,
+                                   rt_error *error)
+{
+    int width = colour->width, height = colour->height, count = s->light_group_count;
+    size_t pixel_count = (size_t)width * height;
+    float *layers = malloc(pixel_count * 4 * (size_t)count * sizeof(float));
+    if (layers == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for the light groups");
+    rt_status status = gpu_tracer_read_light_groups(tracer, layers, error);
+    if (status == RT_OK)
+        status = image_create(groups, width, height, 3 * count, error);
+    if (status != RT_OK) {
+        free(layers);
+        return status;
+    }
+    static const char channels[3] = {'R', 'G', 'B'};
+    for (int g = 0; g < count; g++) {
+        for (int c = 0; c < 3; c++)
+            snprintf(groups->channel_names[3 * g + c], IMAGE_CHANNEL_NAME_MAX, "%s.%c", s->light_groups[g],
+                     channels[c]);
+        const float *layer = layers + (size_t)g * pixel_count * 4;
+        for (size_t i = 0; i < pixel_count; i++) {
+            float samples = colour->pixels[4 * i + 3];
+            for (int c = 0; c < 3; c++)
+                groups->pixels[i * 3 * (size_t)count + 3 * (size_t)g + c] = samples > 0 ? layer[4 * i + c] / samples
+                                                                                        : 0.0f;
+        }
+    }
+    free(layers);
     return RT_OK;
 }
 
@@ -258,6 +298,9 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
         memcpy(region, r, 4 * sizeof *region);
     }
     memcpy(result->region, region, sizeof result->region);
+    /* A partial file keeps no light groups (and its paths in flight are traced again). */
+    if (options->light_groups && options->resume != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT, "RENDER: light groups cannot be resumed from a partial render");
     int width = region[2] - region[0], height = region[3] - region[1];
 
     camera_frame frame;
@@ -390,8 +433,8 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
 /* The read-back of render_scene: the image (and with options->aovs the AOVs) into
  * *result, with the path segments; an error, with nothing allocated, when a path
  * reached the work cap. */
-static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const render_options *options, int width,
-                             int height, render_result *result, rt_error *error)
+static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const scene *s, const render_options *options,
+                             int width, int height, render_result *result, rt_error *error)
 {
     gpu_tracer_totals totals = {0};
     float *luminance_squares = NULL;
@@ -406,15 +449,20 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const ren
     if (status == RT_OK && options->aovs)
         status = render_aovs(tracer, width, height, &result->image, luminance_squares, &result->aovs, error);
     free(luminance_squares);
+    if (status == RT_OK && options->light_groups)
+        status = read_light_groups(tracer, s, &result->image, &result->light_groups, error);
     if (status != RT_OK) {
         image_free(&result->image);
         image_free(&result->aovs);
+        image_free(&result->light_groups);
         return status;
     }
     if (totals.traversal_overflows > 0) {
         gpu_info device;
         gpu_get_info(context, &device);
         image_free(&result->image);
+        image_free(&result->aovs);
+        image_free(&result->light_groups);
         return rt_error_set(error, RT_ERROR_RUNTIME,
                             "RENDER: %.0f paths reached the shader's work cap (%d loop iterations per pass, "
                             "`rtspheres info`) or the traversal stack and were cut short; the image would be "
@@ -452,7 +500,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     bool interrupted = false;
     status = run_passes(context, tracer, options, width, height, budget, start, &progress, &interrupted, result, error);
     if (status == RT_OK)
-        status = read_result(context, tracer, options, width, height, result, error);
+        status = read_result(context, tracer, s, options, width, height, result, error);
     gpu_tracer_destroy(tracer);
     if (status != RT_OK)
         return status;

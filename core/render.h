@@ -60,6 +60,8 @@ typedef struct render_options {
     int sampler;                 /* SAMPLER_* of tracer_interface.h: 0, the default, is
                                   * SAMPLER_SOBOL; SAMPLER_INDEPENDENT for comparisons */
     bool aovs;                   /* also render the AOV image (see render_result.aovs) */
+    bool light_groups;           /* also collect each light group's image (see
+                                  * render_result.light_groups); not with resume */
     uint32_t russian_roulette_depth;
     uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */
     int region[4];               /* x0, y0, x1, y1 (row 0 at the top, x1/y1 exclusive) of the
@@ -88,6 +90,12 @@ typedef struct render_result {
     rt_image aovs;               /* with options.aovs: albedo.R/G/B, normal.X/Y/Z (world,
                                   * first hit), depth.Z (0: no hit), variance.Y (per-pixel
                                   * sample variance of luminance); free with image_free() */
+    rt_image light_groups;       /* with options.light_groups: NAME.R, NAME.G, NAME.B for each
+                                  * of the scene's light groups in order (scene.h), the mean
+                                  * radiance of that group alone: the groups sum to image's
+                                  * R, G, B up to float rounding (an interrupted render's
+                                  * groups also hold part of the paths then in flight);
+                                  * free with image_free() */
     uint64_t samples;            /* samples finished over all pixels */
     double seconds;              /* whole render, including set-up */
     double first_pass_seconds;   /* from the start until the first pass finished */

@@ -68,6 +68,11 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
     placed.full_height = settings->height;
     char hash[24];
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)result->scene_hash);
+    /* The layers' names (the partial file keeps none). */
+    char groups[SCENE_LIGHT_GROUP_MAX * (SCENE_LIGHT_GROUP_NAME_MAX + 1) + 1] = "";
+    for (int g = 0; complete && job->light_groups && g < image->scene.light_group_count; g++)
+        snprintf(groups + strlen(groups), sizeof groups - strlen(groups), "%s%s", g > 0 ? "," : "",
+                 image->scene.light_groups[g]);
     render_output_metadata metadata = {
         .scene = job->scene_path,
         .scene_hash = hash,
@@ -80,6 +85,7 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
         .path_segments = result->path_segments,
         .complete = complete,
         .render_seconds = result->seconds,
+        .light_groups = groups[0] != '\0' ? groups : NULL,
     };
     /* With a tone-mapping operator the exposure was applied before it (postprocess). */
     float exposure = job->tonemap != TONEMAP_CLAMP ? 0.0f : (float)job->exposure;
@@ -175,6 +181,27 @@ static rt_status postprocess_result(const render_job *job, const char *output, r
     return status;
 }
 
+/* Moves the result's light group layers (if any) after its AOVs, where the writer takes
+ * the layers of an EXR from. */
+static rt_status add_light_groups(render_result *result, rt_error *error)
+{
+    if (result->light_groups.pixels == NULL)
+        return RT_OK;
+    if (result->aovs.pixels == NULL) {
+        result->aovs = result->light_groups;
+        result->light_groups = (rt_image){0};
+        return RT_OK;
+    }
+    rt_image joined = {0};
+    rt_status status = image_append_channels(&result->aovs, &result->light_groups, &joined, error);
+    if (status != RT_OK)
+        return status;
+    image_free(&result->aovs);
+    image_free(&result->light_groups);
+    result->aovs = joined;
+    return RT_OK;
+}
+
 /* After the passes: writes the result, post-processed, to the output when the render
  * finished, else (render_status RT_ERROR_INTERRUPTED) as it is to the partial file, which
  * the message then names. */
@@ -195,6 +222,8 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
                             (unsigned long long)result->samples, plan->partial, plan->partial);
     }
     rt_status status = postprocess_result(image->run->job, plan->output, result, error);
+    if (status == RT_OK)
+        status = add_light_groups(result, error);
     if (status != RT_OK)
         return status;
     status = write_image(image, &result->image, plan->output, result->samples, true, result, error);
@@ -218,6 +247,7 @@ static void image_render_options(job_image *image, render_options *options)
     options->sample_start = image->plan.sample_start;
     memcpy(options->region, image->plan.region, sizeof options->region);
     options->aovs = job->aovs || job->denoise;
+    options->light_groups = job->light_groups;
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;
     options->stop_requested = job->stop_requested;
@@ -262,6 +292,7 @@ static rt_status render_image(job_image *image, rt_error *error)
         status = finish_image(image, &result, status, error);
         image_free(&result.image);
         image_free(&result.aovs);
+        image_free(&result.light_groups);
     }
     image_free(&resume_image);
     return status;

@@ -30,6 +30,9 @@
  *   resume_path             NULL: start afresh; else continue that partial file
  *   checkpoint_seconds      0: never; else write the partial file that often
  *   aovs                    add the AOV layers (render.h) to an EXR
+ *   light_groups            add a layer per light group (render.h render_result.light_groups,
+ *                           NAME.R/G/B) to an EXR; not with denoise, blur, resume, sample
+ *                           ranges, tiles or shards other than by frames
  *   denoise                 postprocess_denoise() guided by the AOVs; an EXR keeps the noisy
  *                           colour as noisy.R/G/B
  *   blur_sigma, blur_passes sigma 0: no blur; passes 0: 1
@@ -108,6 +111,7 @@ typedef struct render_job {
     const char *resume_path;
     double checkpoint_seconds;
     bool aovs;
+    bool light_groups;
     bool denoise;
     float blur_sigma;
     int blur_passes;
@@ -194,8 +198,8 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * first output name (batch.h's errors; several frames and no frame number in the
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
  * without EXR; resume with several frames; shard_by without shard; a shard by frames
- * without frames, or with no frame; a shard by samples with a sample range; a shard by
- * tiles with crop or tile. */
+ * without frames, or with no frame; light groups (see the job); a shard by samples with a
+ * sample range; a shard by tiles with crop or tile; light groups with a shard not by frames. */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 
 /* True when the frame at position index of job->frames is this job's to render (always,

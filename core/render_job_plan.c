@@ -80,6 +80,30 @@ static rt_status check_first_output(const render_job *job, const char *output, r
     return RT_OK;
 }
 
+/* Checks --light-groups against the output and the other options: its layers need an
+ * EXR; they must sum to the beauty, which denoise and blur change; a partial file and
+ * merge keep no layers (no resume, sample ranges or tiles). */
+static rt_status check_light_groups(const render_job *job, const char *output, rt_error *error)
+{
+    if (!job->light_groups)
+        return RT_OK;
+    if (image_format_of(output) != IMAGE_FORMAT_EXR)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups writes a layer per light group, which only .exr keeps; not '%s' "
+                            "(rtspheres relight makes other formats from the EXR)", output);
+    if (job->denoise || job->blur_sigma > 0)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups with --%s: the layers would no longer sum to the image; relight, "
+                            "then post-process", job->denoise ? "denoise" : "blur");
+    if (job->resume_path != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT, "--light-groups cannot --resume: a partial file keeps no layers");
+    if (job->sample_count > 0 || job->tile_count)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups with --%s: merge keeps no light group layers; render whole images",
+                            job->sample_count > 0 ? "samples" : "tile");
+    return RT_OK;
+}
+
 /* Resolves the shard (its kind, and for tiles the band) into plan and checks it against
  * the other ways of choosing frames, samples and region. */
 static rt_status plan_shard(const render_job *job, render_job_plan *plan, rt_error *error)
@@ -134,7 +158,15 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
     if (job->resume_path != NULL && job->frame_count > 1)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--resume continues one image; render the frames one at a time");
-    return plan_shard(job, plan, error);
+    status = check_light_groups(job, plan->first_output, error);
+    if (status != RT_OK)
+        return status;
+    status = plan_shard(job, plan, error);
+    if (status == RT_OK && job->light_groups && job->shard_count && plan->shard_by != RENDER_SHARD_FRAMES)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups with --shard by %s: merge keeps no light group layers; shard by frames",
+                            render_job_shard_kind_name(plan->shard_by));
+    return status;
 }
 
 bool render_job_includes_frame(const render_job *job, const render_job_plan *plan, int index)

@@ -65,13 +65,19 @@ rt_status render_output_write(const char *path, const rt_image *image, const rt_
         {.name = METADATA_KEY_PATH_SEGMENTS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
         {.name = METADATA_KEY_COMPLETE, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->complete},
         {.name = METADATA_KEY_RENDER_SECONDS, .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = metadata->render_seconds},
-        {.name = METADATA_KEY_MERGED_PARTS, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->merged_parts},
+        {0}, {0},   /* the optional keys below */
     };
+    int count = (int)(sizeof attributes / sizeof attributes[0]) - 2;
+    if (metadata->merged_parts > 0)
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_MERGED_PARTS, .type = IMAGE_ATTRIBUTE_INT,
+                                                .int_value = metadata->merged_parts};
+    if (metadata->light_groups != NULL)
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_LIGHT_GROUPS, .type = IMAGE_ATTRIBUTE_STRING,
+                                                .string_value = metadata->light_groups};
     image_write_options options = image_write_options_defaults();
     options.exposure = exposure;
     options.attributes = attributes;
-    int count = (int)(sizeof attributes / sizeof attributes[0]);
-    options.attribute_count = metadata->merged_parts > 0 ? count : count - 1;
+    options.attribute_count = count;
     status = image_write(path, written, &options, error);
     image_free(&made);
     return status;

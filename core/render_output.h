@@ -35,6 +35,8 @@ typedef struct render_output_metadata {
     bool complete;
     double render_seconds;
     int merged_parts;                    /* 0: no rtspheres:merged_parts key (not a merge) */
+    const char *light_groups;            /* NULL: no rtspheres:light_groups key; else the
+                                          * layers' group names, comma-separated */
 } render_output_metadata;
 
 /* What a partial file must match to continue a render: its seed, first sample, samples

@@ -48,6 +48,7 @@ shader_modules:
     module "glsl/material_emissive.glsl", SHADER_PROGRAM_TRACER
     module "glsl/material_phong.glsl", SHADER_PROGRAM_TRACER        /* Whitted's shading model */
     module "glsl/material_table.glsl", SHADER_PROGRAM_TRACER        /* the table of materials */
+    module "glsl/light_groups.glsl", SHADER_PROGRAM_TRACER         /* --light-groups layers */
     module "glsl/lights.glsl", SHADER_PROGRAM_TRACER
     module "glsl/direct_light.glsl", SHADER_PROGRAM_TRACER
     module "glsl/path_state.glsl", SHADER_PROGRAM_TRACER

@@ -60,11 +60,15 @@ LightQuery surface_light_query(bool wanted, int model, vec3 p, ShadingFrame fram
 // The light the query's point sends towards view (the reverse of the incoming ray),
 // per unit of the path's throughput: the caller multiplies by query.weight. media and
 // time are the path's, bounce picks the random numbers; light_total receives what MIS at
-// the path's next emitter hit needs of the light choice here (glsl/lights.glsl).
+// the path's next emitter hit needs of the light choice here (glsl/lights.glsl). Each
+// light's share (times query.weight) also goes to its light group (glsl/light_groups.glsl);
+// Whitted's ambient term to the sky's.
 vec3 direct_light(LightQuery query, vec3 view, uint media, float time, uint bounce, inout float light_total)
 {
     bool phong_model = query.model == DIRECT_PHONG;
     vec3 result = phong_model ? ambient * query.material.albedo : vec3(0.0);
+    if (phong_model)
+        add_to_light_group(sky_light_group, query.weight * result);
     if (light_count == 0u)
         return result;
     vec4 phong = phong_model ? phong_parameters(query.material) : vec4(0.0);
@@ -113,7 +117,9 @@ vec3 direct_light(LightQuery query, vec3 view, uint media, float time, uint boun
             weight = power_heuristic(choice * light_sample.pdf, bsdf_pdf) / (choice * light_sample.pdf);
         vec3 transmittance = shadow_transmittance(origin, to_light, light_sample.distance, light_sample.slot, media,
                                                   time);
-        result += transmittance * value * light_sample.emitted * weight;
+        vec3 contribution = transmittance * value * light_sample.emitted * weight;
+        result += contribution;
+        add_to_light_group(light_group_of(light), query.weight * contribution);
     }
     return result;
 }

@@ -82,7 +82,9 @@ void integrate(inout PixelState s)
         if (scatter_in_medium(s, hit.t, u, query, path_done)) {
             // scattered before the surface: done there
         } else if (!hit_something) {
-            s.radiance += s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
+            vec3 sky = s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
+            s.radiance += sky;
+            add_to_light_group(sky_light_group, sky);
             path_done = true;
         } else {
             Surface surface = surface_at(hit, s.origin, s.direction, time);
