@@ -13,6 +13,7 @@
 #   golden   re-render the golden images in golden/ (never run by the tests; say why in
 #            the commit when you commit new ones)
 #   deps     install the Debian packages listed in .ci/debian-packages that are missing
+#   test-deps  the same for .ci/test-packages, what only the tests need (a browser)
 #   bench-deps  the same for .ci/bench-packages, the bench's peers (never the tests')
 #   fuzz     build the libFuzzer harnesses (tests/fuzz/) with clang into build-fuzz/ and
 #            fuzz each for FUZZ_SECONDS; the corpus found grows in build-fuzz/corpus/
@@ -35,7 +36,7 @@
 #              tests/bench/peers.sh say what each does)
 
 all: rtspheres
-.PHONY: all demo test bench bench-deps golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
+.PHONY: all demo test bench bench-deps test-deps golden deps clean unit-tests fuzz fuzz-smoke fuzz-build
 
 CC ?= cc
 CXX ?= c++
@@ -56,7 +57,7 @@ SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer
 endif
 
 PKG_CONFIG ?= pkg-config
-PKGS := epoxy egl OpenImageIO tinyobjloader cglm
+PKGS := epoxy egl OpenImageIO tinyobjloader tinygltf cglm
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell $(PKG_CONFIG) --libs $(PKGS) 2>/dev/null)
 CMOCKA_LIBS = $(shell $(PKG_CONFIG) --libs cmocka 2>/dev/null)
@@ -117,8 +118,8 @@ $(BUILD)/tests/%: tests/unit/%.c $(LIBRARY)
 unit-tests: $(UNIT_TESTS)
 
 # Installs what the list $(1) names and dpkg says is missing (sudo when not root); $(2)
-# is the target, for the message. deps: what rtspheres and its tests need; bench-deps:
-# the bench's peers.
+# is the target, for the message. deps: what rtspheres and its tests need; test-deps:
+# what only the tests need; bench-deps: the bench's peers.
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 define install_missing
 	@missing=$$(grep -v '^\s*#' $(1) | while read -r p; do \
@@ -133,6 +134,9 @@ define install_missing
 endef
 deps:
 	$(call install_missing,.ci/debian-packages,deps)
+
+test-deps: deps
+	$(call install_missing,.ci/test-packages,test-deps)
 
 bench-deps:
 	$(call install_missing,.ci/bench-packages,bench-deps)
@@ -169,7 +173,7 @@ $(BUILD)/keep-libraries-loaded.so: tests/sanitizers/keep_libraries_loaded.c
 	@mkdir -p $(dir $@)
 	$(Q)$(CC) -shared -fPIC -O2 -Wall -Wextra $< -o $@
 
-test: deps
+test: test-deps
 	$(Q)$(MAKE) --no-print-directory $(PROGRAM) unit-tests $(SAN_TEST_SHIM)
 	$(Q)$(if $(SAN_TEST_ENV),rm -rf $(SAN_REPORTS) && mkdir -p $(SAN_REPORTS) && )$(SAN_TEST_ENV) V=$(V) sh tests/run.sh \
 		$(BUILD) ./$(PROGRAM) $(TESTS)
@@ -201,40 +205,61 @@ FUZZ_FLAGS := -std=c11 -D_GNU_SOURCE -g -O1 -fno-omit-frame-pointer -Icore -Igls
 # The packer and the CPU traversal of what it packs (core/pack_internal.h lists its files).
 FUZZ_PACK_SOURCES := core/pack.c core/pack_collect.c core/pack_geometry.c core/pack_lights.c \
 	core/pack_materials.c core/packed_traverse.c
-# The scene parser's parts (core/scene_parse.c lists what each does).
+# The scene parser's parts (core/scene_parse.c lists what each does); its gltf statement
+# reads glTF files through the C++ shim (core/gltf_load.cpp over tinygltf).
 FUZZ_PARSER_SOURCES := core/scene_parse.c core/scene_report.c core/scene_lexer.c core/scene_values.c \
 	core/scene_statements.c core/scene_statements_appearance.c core/scene_statements_geometry.c \
-	core/scene_builder.c core/scene_validate.c core/affine.c
+	core/scene_builder.c core/scene_validate.c core/affine.c core/scene_gltf.c
+FUZZ_GLTF_CXX_SOURCES := core/gltf_load.cpp core/gltf_nodes.cpp
 FUZZ_SCENE_SOURCES := tests/fuzz/fuzz_scene_parse.c $(FUZZ_PARSER_SOURCES) core/expression.c core/scene.c \
-	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c
+	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c $(FUZZ_GLTF_CXX_SOURCES)
 FUZZ_EXPRESSION_SOURCES := tests/fuzz/fuzz_expression.c core/expression.c core/status.c
-# The OBJ harness runs scene_load_assets(), which links the C++ shims (tinyobjloader and,
-# for images, OpenImageIO); the libraries themselves are not instrumented.
+# The loading harnesses run scene_load_assets(), which links the C++ shims (tinyobjloader,
+# tinygltf and, for images, OpenImageIO); the libraries themselves are not instrumented.
 FUZZ_CXX ?= clang++
-FUZZ_OBJ_C_SOURCES := tests/fuzz/fuzz_obj_load.c $(FUZZ_PARSER_SOURCES) core/expression.c core/scene.c \
-	core/status.c core/bvh.c $(FUZZ_PACK_SOURCES) core/camera.c core/scene_assets.c
-FUZZ_OBJ_CXX_SOURCES := core/obj_load.cpp core/image_io.cpp
-FUZZ_HARNESSES := $(FUZZ_DIR)/fuzz_scene_parse $(FUZZ_DIR)/fuzz_expression $(FUZZ_DIR)/fuzz_obj_load
+FUZZ_ASSET_SOURCES := $(FUZZ_PARSER_SOURCES) core/expression.c core/scene.c core/status.c core/bvh.c \
+	$(FUZZ_PACK_SOURCES) core/camera.c core/scene_assets.c core/ply_load.c core/obj_load.cpp core/image_io.cpp \
+	$(FUZZ_GLTF_CXX_SOURCES)
+FUZZ_HARNESSES := $(FUZZ_DIR)/fuzz_scene_parse $(FUZZ_DIR)/fuzz_expression $(FUZZ_DIR)/fuzz_obj_load \
+	$(FUZZ_DIR)/fuzz_gltf_load $(FUZZ_DIR)/fuzz_ply_load
 
-$(FUZZ_DIR)/fuzz_scene_parse: $(FUZZ_SCENE_SOURCES) $(wildcard core/*.h)
-	$(say) FUZZCC $@
+# The sources of the harnesses, each compiled once (instrumented) into build-fuzz/objects/
+# and shared by the harnesses that use it; a harness links its objects with clang++ and
+# the shims' libraries.
+FUZZ_OBJECTS := $(FUZZ_DIR)/objects
+fuzz_objects = $(patsubst %.cpp,$(FUZZ_OBJECTS)/%.o,$(patsubst %.c,$(FUZZ_OBJECTS)/%.o,$(1)))
+
+$(FUZZ_OBJECTS)/%.o: %.c $(wildcard core/*.h)
+	$(say) FUZZCC $<
 	@mkdir -p $(dir $@)
-	$(Q)$(FUZZ_CC) $(FUZZ_FLAGS) $(FUZZ_SCENE_SOURCES) -o $@ -lm
+	$(Q)$(FUZZ_CC) $(FUZZ_FLAGS) -c $< -o $@
+
+$(FUZZ_OBJECTS)/%.o: %.cpp $(wildcard core/*.h)
+	$(say) FUZZCXX $<
+	@mkdir -p $(dir $@)
+	$(Q)$(FUZZ_CXX) $(subst -std=c11,-std=c++17,$(FUZZ_FLAGS)) $(PKG_CFLAGS) -c $< -o $@
+
+define fuzz_link
+	$(say) FUZZLD $@
+	$(Q)$(FUZZ_CXX) -fsanitize=fuzzer,address,undefined $^ $(PKG_LIBS) -lm -o $@
+endef
+
+$(FUZZ_DIR)/fuzz_scene_parse: $(call fuzz_objects,$(FUZZ_SCENE_SOURCES))
+	$(fuzz_link)
 
 $(FUZZ_DIR)/fuzz_expression: $(FUZZ_EXPRESSION_SOURCES) $(wildcard core/*.h)
 	$(say) FUZZCC $@
 	@mkdir -p $(dir $@)
 	$(Q)$(FUZZ_CC) $(FUZZ_FLAGS) $(FUZZ_EXPRESSION_SOURCES) -o $@ -lm
 
-$(FUZZ_DIR)/fuzz_obj_load: $(FUZZ_OBJ_C_SOURCES) $(FUZZ_OBJ_CXX_SOURCES) $(wildcard core/*.h)
-	$(say) FUZZCC $@
-	@mkdir -p $(FUZZ_DIR)/obj
-	$(Q)for source in $(FUZZ_OBJ_C_SOURCES); do \
-		$(FUZZ_CC) $(FUZZ_FLAGS) -c $$source -o $(FUZZ_DIR)/obj/$$(basename $$source .c).o || exit 1; done
-	$(Q)for source in $(FUZZ_OBJ_CXX_SOURCES); do \
-		$(FUZZ_CXX) $(subst -std=c11,-std=c++17,$(FUZZ_FLAGS)) $(PKG_CFLAGS) -c $$source \
-		-o $(FUZZ_DIR)/obj/$$(basename $$source .cpp).o || exit 1; done
-	$(Q)$(FUZZ_CXX) -fsanitize=fuzzer,address,undefined $(FUZZ_DIR)/obj/*.o $(PKG_LIBS) -lm -o $@
+$(FUZZ_DIR)/fuzz_obj_load: $(call fuzz_objects,tests/fuzz/fuzz_obj_load.c $(FUZZ_ASSET_SOURCES))
+	$(fuzz_link)
+
+$(FUZZ_DIR)/fuzz_gltf_load: $(call fuzz_objects,tests/fuzz/fuzz_gltf_load.c $(FUZZ_ASSET_SOURCES))
+	$(fuzz_link)
+
+$(FUZZ_DIR)/fuzz_ply_load: $(call fuzz_objects,tests/fuzz/fuzz_ply_load.c $(FUZZ_ASSET_SOURCES))
+	$(fuzz_link)
 
 fuzz-build: $(FUZZ_HARNESSES)
 

@@ -12,6 +12,7 @@
 
 int command_render(int argc, char **argv);
 int command_diff(int argc, char **argv);
+int command_check(int argc, char **argv);
 int command_info(int argc, char **argv);
 int command_stats(int argc, char **argv);
 int command_merge(int argc, char **argv);

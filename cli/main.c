@@ -14,6 +14,8 @@ static void print_usage(FILE *stream)
             "commands:\n"
             "  render SCENE -o OUTPUT   render a scene file to .exr/.png/.jpg/.hdr\n"
             "  diff A B                 compare two images (exit 0 pass, 1 fail, 2 error)\n"
+            "  check SUITE              render a regression suite and compare each case with its\n"
+            "                           golden image; JUnit XML and an HTML report for CI\n"
             "  info                     list the EGL devices (the numbers --device takes) and show the\n"
             "                           OpenGL renderer a render would use\n"
             "  stats IMAGE              per-channel mean/min/max of an image and its rtspheres metadata\n"
@@ -29,7 +31,7 @@ static const struct {
     const char *name;
     int (*run)(int argc, char **argv);
 } commands[] = {
-    {"render", command_render}, {"diff", command_diff},   {"info", command_info},
+    {"render", command_render}, {"diff", command_diff},   {"check", command_check},  {"info", command_info},
     {"stats", command_stats},   {"merge", command_merge}, {"montage", command_montage},
     {"relight", command_relight},
 };

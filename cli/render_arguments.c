@@ -16,7 +16,8 @@ static void print_help(FILE *stream)
     fprintf(stream,
             "usage: rtspheres render SCENE -o OUTPUT [options]\n"
             "\n"
-            "Renders the scene file SCENE and writes OUTPUT; the format follows the extension:\n"
+            "Renders the scene file SCENE (or a glTF file, .gltf or .glb, as a scene by itself)\n"
+            "and writes OUTPUT; the format follows the extension:\n"
             ".exr (linear float, with metadata and a per-pixel 'samples' channel), .hdr,\n"
             ".png/.jpg/.tif (8-bit sRGB).\n"
             "\n"
@@ -28,6 +29,8 @@ static void print_help(FILE *stream)
             "      --size WxH         image size in pixels, e.g. 640x360\n"
             "      --max-depth N      path segments per sample at most\n"
             "      --seed N           random seed (same seed, same image)\n"
+            "      --camera NAME      a glTF scene: render its camera (or camera node) NAME\n"
+            "                         (default: the first camera its scene places)\n"
             "  -D NAME=VALUE          set scene variable $NAME (wins over the file's `set`)\n"
             "      --frames LIST      render frames, e.g. 1-60 or 1-10,15,20-30:2; each frame\n"
             "                         sets $frame and $time (= frame / --fps)\n"
@@ -52,6 +55,9 @@ static void print_help(FILE *stream)
             "      --light-groups     add a layer per light group to the EXR (NAME.R/G/B; `group`\n"
             "                         clauses of the scene, the rest in 'default'): the layers\n"
             "                         sum to the image; rtspheres relight reweighs them\n"
+            "      --variance         add layers to the EXR: variance.R/G/B, each pixel's sample\n"
+            "                         variance of each colour channel (for `rtspheres diff --test z`\n"
+            "                         and `rtspheres check`)\n"
             "      --denoise          edge-aware a-trous denoiser guided by albedo, normal and depth\n"
             "                         (an EXR keeps the noisy image as noisy.R/G/B)\n"
             "      --blur SIGMA[:N]   Gaussian blur of SIGMA pixels, N times (the seed's blurNum);\n"
@@ -78,8 +84,9 @@ static void print_help(FILE *stream)
 enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
-    OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS, OPTION_LIGHT_GROUPS,
-    OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
+    OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
+    OPTION_LIGHT_GROUPS, OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
+    OPTION_CAMERA,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -253,12 +260,13 @@ static const char *take_value(int option, const char *value, render_job *job)
 
 /* --tile and --shard: I/N (batch.h shard_parse(), whose message says what is wrong)
  * into *index and *count. Returns EXIT_OK, or EXIT_BAD_INPUT after printing why. */
-static int take_split(const char *option_name, const char *value, int *index, int *count)
+static int take_split(const render_arguments *arguments, const char *option_name, const char *value, int *index,
+                      int *count)
 {
     rt_error error = {{0}};
     if (shard_parse(value, index, count, &error) == RT_OK)
         return EXIT_OK;
-    fprintf(stderr, "rtspheres render: %s %s\n", option_name, error.message);
+    fprintf(arguments->messages, "%s%s %s\n", arguments->message_prefix, option_name, error.message);
     return EXIT_BAD_INPUT;
 }
 
@@ -274,14 +282,14 @@ static int take_part(int option, const char *value, render_arguments *arguments)
         job->frames = NULL;
         job->frame_count = 0;
         if (frame_list_parse(value, &arguments->frames, &error) != RT_OK) {
-            fprintf(stderr, "rtspheres render: --%s\n", error.message);
+            fprintf(arguments->messages, "%s--%s\n", arguments->message_prefix, error.message);
             return EXIT_BAD_INPUT;
         }
         job->frames = arguments->frames.frames;
         job->frame_count = arguments->frames.count;
         return EXIT_OK;
-    case OPTION_TILE: return take_split("--tile", value, &job->tile_index, &job->tile_count);
-    case OPTION_SHARD: return take_split("--shard", value, &job->shard_index, &job->shard_count);
+    case OPTION_TILE: return take_split(arguments, "--tile", value, &job->tile_index, &job->tile_count);
+    case OPTION_SHARD: return take_split(arguments, "--shard", value, &job->shard_index, &job->shard_count);
     }
     return EXIT_OK;
 }
@@ -319,8 +327,10 @@ static int take_option(int option, const char *value, render_arguments *argument
     switch (option) {
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
+    case OPTION_CAMERA: job->camera = value; break;
     case OPTION_AOVS: job->aovs = true; break;
     case OPTION_LIGHT_GROUPS: job->light_groups = true; break;
+    case OPTION_VARIANCE: job->variance = true; break;
     case OPTION_DENOISE: job->denoise = true; break;
     case OPTION_FULL_TRACER: job->tracer.full_tracer = true; break;
     case 'q': arguments->quiet = true; break;
@@ -345,17 +355,23 @@ static int take_option(int option, const char *value, render_arguments *argument
         break;
     }
     if (out_of_memory) {
-        fprintf(stderr, "rtspheres render: out of memory\n");
+        fprintf(arguments->messages, "%sout of memory\n", arguments->message_prefix);
         return EXIT_RUNTIME;
     }
     if (complaint != NULL) {
-        fprintf(stderr, "rtspheres render: %s, not '%s'\n", complaint, value);
+        fprintf(arguments->messages, "%s%s, not '%s'\n", arguments->message_prefix, complaint, value);
         return EXIT_BAD_INPUT;
     }
     return EXIT_OK;
 }
 
 int render_arguments_parse(int argc, char **argv, render_arguments *arguments, bool *help_shown)
+{
+    return render_arguments_parse_to(argc, argv, arguments, help_shown, stderr, "rtspheres render: ");
+}
+
+int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments, bool *help_shown, FILE *messages,
+                              const char *prefix)
 {
     static const struct option long_options[] = {
         {"output", required_argument, NULL, 'o'},
@@ -376,12 +392,14 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
         {"shard-by", required_argument, NULL, OPTION_SHARD_BY},
         {"checkpoint", required_argument, NULL, OPTION_CHECKPOINT},
         {"resume", required_argument, NULL, OPTION_RESUME},
+        {"camera", required_argument, NULL, OPTION_CAMERA},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
         {"sampler", required_argument, NULL, OPTION_SAMPLER},
         {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
         {"aovs", no_argument, NULL, OPTION_AOVS},
         {"light-groups", no_argument, NULL, OPTION_LIGHT_GROUPS},
+        {"variance", no_argument, NULL, OPTION_VARIANCE},
         {"denoise", no_argument, NULL, OPTION_DENOISE},
         {"blur", required_argument, NULL, OPTION_BLUR},
         {"tonemap", required_argument, NULL, OPTION_TONEMAP},
@@ -393,14 +411,24 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
     memset(arguments, 0, sizeof *arguments);
     arguments->job = render_job_defaults();
     arguments->device = -1;
+    arguments->messages = messages;
+    arguments->message_prefix = prefix;
     *help_shown = false;
+    /* getopt's own messages go to stderr: elsewhere ours say the same. */
+    bool own_messages = messages != stderr;
+    opterr = !own_messages;
     optind = 1;
     int option;
-    while ((option = getopt_long(argc, argv, "o:s:D:qvh", long_options, NULL)) != -1) {
+    while ((option = getopt_long(argc, argv, own_messages ? ":o:s:D:qvh" : "o:s:D:qvh", long_options, NULL)) != -1) {
         if (option == 'h') {
             print_help(stdout);
             *help_shown = true;
             return EXIT_OK;
+        }
+        if (own_messages && (option == '?' || option == ':')) {
+            fprintf(messages, option == '?' ? "%sunknown render option '%s'\n" : "%s%s needs a value\n", prefix,
+                    argv[optind - 1]);
+            return EXIT_BAD_INPUT;
         }
         if (option == '?' || option == ':')
             return EXIT_BAD_INPUT;  /* getopt has said what is wrong */
@@ -409,16 +437,17 @@ int render_arguments_parse(int argc, char **argv, render_arguments *arguments, b
             return code;
     }
     if (optind >= argc) {
-        fprintf(stderr, "rtspheres render: which scene? usage: rtspheres render SCENE -o OUTPUT\n");
+        fprintf(arguments->messages, "%swhich scene? usage: rtspheres render SCENE -o OUTPUT\n", arguments->message_prefix);
         return EXIT_BAD_INPUT;
     }
     if (optind + 1 < argc) {
-        fprintf(stderr, "rtspheres render: one scene at a time; unexpected '%s'\n", argv[optind + 1]);
+        fprintf(arguments->messages, "%sone scene at a time; unexpected '%s'\n", arguments->message_prefix, argv[optind + 1]);
         return EXIT_BAD_INPUT;
     }
     arguments->job.scene_path = argv[optind];
     if (arguments->job.output == NULL) {
-        fprintf(stderr, "rtspheres render: no output file; add -o OUTPUT (.exr, .png, .jpg, .hdr, .tif)\n");
+        fprintf(arguments->messages, "%sno output file; add -o OUTPUT (.exr, .png, .jpg, .hdr, .tif)\n",
+                arguments->message_prefix);
         return EXIT_BAD_INPUT;
     }
     return EXIT_OK;

@@ -8,6 +8,7 @@
 #define RT_RENDER_ARGUMENTS_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "batch.h"
 #include "render_job.h"
@@ -21,6 +22,8 @@ typedef struct render_arguments {
     frame_list frames;
     scene_define defines[RENDER_ARGUMENTS_MAX_DEFINES];
     char *define_copies[RENDER_ARGUMENTS_MAX_DEFINES];  /* NAME\0VALUE of each -D */
+    FILE *messages;              /* where complaints go, after message_prefix */
+    const char *message_prefix;
 } render_arguments;
 
 /* Parses argv (argv[0] is "render") into *arguments (initialised here; free with
@@ -28,6 +31,13 @@ typedef struct render_arguments {
  * printing why on stderr; *help_shown is set when --help printed the help (then nothing
  * else is to be done). */
 int render_arguments_parse(int argc, char **argv, render_arguments *arguments, bool *help_shown);
+
+/* The same, with each complaint written to messages after prefix (one line each) instead
+ * of to stderr after "rtspheres render: ", and getopt's messages replaced by such lines
+ * ("unknown render option '--x'", "--size needs a value"): how `rtspheres check` reads a
+ * suite case's render options. */
+int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments, bool *help_shown, FILE *messages,
+                              const char *prefix);
 
 /* Frees what parsing allocated and zeroes *arguments. */
 void render_arguments_free(render_arguments *arguments);

@@ -110,6 +110,9 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *                            LIGHT_LOCAL_CHOICE_MAX of core/tracer_interface.h), never by
  *                            their estimated irradiance at the point (glsl/lights.glsl)
  *   GPU_OMIT_RECTANGLE_LIGHTS  no quad light, so no sampling by spherical rectangles
+ *   GPU_OMIT_PBR             no pbr material
+ *   GPU_OMIT_ALPHA_MASK      no alpha-masked material (the traversal's alpha test)
+ *   GPU_OMIT_VERTEX_COLORS   no vertex colour section
  *   GPU_OMIT_LIGHT_GROUPS    no light group layers asked for (render_options.light_groups)
  *   GPU_FIX_UNIFORMS         the integrator, the sky type and the sampler compiled in as constants
  *                            (the values in the parameters), not read from the
@@ -127,8 +130,11 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_FIX_UNIFORMS (1u << 9)
 #define GPU_OMIT_LIGHT_CHOICE (1u << 10)
 #define GPU_OMIT_RECTANGLE_LIGHTS (1u << 11)
-#define GPU_OMIT_LIGHT_GROUPS (1u << 12)
-#define GPU_VARIANT_BITS 13
+#define GPU_OMIT_PBR (1u << 12)
+#define GPU_OMIT_ALPHA_MASK (1u << 13)
+#define GPU_OMIT_VERTEX_COLORS (1u << 14)
+#define GPU_OMIT_LIGHT_GROUPS (1u << 15)
+#define GPU_VARIANT_BITS 16
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct
@@ -212,6 +218,11 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
  * RT_ERROR_RUNTIME. */
 rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error);
 
+/* Reads the per-channel sums of squares: squares receives width*height*4 floats, rows top
+ * to bottom, (sum of finished samples' squared radiance r^2, g^2, b^2, 0), from which
+ * render.c makes the variance layers. */
+rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error);
+
 /* Renders the first-hit AOVs with samples jittered camera rays per pixel (the same camera
  * rays as the render's first samples): albedo_depth receives width*height*4 floats (albedo
  * r, g, b; distance to the first hit, 0 where nothing was hit), normal_coverage
@@ -248,6 +259,44 @@ typedef struct gpu_random_request {
  * dimension per output pixel. For testing the sampler where it runs. */
 rt_status gpu_random_numbers(gpu_context *context, const gpu_random_request *request, float *rgba,
                              rt_error *error);
+
+/* One query of the material test: a ray along direction meets a surface (normal: the
+ * geometric normal facing the ray, shading: the shading normal, front_face: whether the
+ * ray met the primitive's front) whose material is the packed scene's material number
+ * material; u are the four uniform numbers its sample function draws from, to_light a
+ * direction at which its evaluate and pdf functions are read as well. All directions
+ * unit, in the world. */
+typedef struct gpu_material_query {
+    float direction[3];
+    float normal[3];
+    float shading[3];
+    bool front_face;
+    float u[4];
+    float to_light[3];
+    uint32_t material;
+} gpu_material_query;
+
+/* What the material functions of glsl/material_table.glsl return for one query
+ * (view = -direction). */
+typedef struct gpu_material_result {
+    float direction[3];          /* material_sample: where the path goes on */
+    float pdf;                   /* its BsdfSample.pdf (the density MIS is given) */
+    float weight[3];             /* its f cos / pdf */
+    bool absorbed, light_sampled;
+    float evaluate[3];           /* material_evaluate(view, to_light): f cos */
+    float evaluate_pdf;          /* material_pdf(view, to_light) */
+    float sampled_evaluate[3];   /* the same at the sampled direction */
+    float sampled_pdf;
+} gpu_material_result;
+
+/* Runs the tracer's material functions (the whole tracer's: no part left out) on the
+ * device for count queries against a packed scene (texels as gpu_tracer_create takes
+ * them; only its header, materials, textures and images are read), filling results[0 ..
+ * count - 1]. For testing a material's sampling, density and evaluation where they run
+ * (tests/unit/test_material_pbr.c). The caller owns both arrays. */
+rt_status gpu_material_test(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
+                            const gpu_material_query *queries, int count, gpu_material_result *results,
+                            rt_error *error);
 
 /* Compiles the whole tracer (no part left out) and reads where the GL placed the members
  * of its parameter block: offsets[i] receives the byte offset of the member called

@@ -30,9 +30,9 @@
 
 namespace {
 
-const double default_fail_threshold = 0.016;
-const double default_fail_percent = 1.0;
-const double default_diff_scale = 16.0;
+const double default_fail_threshold = IMAGE_DIFF_DEFAULT_FAIL_THRESHOLD;
+const double default_fail_percent = IMAGE_DIFF_DEFAULT_FAIL_PERCENT;
+const double default_diff_scale = IMAGE_DIFF_DEFAULT_SCALE;
 
 /* Returns value, or fallback when value is zero ("zero means default"). */
 double or_default(double value, double fallback)

@@ -24,6 +24,11 @@
 extern "C" {
 #endif
 
+/* The defaults, for callers that show them. */
+#define IMAGE_DIFF_DEFAULT_FAIL_THRESHOLD 0.016
+#define IMAGE_DIFF_DEFAULT_FAIL_PERCENT 1.0
+#define IMAGE_DIFF_DEFAULT_SCALE 16.0
+
 typedef struct image_diff_options {
     double fail_threshold;
     double fail_percent;

@@ -494,13 +494,48 @@ void decode_to_linear(const OIIO::ImageSpec &spec, rt_image *out)
     }
 }
 
-/* Reads path into *out, which the caller has zeroed and frees on an exception. Images
- * wider or taller than max_side (when > 0) are refused before their pixels are read;
- * linear asks for decode_to_linear(). */
-rt_status image_read_impl(const char *path, int max_side, bool linear, rt_image *out,
-                          rt_error *error)
+/* An image file's bytes in memory (image_read_memory), read through an IOProxy. */
+struct memory_file {
+    const void *bytes;
+    size_t size;
+};
+
+/* Opens the image file in memory, which messages call name. OpenImageIO picks a reader by
+ * the name's extension (trying the others when that one fails), so the name it is given
+ * says what the first bytes say: PNG or JPEG, the formats glTF files embed. */
+std::unique_ptr<OIIO::ImageInput> open_memory_input(const char *name, const memory_file &memory,
+                                                    OIIO::Filesystem::IOMemReader *proxy, rt_error *error)
 {
-    auto input = open_input(path, error);
+    if (memory.bytes == nullptr || memory.size == 0) {
+        read_failed(error, name, "the image is empty");
+        return nullptr;
+    }
+    const unsigned char *b = (const unsigned char *)memory.bytes;
+    bool jpeg = memory.size >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF;
+    /* OpenImageIO 2.4 ignores open()'s proxy argument when a config is given: the proxy
+     * goes in the config ("oiio:ioproxy", a pointer). */
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    void *proxy_pointer = proxy;
+    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
+    auto input = OIIO::ImageInput::open(jpeg ? "memory.jpg" : "memory.png", &config);
+    if (!input)
+        read_failed(error, name, one_line(OIIO::geterror(), "not an image file OpenImageIO reads"));
+    return input;
+}
+
+/* Reads path (or the file in memory, when memory is not nullptr; path then names it) into
+ * *out, which the caller has zeroed and frees on an exception. Images wider or taller
+ * than max_side (when > 0) are refused before their pixels are read; linear asks for
+ * decode_to_linear(). */
+rt_status image_read_impl(const char *path, int max_side, bool linear, rt_image *out,
+                          rt_error *error, const memory_file *memory = nullptr)
+{
+    std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
+    if (memory != nullptr)
+        proxy.reset(new OIIO::Filesystem::IOMemReader((void *)memory->bytes, memory->size));
+    auto input = memory != nullptr ? open_memory_input(path, *memory, proxy.get(), error)
+                                   : open_input(path, error);
     if (!input)
         return RT_ERROR_INPUT;
     const OIIO::ImageSpec &spec = input->spec();
@@ -723,6 +758,32 @@ rt_status image_read(const char *path, rt_image *out, rt_error *error)
 rt_status image_read_linear(const char *path, int max_side, rt_image *out, rt_error *error)
 {
     return image_read_guarded(path, max_side, true, out, error);
+}
+
+rt_status image_read_memory(const void *bytes, size_t size, const char *name, int max_side, bool linear,
+                            rt_image *out, rt_error *error)
+{
+    memset(out, 0, sizeof *out);
+    if (name == nullptr)
+        name = "<memory>";
+    memory_file memory = {bytes, size};
+    try {
+        return image_read_impl(name, max_side, linear, out, error, &memory);
+    } catch (const std::bad_alloc &) {
+        image_free(out);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory", name);
+    } catch (const std::exception &e) {
+        image_free(out);
+        return read_failed(error, name, one_line(e.what()));
+    } catch (...) {
+        image_free(out);
+        return read_failed(error, name, "unexpected C++ exception");
+    }
+}
+
+float image_srgb_decode(float value)
+{
+    return srgb_decode(value);
 }
 
 rt_status image_read_attribute(const char *path, const char *name, char *value, int value_size,

@@ -22,6 +22,9 @@
 #ifndef RT_IMAGE_IO_H
 #define RT_IMAGE_IO_H
 
+#include <stdbool.h>
+#include <stddef.h>
+
 #include "status.h"
 
 #ifdef __cplusplus
@@ -113,6 +116,17 @@ rt_status image_read(const char *path, rt_image *out, rt_error *error);
  * stored. An image wider or taller than max_side pixels (when max_side > 0) is refused
  * with RT_ERROR_INPUT before its pixels are read. Errors as image_read(). */
 rt_status image_read_linear(const char *path, int max_side, rt_image *out, rt_error *error);
+
+/* Reads an image file held in memory (bytes, size: a PNG or JPEG a glTF file embeds) like
+ * image_read_linear() when linear is true, else like image_read(); name is what messages
+ * call it ("IMAGE: cannot read 'NAME': ..."). An image wider or taller than max_side
+ * (when > 0) is refused. The bytes are only read; out as for image_read(). */
+rt_status image_read_memory(const void *bytes, size_t size, const char *name, int max_side, bool linear,
+                            rt_image *out, rt_error *error);
+
+/* The sRGB transfer function's decoding (IEC 61966-2-1): an encoded value in [0, 1] to
+ * linear light, as image_read_linear() decodes 8-bit colour (128/255 becomes 0.2158). */
+float image_srgb_decode(float value);
 
 /* Reads one metadata attribute of the file as text into value (at most value_size bytes,
  * NUL-terminated). Returns RT_OK, or RT_ERROR_INPUT if the file or attribute is missing. */

@@ -70,11 +70,17 @@ static rt_status plan_layout(packer *p, rt_error *error)
     layout->shape_offset = layout->info_offset + (layout->primitive_count + 3) / 4;
     layout->vertex_offset = layout->shape_offset + layout->shape_texels;
     layout->uv_offset = layout->vertex_offset + vertex_count;
+    uint64_t after_uvs = layout->uv_offset + (vertex_count + 1) / 2;
+    layout->color_offset = PACKED_NONE;
+    if (pack_needs_vertex_colors(s)) {
+        layout->color_offset = after_uvs;
+        after_uvs += (vertex_count + 1) / 2;
+    }
     /* A node is 32 bytes and an interior node reads its two children, first and first + 1,
      * which are contiguous: with node_offset 2 mod 4 texels and every pair at an odd node,
      * each pair is one 64-byte cache line instead of straddling two (the buffer itself
      * is 64-byte aligned). */
-    layout->node_offset = layout->uv_offset + (vertex_count + 1) / 2;
+    layout->node_offset = after_uvs;
     layout->node_offset += (6 - layout->node_offset % 4) % 4;
     layout->instance_offset = layout->node_offset + layout->node_count * PACKED_NODE_STRIDE;
     layout->texture_offset = layout->instance_offset + (uint64_t)p->packed_instances * PACKED_INSTANCE_STRIDE;
@@ -120,6 +126,7 @@ static void write_header(packer *p)
     out->vertex_offset = (uint32_t)l->vertex_offset;
     out->vertex_count = (uint32_t)l->vertex_count;
     out->uv_offset = (uint32_t)l->uv_offset;
+    out->color_offset = (uint32_t)l->color_offset;
     out->node_offset = (uint32_t)l->node_offset;
     out->node_count = (uint32_t)l->node_count;
     out->instance_offset = (uint32_t)l->instance_offset;
@@ -138,6 +145,7 @@ static void write_header(packer *p)
     put_texel(p->texels, 3, out->texture_offset, out->texture_count, out->image_offset, out->image_count);
     put_texel(p->texels, 4, out->light_offset, out->light_count, environment_offset, out->area_light_count);
     put_texel(p->texels, 5, out->shape_offset, out->vertex_offset, out->uv_offset, out->vertex_count);
+    put_texel(p->texels, 6, out->color_offset, 0, 0, 0);
 }
 
 /* Allocates the packer's per-object, per-instance and per-mesh arrays. */

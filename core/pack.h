@@ -57,6 +57,9 @@ typedef struct pack_summary {
     bool emitters;               /* an emissive material, whether a primitive uses it or not */
     bool textures;               /* a texture record, or a material naming a texture */
     bool normal_maps;            /* a material with a normal map */
+    bool pbr;                    /* a MATERIAL_PBR material */
+    bool alpha_mask;             /* a material with MATERIAL_FLAG_ALPHA_MASK */
+    bool vertex_colors;          /* the vertex colour section (packed_layout.h "colours") */
 } pack_summary;
 
 typedef struct packed_scene {
@@ -68,6 +71,7 @@ typedef struct packed_scene {
     uint32_t shape_offset, shape_texels;        /* moving sphere and quad records */
     uint32_t vertex_offset, vertex_count;
     uint32_t uv_offset;                         /* two vertices' uvs to a texel */
+    uint32_t color_offset;                      /* vertex colours, or PACKED_NONE */
     uint32_t node_offset, node_count;
     uint32_t instance_offset, instance_count;
     uint32_t texture_offset, texture_count;

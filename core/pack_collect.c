@@ -13,14 +13,16 @@
 
 /* ---- primitives before packing ------------------------------------------------------- */
 
-/* Appends a zeroed vertex; returns its index, or UINT32_MAX when memory runs out or the
- * list would pass 32-bit indices. */
+/* Appends a zeroed vertex (its colour white); returns its index, or UINT32_MAX when memory
+ * runs out or the list would pass 32-bit indices. */
 static uint32_t vertex_push(vertex_list *list)
 {
     if (list->count >= PACK_LIST_LIMIT
         || !array_reserve((void **)&list->items, &list->capacity, (size_t)list->count + 1, sizeof *list->items))
         return UINT32_MAX;
-    memset(&list->items[list->count], 0, sizeof list->items[0]);
+    pending_vertex *vertex = &list->items[list->count];
+    memset(vertex, 0, sizeof *vertex);
+    vertex->color[0] = vertex->color[1] = vertex->color[2] = 1;
     return list->count++;
 }
 
@@ -281,6 +283,8 @@ static rt_status add_mesh_vertices(packer *p, const scene_mesh *mesh, const floa
         }
         if (mesh->uvs != NULL)
             memcpy(vertex->uv, mesh->uvs + 2 * (size_t)v, sizeof vertex->uv);
+        if (mesh->colors != NULL)
+            memcpy(vertex->color, mesh->colors + 3 * (size_t)v, sizeof vertex->color);
     }
     return RT_OK;
 }
@@ -403,7 +407,12 @@ static bool material_is(const scene *s, uint32_t material, int type)
 
 bool pack_is_emissive(const scene *s, uint32_t material)
 {
-    return material_is(s, material, MATERIAL_EMISSIVE);
+    if (!material_is(s, material, MATERIAL_PBR))
+        return material_is(s, material, MATERIAL_EMISSIVE);
+    const scene_material *m = &s->materials[material];
+    bool emission = m->emission[0] > 0 || m->emission[1] > 0 || m->emission[2] > 0;
+    /* An alpha-masked emitter is no light: light sampling would pick points in its holes. */
+    return emission && m->alpha_mode != SCENE_ALPHA_MASK;
 }
 
 /* ---- which placements bake ----------------------------------------------------------
@@ -483,7 +492,8 @@ static bool material_normal_map(const scene *s, uint32_t material, bool *reads_u
     if (material == PACKED_NONE || material >= (uint32_t)s->material_count)
         return false;
     const scene_material *m = &s->materials[material];
-    *reads_uv = texture_reads_uv(s, m->albedo_texture) || texture_reads_uv(s, m->emission_texture);
+    *reads_uv = texture_reads_uv(s, m->albedo_texture) || texture_reads_uv(s, m->emission_texture)
+                || (m->type == MATERIAL_PBR && m->metallic_roughness_texture >= 0);
     return m->normal_map >= 0;
 }
 

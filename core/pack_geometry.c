@@ -113,6 +113,29 @@ uint32_t packed_encode_normal(const float normal[3])
     return (uint32_t)(uint16_t)qx | (uint32_t)(uint16_t)qy << 16;
 }
 
+bool pack_needs_vertex_colors(const scene *s)
+{
+    bool asked = false, given = false;
+    for (int i = 0; i < s->material_count; i++)
+        asked |= s->materials[i].type == MATERIAL_PBR && s->materials[i].vertex_colors;
+    for (int i = 0; i < s->mesh_count; i++)
+        given |= s->meshes[i].colors != NULL;
+    return asked && given;
+}
+
+/* Two values from 0 to 1 as unsigned 16-bit fractions in one word, a low (GLSL's
+ * unpackUnorm2x16). */
+static uint32_t unorm16_pair(float a, float b)
+{
+    float values[2] = {a, b};
+    uint32_t word = 0;
+    for (int k = 0; k < 2; k++) {
+        float clamped = values[k] > 0 ? (values[k] < 1 ? values[k] : 1) : 0;   /* NaN: 0 */
+        word |= (uint32_t)lrintf(clamped * 65535.0f) << (16 * k);
+    }
+    return word;
+}
+
 void pack_write_vertices(packer *p)
 {
     const pack_layout *layout = &p->layout;
@@ -126,7 +149,14 @@ void pack_write_vertices(packer *p)
                   vertex->has_normal ? packed_encode_normal(vertex->normal) : VERTEX_NO_NORMAL);
         p->texels[4 * (layout->uv_offset + v / 2) + 2 * (v % 2)] = float_bits(vertex->uv[0]);
         p->texels[4 * (layout->uv_offset + v / 2) + 2 * (v % 2) + 1] = float_bits(vertex->uv[1]);
+        if (layout->color_offset != PACKED_NONE) {
+            p->texels[4 * (layout->color_offset + v / 2) + 2 * (v % 2)] =
+                unorm16_pair(vertex->color[0], vertex->color[1]);
+            p->texels[4 * (layout->color_offset + v / 2) + 2 * (v % 2) + 1] =
+                unorm16_pair(vertex->color[2], 1);
+        }
     }
+    p->out->summary.vertex_colors = layout->color_offset != PACKED_NONE;
 }
 
 rt_status pack_write_instances(packer *p, rt_error *error)

@@ -51,6 +51,7 @@ typedef struct pending_vertex {
     float normal[3];
     bool has_normal;
     float uv[2];
+    float color[3];              /* linear RGB; white when its mesh has no colours */
 } pending_vertex;
 
 typedef struct vertex_list {
@@ -76,6 +77,7 @@ typedef struct pack_layout {
     uint64_t shape_offset, shape_texels;
     uint64_t vertex_offset, vertex_count;
     uint64_t uv_offset;
+    uint64_t color_offset;                        /* PACKED_NONE: no vertex colour section */
     uint64_t node_offset, node_count;
     uint64_t instance_offset;
     uint64_t texture_offset;
@@ -137,7 +139,8 @@ rt_status pack_collect(packer *p, rt_error *error);
  * build time to out->bvh_build_seconds. */
 rt_status pack_build_trees(packer *p, rt_error *error);
 
-/* Whether the material index resolves to an emissive material of the scene. */
+/* Whether the material index resolves to a material of the scene whose surfaces are
+ * lights: emissive, or pbr with an emission and no alpha mask. */
 bool pack_is_emissive(const scene *s, uint32_t material);
 
 /* Inverts the affine 3x4 matrix m into inverse. Returns false when it is singular. */
@@ -151,7 +154,12 @@ rt_status pack_order_vertices(packer *p, uint32_t *vertex_count, rt_error *error
 /* Writes every BVH's primitive records, their info and shape records, and its nodes. */
 void pack_write_primitives(packer *p);
 
-/* Writes the vertex section (positions and encoded normals) and the uv section. */
+/* Whether the scene needs the vertex colour section: a material with vertex_colors used
+ * by a mesh with colours (packed_layout.h "colours"). */
+bool pack_needs_vertex_colors(const scene *s);
+
+/* Writes the vertex section (positions and encoded normals), the uv section and, when
+ * the plan has one, the vertex colour section. */
 void pack_write_vertices(packer *p);
 
 /* Writes the instance records. */

@@ -28,6 +28,7 @@
  *   shapes      the further texels of moving spheres and quads
  *   vertices    one texel per triangle vertex: position and normal
  *   uvs         (u, v) per vertex, two vertices to a texel
+ *   colours     vertex colours, two vertices to a texel (only when a material uses them)
  *   nodes       PACKED_NODE_STRIDE texels each; the two children of an interior node are
  *               contiguous (left = first, right = first + 1)
  *   instances   PACKED_INSTANCE_STRIDE texels each
@@ -43,9 +44,9 @@
 #define PACKED_LAYOUT_VERSION 4
 #define PACKED_NONE 4294967295u
 
-/* ---- header (6 texels), field i is component i % 4 of texel i / 4 */
+/* ---- header (7 texels), field i is component i % 4 of texel i / 4 */
 #define PACKED_MAGIC 1381258067
-#define PACKED_HEADER_TEXELS 6
+#define PACKED_HEADER_TEXELS 7
 #define PACKED_HEADER_MAGIC 0
 #define PACKED_HEADER_VERSION 1
 #define PACKED_HEADER_MATERIAL_OFFSET 2
@@ -70,21 +71,36 @@
 #define PACKED_HEADER_VERTEX_OFFSET 21
 #define PACKED_HEADER_UV_OFFSET 22
 #define PACKED_HEADER_VERTEX_COUNT 23
+#define PACKED_HEADER_COLOR_OFFSET 24    /* PACKED_NONE: no vertex colour section */
 
-/* ---- materials: 4 texels
- *   texel 0 = (type tag, albedo.r, albedo.g, albedo.b)
+/* ---- materials: 6 texels
+ *   texel 0 = (type tag | flags, albedo.r, albedo.g, albedo.b)    albedo: pbr's base colour
  *   texel 1 = (emission.r, emission.g, emission.b, fuzz)        emission is colour x strength
  *   texel 2 = (index of refraction, albedo texture, emission texture, normal map image)
  *             (texture and image indices, or PACKED_NONE)
  *   texel 3 = (Phong exponent, Phong specular colour.rgb)      Whitted integrator only
- *   emissive: texel 1 .w = its light group (scene.h light_groups; fuzz is metal's) */
-#define PACKED_MATERIAL_STRIDE 4
+ *   emitters (emissive, pbr): texel 1 .w = the light group (scene.h light_groups; fuzz is
+ *   metal's)
+ *   texel 4 = (metallic, roughness, transmission, metallic-roughness image)        pbr only
+ *   texel 5 = (alpha, alpha cutoff, alpha image, 0)                                pbr only
+ * The type word is the MATERIAL_* tag in its low MATERIAL_TYPE_BITS bits and MATERIAL_FLAG_*
+ * bits above them. pbr: roughness is perceptual (GGX alpha = roughness^2); the
+ * metallic-roughness image (PACKED_NONE: none) multiplies roughness by its G channel and
+ * metallic by its B channel (glTF's packing); with MATERIAL_FLAG_ALPHA_MASK, a hit where
+ * alpha x the alpha image's A channel (the albedo texture's image; PACKED_NONE: 1) is below
+ * the cutoff is no hit at all. */
+#define PACKED_MATERIAL_STRIDE 6
 #define MATERIAL_LAMBERTIAN 0
 #define MATERIAL_METAL 1
 #define MATERIAL_DIELECTRIC 2
 #define MATERIAL_EMISSIVE 3
 #define MATERIAL_PBR 4               /* glTF metallic-roughness (scene.h scene_material "pbr") */
 #define MATERIAL_TYPE_COUNT 5
+#define MATERIAL_TYPE_BITS 8
+#define MATERIAL_TYPE_MASK 255
+#define MATERIAL_FLAG_ONE_SIDED 256       /* emits only from its front face (emissive, pbr) */
+#define MATERIAL_FLAG_VERTEX_COLORS 512   /* pbr: base colour x the vertex colours */
+#define MATERIAL_FLAG_ALPHA_MASK 1024     /* pbr: alpha-tested (texel 5) */
 
 /* ---- primitives: one texel each (a leaf's primitives are contiguous)
  *   sphere:         (centre.xyz, radius)
@@ -124,7 +140,11 @@
  * VERTEX_NO_NORMAL (flat shading). Mesh vertices are stored once per mesh however often it
  * is placed (and once more per placement baked into the world).
  * ---- uvs: vertex i's (u, v) are components 2 (i % 2) and 2 (i % 2) + 1 of uv texel
- * i / 2; v points up (v = 1: an image's top row). */
+ * i / 2; v points up (v = 1: an image's top row).
+ * ---- colours: vertex i's linear (r, g) and (b, 1) as pairs of unsigned 16-bit fractions
+ * (GLSL unpackUnorm2x16: first value low) are components 2 (i % 2) and 2 (i % 2) + 1 of
+ * colour texel i / 2; white for vertices whose mesh has no colours. The section exists
+ * only when a material with MATERIAL_FLAG_VERTEX_COLORS is used by a mesh with colours. */
 #define VERTEX_NO_NORMAL 4294967295u
 
 /* ---- BVH nodes: 2 texels
@@ -153,9 +173,15 @@
 #define TEXTURE_IMAGE 5
 #define TEXTURE_TYPE_COUNT 6
 
-/* ---- images: 1 texel record = (first pixel texel, width, height, 0); pixels are RGBA
- * float bits, one texel each, rows top to bottom, after all the records */
+/* ---- images: 1 texel record = (first pixel texel, width, height, wrap); pixels are RGBA
+ * float bits, one texel each, rows top to bottom, after all the records. wrap: how a
+ * lookup outside [0, 1] folds, IMAGE_WRAP_* of u in bits 0-1 and of v in bits 2-3 (glTF's
+ * samplers; every other image repeats) */
 #define PACKED_IMAGE_STRIDE 1
+#define IMAGE_WRAP_REPEAT 0
+#define IMAGE_WRAP_CLAMP 1
+#define IMAGE_WRAP_MIRROR 2
+#define IMAGE_WRAP_V_SHIFT 2
 
 /* ---- lights: 5 texels (what next-event estimation samples: see glsl/lights.glsl for how
  * one is chosen: by power, or by its estimated irradiance at the point)

@@ -78,8 +78,9 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
  * GPU_FIX_UNIFORMS, from what the packed scene holds (pack.h, pack_summary): no light
  * sampling in path tracing without lights (or with it switched off), no volumes when there
  * is none and the camera is in none, no textures when there is none and no material has a
- * normal map; primitive types and emitters as the packed records (every BVH level) hold
- * them. The --full-tracer option asks for 0: everything, read from uniforms. */
+ * normal map; primitive types, emitters, the pbr material, alpha masks and vertex colours
+ * as the packed records (every BVH level) hold them. The --full-tracer option asks for 0:
+ * everything, read from uniforms. */
 static uint32_t omitted_features(const packed_scene *packed, const render_options *options, uint32_t camera_media)
 {
     if (options->full_tracer)
@@ -109,6 +110,12 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_LIGHT_CHOICE;
     if (!(contents->light_types & 1u << LIGHT_QUAD))
         omitted |= GPU_OMIT_RECTANGLE_LIGHTS;
+    if (!contents->pbr)
+        omitted |= GPU_OMIT_PBR;
+    if (!contents->alpha_mask)
+        omitted |= GPU_OMIT_ALPHA_MASK;
+    if (!contents->vertex_colors)
+        omitted |= GPU_OMIT_VERTEX_COLORS;
     if (!options->light_groups)
         omitted |= GPU_OMIT_LIGHT_GROUPS;
     return omitted;
@@ -234,6 +241,58 @@ static rt_status render_aovs(gpu_tracer *tracer, int width, int height, const rt
     }
     free(albedo_depth);
     free(normal);
+    return status;
+}
+
+/* Builds the variance layers variance.R/G/B: each pixel's sample variance of each colour
+ * channel, E[c^2] - E[c]^2 over its finished samples (as variance.Y is of luminance), from
+ * the means in colour and the tracer's sums of squares (width*height*4). Float rounding
+ * can make a constant pixel's difference slightly negative: it is 0 then. The caller
+ * frees layers. */
+static rt_status variance_layers(int width, int height, const rt_image *colour, const float *squares,
+                                 rt_image *layers, rt_error *error)
+{
+    rt_status status = image_create(layers, width, height, 3, error);
+    if (status != RT_OK)
+        return status;
+    static const char *const names[3] = {"variance.R", "variance.G", "variance.B"};
+    for (int c = 0; c < 3; c++)
+        snprintf(layers->channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", names[c]);
+    size_t pixel_count = (size_t)width * height;
+    for (size_t i = 0; i < pixel_count; i++) {
+        const float *pixel = colour->pixels + 4 * i;
+        float count = pixel[3];
+        for (int c = 0; c < 3; c++)
+            layers->pixels[3 * i + c] =
+                count > 0 ? fmaxf(0.0f, squares[4 * i + c] / count - pixel[c] * pixel[c]) : 0.0f;
+    }
+    return RT_OK;
+}
+
+/* Reads the tracer's sums of squares and adds the variance layers to result->aovs (after
+ * the AOVs when there are any). */
+static rt_status add_variance_layers(gpu_tracer *tracer, int width, int height, render_result *result,
+                                     rt_error *error)
+{
+    float *squares = malloc((size_t)width * height * 4 * sizeof *squares);
+    if (squares == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
+    rt_image layers = {0};
+    rt_status status = gpu_tracer_read_squares(tracer, squares, error);
+    if (status == RT_OK)
+        status = variance_layers(width, height, &result->image, squares, &layers, error);
+    free(squares);
+    if (status == RT_OK && result->aovs.pixels != NULL) {
+        rt_image joined;
+        status = image_append_channels(&result->aovs, &layers, &joined, error);
+        if (status == RT_OK) {
+            image_free(&result->aovs);
+            result->aovs = joined;
+        }
+        image_free(&layers);
+    } else if (status == RT_OK) {
+        result->aovs = layers;
+    }
     return status;
 }
 
@@ -430,7 +489,7 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
     }
 }
 
-/* The read-back of render_scene: the image (and with options->aovs the AOVs) into
+/* The read-back of render_scene: the image (and the AOVs and variance layers asked for) into
  * *result, with the path segments; an error, with nothing allocated, when a path
  * reached the work cap. */
 static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const scene *s, const render_options *options,
@@ -448,6 +507,8 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const sce
         status = read_image(tracer, width, height, &result->image, luminance_squares, &totals, &result->samples, error);
     if (status == RT_OK && options->aovs)
         status = render_aovs(tracer, width, height, &result->image, luminance_squares, &result->aovs, error);
+    if (status == RT_OK && options->variance)
+        status = add_variance_layers(tracer, width, height, result, error);
     free(luminance_squares);
     if (status == RT_OK && options->light_groups)
         status = read_light_groups(tracer, s, &result->image, &result->light_groups, error);

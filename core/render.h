@@ -62,6 +62,7 @@ typedef struct render_options {
     bool aovs;                   /* also render the AOV image (see render_result.aovs) */
     bool light_groups;           /* also collect each light group's image (see
                                   * render_result.light_groups); not with resume */
+    bool variance;               /* also make the variance layers (see render_result.aovs) */
     uint32_t russian_roulette_depth;
     uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */
     int region[4];               /* x0, y0, x1, y1 (row 0 at the top, x1/y1 exclusive) of the
@@ -87,9 +88,14 @@ typedef struct render_options {
 typedef struct render_result {
     rt_image image;              /* R, G, B, samples; free with image_free() */
     int region[4];               /* the region image covers (x0, y0, x1, y1) */
-    rt_image aovs;               /* with options.aovs: albedo.R/G/B, normal.X/Y/Z (world,
-                                  * first hit), depth.Z (0: no hit), variance.Y (per-pixel
-                                  * sample variance of luminance); free with image_free() */
+    rt_image aovs;               /* extra layers: with options.aovs albedo.R/G/B, normal.X/Y/Z
+                                  * (world, first hit), depth.Z (0: no hit), variance.Y
+                                  * (per-pixel sample variance of luminance); then, with
+                                  * options.variance, variance.R/G/B (per-pixel sample
+                                  * variance of each colour channel, E[c^2] - E[c]^2 over the
+                                  * pixel's finished samples: the variance of the pixel's
+                                  * mean is it / (samples - 1)); empty when neither is
+                                  * asked; free with image_free() */
     rt_image light_groups;       /* with options.light_groups: NAME.R, NAME.G, NAME.B for each
                                   * of the scene's light groups in order (scene.h), the mean
                                   * radiance of that group alone: the groups sum to image's

@@ -12,6 +12,7 @@
 #include "paths.h"
 #include "render_output.h"
 #include "scene_assets.h"
+#include "scene_gltf.h"
 
 /* One run of a job: what every image needs. */
 typedef struct job_run {
@@ -43,7 +44,11 @@ static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
     scene_parse_options parse_options = scene_parse_options_defaults();
     parse_options.defines = defines;
     parse_options.define_count = render_job_scene_defines(job, frame, defines, &values);
-    rt_status status = scene_load_file(job->scene_path, &parse_options, s, error);
+    /* A glTF file is a scene by itself (scene_gltf.h); render_job_check() refused defines
+     * for it, and its frames' $frame and $time are optional. */
+    rt_status status = scene_gltf_is_model_path(job->scene_path)
+                           ? scene_gltf_load_file(job->scene_path, job->camera, s, error)
+                           : scene_load_file(job->scene_path, &parse_options, s, error);
     free(defines);
     if (status == RT_OK) {
         status = scene_load_assets(s, error);
@@ -248,6 +253,7 @@ static void image_render_options(job_image *image, render_options *options)
     memcpy(options->region, image->plan.region, sizeof options->region);
     options->aovs = job->aovs || job->denoise;
     options->light_groups = job->light_groups;
+    options->variance = job->variance;
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;
     options->stop_requested = job->stop_requested;

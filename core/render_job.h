@@ -7,10 +7,14 @@
  *
  * ## The job
  * A plain struct; zero means default (render_job_defaults() returns it all zero):
- *   scene_path, output      required; output is a name pattern (batch.h): with frames each
+ *   scene_path, output      required; scene_path a scene file, or a glTF file (.gltf, .glb:
+ *                           a scene by itself, scene_gltf.h); output is a name pattern (batch.h): with frames each
  *                           frame formats it, without them it is formatted once with the
  *                           value of the last define of `frame`, else with 0
- *   defines                 scene variables (scene_parse.h) for every image; none
+ *   defines                 scene variables (scene_parse.h) for every image; none (a glTF
+ *                           scene has no variables: a define is refused)
+ *   camera                  NULL: the scene's camera; a glTF scene's camera (or camera
+ *                           node) of that name; only for a glTF scene
  *   frames                  frame numbers to render (batch.h frame_list); none: one image
  *                           without $frame and $time. Each frame sets $frame and $time =
  *                           frame / frames_per_second (default 24) as optional variables.
@@ -33,12 +37,13 @@
  *   light_groups            add a layer per light group (render.h render_result.light_groups,
  *                           NAME.R/G/B) to an EXR; not with denoise, blur, resume, sample
  *                           ranges, tiles or shards other than by frames
+ *   variance                add the variance layers variance.R/G/B (render.h) to an EXR
  *   denoise                 postprocess_denoise() guided by the AOVs; an EXR keeps the noisy
  *                           colour as noisy.R/G/B
  *   blur_sigma, blur_passes sigma 0: no blur; passes 0: 1
  *   tonemap, exposure       for 8-bit outputs: TONEMAP_CLAMP and 0 stops
  *   tracer                  how each image is traced (render.h; zero = its defaults). The
- *                           job sets its sample_start, region, aovs, progress,
+ *                           job sets its sample_start, region, aovs, variance, progress,
  *                           stop_requested, resume and checkpoint fields itself.
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
@@ -95,6 +100,7 @@ typedef enum render_job_shard_kind {
 typedef struct render_job {
     const char *scene_path;
     const char *output;
+    const char *camera;
     const scene_define *defines;
     int define_count;
     const int *frames;
@@ -112,6 +118,7 @@ typedef struct render_job {
     double checkpoint_seconds;
     bool aovs;
     bool light_groups;
+    bool variance;
     bool denoise;
     float blur_sigma;
     int blur_passes;
@@ -197,9 +204,10 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * with the first rule broken, in this order: a define of frame or time with frames; the
  * first output name (batch.h's errors; several frames and no frame number in the
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
- * without EXR; resume with several frames; shard_by without shard; a shard by frames
- * without frames, or with no frame; light groups (see the job); a shard by samples with a
- * sample range; a shard by tiles with crop or tile; light groups with a shard not by frames. */
+ * without EXR; variance without EXR; variance with resume; resume with several frames;
+ * shard_by without shard; a shard by frames without frames, or with no frame; light groups
+ * (see the job); a shard by samples with a sample range; a shard by tiles with crop or
+ * tile; light groups with a shard not by frames. */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 
 /* True when the frame at position index of job->frames is this job's to render (always,

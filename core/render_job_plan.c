@@ -9,6 +9,7 @@
 #include "batch.h"
 #include "image_io.h"
 #include "paths.h"
+#include "scene_gltf.h"
 
 render_job render_job_defaults(void)
 {
@@ -155,6 +156,21 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
     if (job->aovs && image_format_of(plan->first_output) != IMAGE_FORMAT_EXR)
         return rt_error_set(error, RT_ERROR_INPUT, "--aovs writes extra layers, which only .exr keeps; not '%s'",
                             plan->first_output);
+    bool gltf_scene = scene_gltf_is_model_path(job->scene_path);
+    if (job->camera != NULL && !gltf_scene)
+        return rt_error_set(error, RT_ERROR_INPUT, "--camera picks a camera of a glTF file (.gltf, .glb); '%s' is a "
+                            "scene file, whose camera statement sets the camera", job->scene_path);
+    for (int i = 0; gltf_scene && i < job->define_count; i++)
+        if (!job->defines[i].optional)
+            return rt_error_set(error, RT_ERROR_INPUT, "-D %s: a glTF scene ('%s') has no variables",
+                                job->defines[i].name, job->scene_path);
+    if (job->variance && image_format_of(plan->first_output) != IMAGE_FORMAT_EXR)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--variance writes extra layers, which only .exr keeps; not '%s'", plan->first_output);
+    if (job->variance && job->resume_path != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--variance needs the squares of every sample, which a partial file does not keep; "
+                            "render without --resume");
     if (job->resume_path != NULL && job->frame_count > 1)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--resume continues one image; render the frames one at a time");

@@ -39,14 +39,17 @@ void scene_free(scene *s)
         free(s->meshes[i].positions);
         free(s->meshes[i].normals);
         free(s->meshes[i].uvs);
+        free(s->meshes[i].colors);
         free(s->meshes[i].indices);
         free(s->meshes[i].triangle_materials);
     }
     free(s->meshes);
     free(s->textures);
     free(s->lights);
-    for (int i = 0; i < s->image_count; i++)
+    for (int i = 0; i < s->image_count; i++) {
         free(s->images[i].pixels);
+        free(s->images[i].encoded);
+    }
     free(s->images);
     free(s->warnings);
     scene_defaults(s);

@@ -70,11 +70,17 @@ typedef struct scene_sky {
 } scene_sky;
 
 /* An image file used by a texture, a normal map or the sky: recorded by the parser
- * (deduplicated by resolved path), pixels filled by the asset loader. */
+ * (deduplicated by resolved path), pixels filled by the asset loader. An image of a glTF
+ * model comes with its file's bytes (encoded) and a path that only names it. */
 typedef struct scene_image {
     char path[1024];
     char position[256];          /* "file:line:column" of the first statement naming it */
     bool data;                   /* values, not colours (normal maps): never sRGB-decoded */
+    unsigned char *encoded;      /* NULL, or the image file's bytes, which the loader decodes
+                                  * instead of reading path (owned; scene_free frees it) */
+    size_t encoded_size;
+    int wrap[2];                 /* IMAGE_WRAP_* of packed_layout.h for u and v: how lookups
+                                  * outside [0, 1] fold; 0 (repeat) unless a glTF sampler says */
     int width, height;           /* filled by the loader */
     float *pixels;               /* filled by the loader: RGBA, linear, rows top to bottom */
 } scene_image;
@@ -198,8 +204,9 @@ typedef struct scene_shape {
     float uvs[3][2];             /* any finite values when has_uvs, else zero */
 } scene_shape;
 
-/* A triangle mesh, loaded from an OBJ file once however often it is placed. The parser
- * records path and position; the asset loader (scene_assets.h) fills the arrays. */
+/* A triangle mesh, loaded from an OBJ or PLY file once however often it is placed. The
+ * parser records path and position; the asset loader (scene_assets.h) fills the arrays.
+ * A mesh of a glTF model comes filled (scene_gltf.h) and its path only names it. */
 typedef struct scene_mesh {
     char path[1024];             /* resolved relative to the scene file that names it */
     char position[256];          /* "file:line:column" of the first statement naming it */
@@ -208,6 +215,9 @@ typedef struct scene_mesh {
     float *positions;            /* 3 per vertex */
     float *normals;              /* 3 per vertex, or NULL: flat shading */
     float *uvs;                  /* 2 per vertex, or NULL; v points up (v = 1: image top row) */
+    float *colors;               /* 3 per vertex (linear RGB, 0..1), or NULL: none; a pbr
+                                  * material with vertex_colors multiplies its base colour
+                                  * by them (PLY, glTF COLOR_0) */
     uint32_t *indices;           /* 3 per triangle, into the vertex arrays */
     int *triangle_materials;     /* per triangle: index into scene.materials or -1 */
     int vertex_count, triangle_count;

@@ -10,6 +10,7 @@
 
 #include "image_io.h"
 #include "obj_load.h"
+#include "ply_load.h"
 
 /* The largest Kd component of a material that counts as dark, and the smallest largest-Ks
  * component that counts as bright, for the metal rule. */
@@ -82,8 +83,50 @@ static int find_material_among(const scene *s, int count, const char *name)
     return -1;
 }
 
-/* Loads mesh index into the scene; scene_materials is the count of the scene's own
- * materials (those usemtl names are matched against). */
+/* Whether path's last component ends in extension (".ply"; any case). */
+static bool has_extension(const char *path, const char *extension)
+{
+    size_t length = strlen(path), wanted = strlen(extension);
+    return length > wanted && strcasecmp(path + length - wanted, extension) == 0 &&
+           strchr(path + length - wanted, '/') == NULL;
+}
+
+/* Loads the PLY mesh index into the scene (see scene_assets.h): its vertex colours are
+ * decoded from sRGB, every triangle gets the mesh's default material. */
+static rt_status load_ply_mesh(scene *s, int index, rt_error *error)
+{
+    scene_mesh *mesh = &s->meshes[index];
+    ply_mesh ply;
+    rt_error inner;
+    rt_status status = ply_load(mesh->path, &ply, &inner);
+    if (status != RT_OK)
+        return rt_error_set(error, status, "%s: cannot read mesh '%s': %s", mesh->position, mesh->path,
+                            reason_of(inner.message, "PLY", mesh->path));
+    int *triangle_materials = malloc((size_t)ply.triangle_count * sizeof *triangle_materials);
+    if (triangle_materials == NULL) {
+        ply_mesh_free(&ply);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "%s: out of memory loading mesh '%s'", mesh->position,
+                            mesh->path);
+    }
+    for (int t = 0; t < ply.triangle_count; t++)
+        triangle_materials[t] = mesh->default_material;
+    for (int i = 0; ply.colors != NULL && i < 3 * ply.vertex_count; i++)
+        ply.colors[i] = image_srgb_decode(ply.colors[i]);
+    /* The scene takes the arrays over. */
+    mesh->positions = ply.positions;
+    mesh->normals = ply.normals;
+    mesh->uvs = ply.uvs;
+    mesh->colors = ply.colors;
+    mesh->indices = ply.indices;
+    mesh->triangle_materials = triangle_materials;
+    mesh->vertex_count = ply.vertex_count;
+    mesh->triangle_count = ply.triangle_count;
+    return RT_OK;
+}
+
+/* Loads mesh index into the scene, by its file's extension: .ply, else OBJ;
+ * scene_materials is the count of the scene's own materials (those usemtl names are
+ * matched against). */
 static rt_status load_mesh(scene *s, int index, int scene_materials, rt_error *error)
 {
     scene_mesh *mesh = &s->meshes[index];
@@ -92,6 +135,8 @@ static rt_status load_mesh(scene *s, int index, int scene_materials, rt_error *e
                             "%s: mesh '%s' has default material %d, which is not a material "
                             "of the scene (%d)", mesh->position, mesh->path,
                             mesh->default_material, s->material_count);
+    if (has_extension(mesh->path, ".ply"))
+        return load_ply_mesh(s, index, error);
     obj_mesh obj;
     rt_error inner;
     rt_status status = obj_load(mesh->path, &obj, &inner);
@@ -213,9 +258,13 @@ static rt_status load_image(scene *s, int index, const char *prefix, const char 
     scene_image *target = &s->images[index];
     rt_image image;
     rt_error inner;
-    /* A normal map stores vectors, not colours: its values are used as they are. */
-    rt_status status = target->data ? image_read(target->path, &image, &inner)
-                                    : image_read_linear(target->path, SCENE_IMAGE_MAX_SIDE, &image, &inner);
+    /* A normal map stores vectors, not colours: its values are used as they are. An image
+     * of a glTF model is decoded from its bytes. */
+    rt_status status = target->encoded != NULL
+                           ? image_read_memory(target->encoded, target->encoded_size, target->path,
+                                               SCENE_IMAGE_MAX_SIDE, !target->data, &image, &inner)
+                       : target->data ? image_read(target->path, &image, &inner)
+                                      : image_read_linear(target->path, SCENE_IMAGE_MAX_SIDE, &image, &inner);
     if (status == RT_OK && target->data && (image.width > SCENE_IMAGE_MAX_SIDE || image.height > SCENE_IMAGE_MAX_SIDE)) {
         image_free(&image);
         return rt_error_set(error, RT_ERROR_INPUT, "%s: %s%s '%s' is larger than %d pixels on a side",
@@ -268,6 +317,9 @@ static rt_status load_image(scene *s, int index, const char *prefix, const char 
     target->width = image.width;
     target->height = image.height;
     target->pixels = pixels;
+    free(target->encoded);
+    target->encoded = NULL;
+    target->encoded_size = 0;
     image_free(&image);
     return RT_OK;
 }

@@ -1,13 +1,17 @@
-/* scene_assets.h: loading the files a parsed scene names: OBJ meshes (obj_load.h) and
- * images (image_io.h), into the scene's own arrays.
+/* scene_assets.h: loading the files a parsed scene names: OBJ and PLY meshes (obj_load.h,
+ * ply_load.h) and images (image_io.h), into the scene's own arrays. (A glTF model's meshes
+ * come filled by the parser's gltf statement, its images with their bytes: scene_gltf.h.)
  *
  * The parser records each mesh and image with its resolved path and the "file:line:column"
  * of the first statement naming it, and leaves the arrays empty; scene_load_assets() fills
  * them. Everything here is plain C and calls no GL.
  *
- * Meshes (scene_mesh): positions, normals (or NULL), uvs (or NULL), indices, vertex and
- * triangle counts as obj_load() returns them, and triangle_materials, one scene material
- * index per triangle (or -1: the instance's material applies):
+ * Meshes (scene_mesh), by the file's extension: ".ply" (any case) is read by ply_load():
+ * positions, normals, uvs and colours as it returns them, the colours decoded from sRGB
+ * to linear (image_srgb_decode), every triangle's material the mesh's default_material.
+ * Any other name is an OBJ file: positions, normals (or NULL), uvs (or NULL), indices,
+ * vertex and triangle counts as obj_load() returns them, and triangle_materials, one
+ * scene material index per triangle (or -1: the instance's material applies):
  *   - a triangle without `usemtl` gets the mesh's default_material (which may be -1);
  *   - a `usemtl NAME` where NAME is one of the scene's own materials (those it had before
  *     this call) uses that material: the scene wins over the MTL file;
@@ -27,7 +31,8 @@
  *     default_material, like a triangle without `usemtl`.
  *
  * Images (scene_image): width, height and pixels as RGBA 32-bit floats in linear light,
- * rows top to bottom. Colour is decoded to linear by the file's colour space
+ * rows top to bottom; an image with encoded bytes (a glTF model's) is decoded from them
+ * (image_read_memory) and the bytes freed, the others read from their path. Colour is decoded to linear by the file's colour space
  * (image_read_linear(): sRGB for PNG and JPEG, so 8-bit 128 becomes about 0.2158);
  * alpha is kept as stored. Channels: R, G, B and A by name when the file has R, G and B;
  * otherwise by count: 1 is grey (copied to R, G and B), 2 grey and alpha, 3 RGB, 4 or
@@ -52,7 +57,8 @@
  * directory", "...: cannot read image 'scenes/t.png': it is 20000x100 pixels, more than
  * 16384 on a side", "...: sky box: the +Y face 'scenes/py.png' is 256x256, the +X face is
  * 512x512", "...: sky box: cannot read the -Z face image 'scenes/nz.png': No such file or
- * directory". Mesh reasons are obj_load()'s (with "line N: " for a line of the OBJ file).
+ * directory". Mesh reasons are obj_load()'s or ply_load()'s (with "line N: " for a line of
+ * the OBJ file or a PLY header).
  * An image with a NaN or infinite pixel is refused. Out of memory: RT_ERROR_RUNTIME.
  *
  * On failure the scene keeps what was loaded before the error (and the materials added

@@ -4,6 +4,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -23,6 +24,13 @@ typedef struct placement {
     float density;
     float volume_albedo[3];
 } placement;
+
+/* A model imported by a gltf statement: what it placed, for the next statement naming it. */
+typedef struct imported_model {
+    char path[1024];
+    scene_gltf_placement *placements;
+    int count;
+} imported_model;
 
 /* A shape of a block, kept until the block closes so that its object's shapes are
  * contiguous in the scene even when nested blocks add theirs in between. */
@@ -57,6 +65,9 @@ void builder_free(scene_builder *builder)
     for (int i = 0; i < builder->group_count; i++)
         free(builder->groups[i].placements);
     free(builder->groups);
+    for (int i = 0; i < builder->import_count; i++)
+        free(builder->imports[i].placements);
+    free(builder->imports);
     for (int i = 0; i < builder->block_count; i++)
         free(builder->blocks[i].shapes);
     builder->block_count = 0;
@@ -209,7 +220,8 @@ bool builder_add_image(scene_builder *builder, const char *path, source_position
 {
     scene *s = builder->scene;
     for (int i = 0; i < s->image_count; i++) {
-        if (strcmp(s->images[i].path, path) == 0) {
+        /* An image of a glTF model (its bytes in the scene) only has a name, not a file. */
+        if (s->images[i].encoded == NULL && strcmp(s->images[i].path, path) == 0) {
             *image = i;
             return true;
         }
@@ -422,6 +434,77 @@ bool builder_place_mesh(scene_builder *builder, const char *path, source_positio
     if (!find_or_add_mesh_object(builder, path, path_where, &object))
         return false;
     placement local = {.object = object, .transform = affine_identity(), .material = material};
+    return place_object(builder, &local, where);
+}
+
+/* ------------------------------------------------------------------ imported models */
+
+const scene_gltf_placement *builder_find_import(const scene_builder *builder, const char *path, int *count)
+{
+    for (int i = 0; i < builder->import_count; i++) {
+        if (strcmp(builder->imports[i].path, path) == 0) {
+            *count = builder->imports[i].count;
+            return builder->imports[i].placements;
+        }
+    }
+    *count = 0;
+    return NULL;
+}
+
+/* Records what scene_gltf_add() added for the statement at where (builder_import_model). */
+static bool record_import(scene_builder *builder, const char *path, const scene_gltf_contents *contents,
+                          source_position where)
+{
+    scene *s = builder->scene;
+    for (int i = contents->first_material; i < s->material_count; i++)
+        if (!remember_position(builder, &builder->material_positions, &builder->material_position_capacity, i, where))
+            return false;
+    for (int i = contents->first_texture; i < s->texture_count; i++)
+        if (!remember_position(builder, &builder->texture_positions, &builder->texture_position_capacity, i, where))
+            return false;
+    /* An imported mesh's object, as find_or_add_mesh_object keeps them (its path names no
+     * file, but a mesh statement could still spell it). */
+    if (s->mesh_count > contents->first_mesh &&
+        !array_reserve((void **)&builder->mesh_objects, &builder->mesh_object_capacity, (size_t)s->mesh_count,
+                       sizeof *builder->mesh_objects))
+        return fail_out_of_memory(builder->report);
+    for (int o = 0; o < s->object_count; o++)
+        if (s->objects[o].mesh >= contents->first_mesh)
+            builder->mesh_objects[s->objects[o].mesh] = o;
+    if (!array_reserve((void **)&builder->imports, &builder->import_capacity, (size_t)builder->import_count + 1,
+                       sizeof *builder->imports))
+        return fail_out_of_memory(builder->report);
+    imported_model *model = &builder->imports[builder->import_count];
+    memset(model, 0, sizeof *model);
+    snprintf(model->path, sizeof model->path, "%s", path);
+    size_t n = contents->placement_count > 0 ? (size_t)contents->placement_count : 1;
+    model->placements = malloc(n * sizeof *model->placements);
+    if (model->placements == NULL)
+        return fail_out_of_memory(builder->report);
+    if (contents->placement_count > 0)
+        memcpy(model->placements, contents->placements, (size_t)contents->placement_count * sizeof *model->placements);
+    model->count = contents->placement_count;
+    builder->import_count++;
+    return true;
+}
+
+bool builder_import_model(scene_builder *builder, gltf_model *model, const char *path, source_position where)
+{
+    char position[256];
+    format_position(position, sizeof position, &where);
+    scene_gltf_contents contents;
+    rt_error ignored;
+    /* scene_gltf_add fails only when memory runs out. */
+    if (scene_gltf_add(builder->scene, model, path, position, &contents, &ignored) != RT_OK)
+        return fail_out_of_memory(builder->report);
+    bool recorded = record_import(builder, path, &contents, where);
+    scene_gltf_contents_free(&contents);
+    return recorded;
+}
+
+bool builder_place_object(scene_builder *builder, int object, const affine *transform, const source_position *where)
+{
+    placement local = {.object = object, .transform = *transform, .material = -1};
     return place_object(builder, &local, where);
 }
 

@@ -36,6 +36,7 @@
 
 #include "affine.h"
 #include "scene.h"
+#include "scene_gltf.h"
 #include "scene_report.h"
 
 /* Blocks nest at most this deep (the top level does not count). */
@@ -44,6 +45,7 @@
 struct source_file;                  /* scene_lexer.h: a block's file, compared by identity */
 struct placement;
 struct pending_shape;
+struct imported_model;
 
 typedef enum block_kind {
     BLOCK_TOP_LEVEL,
@@ -94,6 +96,9 @@ typedef struct scene_builder {
     int group_count;
     size_t group_capacity;
     int placement_total;                   /* instances and group records, for the limit */
+    struct imported_model *imports;        /* glTF models read so far, by path */
+    int import_count;
+    size_t import_capacity;
     bool camera_seen;
     source_position last_camera;
     /* blocks[0] is the top level; one spare entry above MAX_BLOCK_DEPTH holds the implicit
@@ -200,6 +205,22 @@ bool builder_add_shape(scene_builder *builder, const scene_shape *shape, const s
  * statement at where. */
 bool builder_place_mesh(scene_builder *builder, const char *path, source_position path_where, int material,
                         const source_position *where);
+
+/* ---- imported models (the gltf statement; scene_gltf.h adds their contents) */
+
+/* Returns what the model at path (resolved) placed when a statement imported it before
+ * (*count placements; the array stays the builder's), or NULL when none did. */
+const scene_gltf_placement *builder_find_import(const scene_builder *builder, const char *path, int *count);
+
+/* Adds the loaded model (from the file at path) to the scene for the statement at where
+ * (scene_gltf_add(): its meshes and image bytes move out of model) and records it: the
+ * positions of the materials and textures it added, its meshes' objects, and its
+ * placements for the next statement naming the same file. */
+bool builder_import_model(scene_builder *builder, gltf_model *model, const char *path, source_position where);
+
+/* Places object with transform (in double, relative to the current block's contents) and
+ * no material of its own, for the statement at where. */
+bool builder_place_object(scene_builder *builder, int object, const affine *transform, const source_position *where);
 
 /* ---- blocks */
 

@@ -37,6 +37,7 @@ static const struct {
     {"quad", statement_quad, true},
     {"box", statement_box, true},
     {"mesh", statement_mesh, true},
+    {"gltf", statement_gltf, true},
     {"group", statement_group, true},
     {"instance", statement_instance, true},
     {"volume", statement_volume, true},

@@ -43,7 +43,7 @@ typedef bool (*statement_parser)(scene_parser *p, source_line *line, const token
 typedef bool (*clause_reader)(scene_parser *p, source_line *line, int clause, void *target);
 
 /* A statement takes at most this many kinds of clause. */
-#define MAX_CLAUSES 8
+#define MAX_CLAUSES 16
 
 /* Reads the clauses of a statement to the end of its line, in any order, each at most
  * once: names (count of them) are the clause words, statement names the statement in
@@ -86,6 +86,7 @@ bool statement_triangle(scene_parser *p, source_line *line, const token *keyword
 bool statement_quad(scene_parser *p, source_line *line, const token *keyword);
 bool statement_box(scene_parser *p, source_line *line, const token *keyword);
 bool statement_mesh(scene_parser *p, source_line *line, const token *keyword);
+bool statement_gltf(scene_parser *p, source_line *line, const token *keyword);
 bool statement_group(scene_parser *p, source_line *line, const token *keyword);
 bool statement_instance(scene_parser *p, source_line *line, const token *keyword);
 bool statement_volume(scene_parser *p, source_line *line, const token *keyword);

@@ -313,14 +313,19 @@ static bool read_material_clause(scene_parser *p, source_line *line, int index, 
         material->specular_set = true;
         return true;
     }
+    if (strcmp(name, "one_sided") == 0) {
+        material->one_sided = true;
+        return true;
+    }
     return read_number(&p->variables, line, description, clauses->value, clauses->value_offset);
 }
 
 /* Reads the optional clauses of a material, in any order: a number (fuzz, strength) into
- * *value (offset into *value_offset), group NAME (emissive: its light group), normal_map "FILE" into material->normal_map, phong
+ * *value (offset into *value_offset), group NAME (emissive: its light group), normal_map
+ * "FILE" into material->normal_map, phong
  * EXPONENT (> 0; 0 in scene_material means "the default") and specular R G B (lambertian
- * and metal) into the Whitted fields. statement names the material type for messages
- * ("metal material"), owner the material ("material 'm'"). */
+ * and metal) into the Whitted fields, one_sided (emissive). statement names the material
+ * type for messages ("metal material"), owner the material ("material 'm'"). */
 static bool read_material_clauses(scene_parser *p, source_line *line, const char *statement, const char *owner,
                                   const char *const *names, int count, scene_material *material, double *value,
                                   size_t *value_offset)
@@ -330,6 +335,103 @@ static bool read_material_clauses(scene_parser *p, source_line *line, const char
         .value_offset = value_offset,
     };
     return read_clauses(p, line, statement, names, count, read_material_clause, &clauses);
+}
+
+/* What the clauses of a pbr material fill (read_pbr_clause says what each is). */
+typedef struct pbr_clauses {
+    const char *owner;               /* "material 'm'", for messages */
+    scene_material *material;
+    float emission[3];               /* the emission clause's colour (1 1 1 for a texture) */
+    double strength;                 /* multiplies it; 1 unless given */
+    size_t strength_offset;          /* where strength came, SIZE_MAX when it did not */
+    bool metallic_given, roughness_given;
+} pbr_clauses;
+
+/* The clause words of a pbr material, in the order of read_pbr_clause's switch. */
+static const char *const pbr_clause_names[] = {
+    "metallic", "roughness", "ior",       "transmission", "emission",   "strength",
+    "one_sided", "alpha",    "alpha_cutoff", "vertex_colors", "normal_map", "metallic_roughness_map",
+    "group",
+};
+#define PBR_CLAUSE_COUNT ((int)(sizeof pbr_clause_names / sizeof pbr_clause_names[0]))
+
+/* Reads the value of pbr clause index (into pbr_clause_names) into target, a pbr_clauses. */
+static bool read_pbr_clause(scene_parser *p, source_line *line, int index, void *target)
+{
+    pbr_clauses *clauses = target;
+    scene_material *material = clauses->material;
+    char what[DESCRIPTION_BUFFER];
+    snprintf(what, sizeof what, "the %s of %s", pbr_clause_names[index], clauses->owner);
+    switch (index) {
+    case 0:
+        clauses->metallic_given = true;
+        return read_unit_float(&p->variables, line, what, &material->metallic);
+    case 1:
+        clauses->roughness_given = true;
+        return read_unit_float(&p->variables, line, what, &material->roughness);
+    case 2:
+        return read_positive_float(&p->variables, line, what, &material->index_of_refraction);
+    case 3:
+        return read_unit_float(&p->variables, line, what, &material->transmission);
+    case 4:
+        return read_colour_or_texture(p, line, what, clauses->emission, &material->emission_texture);
+    case 5: {
+        if (!read_number(&p->variables, line, what, &clauses->strength, &clauses->strength_offset))
+            return false;
+        char number[NUMBER_BUFFER];
+        if (!(clauses->strength >= 0))
+            return fail_at(line, clauses->strength_offset, "%s must be >= 0, found %s", what,
+                           format_number(number, sizeof number, clauses->strength));
+        return true;
+    }
+    case 6:
+        material->one_sided = true;
+        return true;
+    case 7:
+        material->alpha_mode = SCENE_ALPHA_MASK;
+        return read_unit_float(&p->variables, line, what, &material->alpha);
+    case 8:
+        material->alpha_mode = SCENE_ALPHA_MASK;
+        return read_unit_float(&p->variables, line, what, &material->alpha_cutoff);
+    case 9:
+        material->vertex_colors = true;
+        return true;
+    case 12:
+        return read_light_group(p, line, clauses->owner, &material->light_group);
+    default: {
+        int *image = index == 10 ? &material->normal_map : &material->metallic_roughness_texture;
+        snprintf(what, sizeof what, "the %s of the pbr material", pbr_clause_names[index]);
+        if (!read_image(p, line, what, image))
+            return false;
+        /* Both hold values, not colours: the loader must not sRGB-decode them. */
+        builder_mark_image_data(&p->builder, *image);
+        return true;
+    }
+    }
+}
+
+/* Reads `pbr COLOR metallic M roughness R [clauses]` (type is the `pbr` token) into
+ * *material for owner ("material 'm'"): glTF's metallic-roughness model
+ * (docs/scene-format.md). metallic and roughness are required; ior defaults to glTF's
+ * 1.5; emission is colour x strength. */
+static bool read_pbr_material(scene_parser *p, source_line *line, const char *owner, const token *type,
+                              scene_material *material)
+{
+    material->type = MATERIAL_PBR;
+    material->index_of_refraction = 1.5f;
+    pbr_clauses clauses = {.owner = owner, .material = material, .strength = 1, .strength_offset = SIZE_MAX};
+    if (!read_colour_or_texture(p, line, owner, material->albedo, &material->albedo_texture) ||
+        !read_clauses(p, line, "pbr material", pbr_clause_names, PBR_CLAUSE_COUNT, read_pbr_clause, &clauses))
+        return false;
+    if (!clauses.metallic_given || !clauses.roughness_given)
+        return fail_at(line, type->offset, "the pbr %s needs metallic M and roughness R, each from 0 to 1 (e.g. "
+                       "pbr 0.8 0.8 0.8 metallic 0 roughness 0.5)", owner);
+    size_t offset = clauses.strength_offset != SIZE_MAX ? clauses.strength_offset : type->offset;
+    for (int i = 0; i < 3; i++)
+        if (!to_float(line, offset, "the emission (colour x strength)", clauses.emission[i] * clauses.strength,
+                      &material->emission[i]))
+            return false;
+    return true;
 }
 
 /* Reads the material type word and everything after it into *material, for owner
@@ -370,12 +472,12 @@ static bool read_material_type(scene_parser *p, source_line *line, const char *o
                read_material_clauses(p, line, "dielectric material", owner, normal_map_only, 1, material, NULL, NULL);
     }
     if (token_is(line, &type, "emissive")) {
-        static const char *const clauses[] = {"strength", "group"};
+        static const char *const clauses[] = {"strength", "one_sided", "group"};
         material->type = MATERIAL_EMISSIVE;
         float colour[3];
         value = 1;
         if (!read_colour_or_texture(p, line, owner, colour, &material->emission_texture) ||
-            !read_material_clauses(p, line, "emissive material", owner, clauses, 2, material, &value, &offset))
+            !read_material_clauses(p, line, "emissive material", owner, clauses, 3, material, &value, &offset))
             return false;
         if (!(value >= 0))
             return fail_at(line, offset, "the strength of %s must be >= 0, found %s", owner,
@@ -385,14 +487,19 @@ static bool read_material_type(scene_parser *p, source_line *line, const char *o
                 return false;
         return true;
     }
-    return fail_at(line, type.offset, "expected a material type (lambertian, metal, dielectric or emissive), found %s",
-                   describe_token(line, &type, found, sizeof found));
+    if (token_is(line, &type, "pbr"))
+        return read_pbr_material(p, line, owner, &type, material);
+    return fail_at(line, type.offset, "expected a material type (lambertian, metal, dielectric, emissive or pbr), "
+                   "found %s", describe_token(line, &type, found, sizeof found));
 }
 
 /* material NAME lambertian COLOR [normal_map "F"] [phong E] [specular R G B] |
  * metal COLOR [fuzz F] [normal_map "F"] [phong E] [specular R G B] |
- * dielectric IOR [normal_map "F"] | emissive COLOR [strength S] [group NAME], COLOR being R G B or
- * @TEXTURE. The builder remembers where NAME was defined, for duplicate errors. */
+ * dielectric IOR [normal_map "F"] | emissive COLOR [strength S] [one_sided] [group NAME] |
+ * pbr COLOR metallic M roughness R [ior I] [transmission T] [emission COLOR] [strength S]
+ * [one_sided] [group NAME] [alpha A] [alpha_cutoff C] [vertex_colors] [normal_map "F"]
+ * [metallic_roughness_map "F"], COLOR being R G B or @TEXTURE. The builder remembers where
+ * NAME was defined, for duplicate errors. */
 bool statement_material(scene_parser *p, source_line *line, const token *keyword)
 {
     (void)keyword;

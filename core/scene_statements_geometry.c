@@ -9,6 +9,8 @@
 #include <string.h>
 
 #include "affine.h"
+#include "gltf_load.h"
+#include "scene_gltf.h"
 
 /* ------------------------------------------------------------------ transforms */
 
@@ -349,8 +351,8 @@ bool statement_box(scene_parser *p, source_line *line, const token *keyword)
     return true;
 }
 
-/* mesh "FILE.obj" [MATERIAL]: one instance of the mesh's object (one per resolved path,
- * however often it is placed); the asset loader reads the file later. */
+/* mesh "FILE.obj" | "FILE.ply" [MATERIAL]: one instance of the mesh's object (one per
+ * resolved path, however often it is placed); the asset loader reads the file later. */
 bool statement_mesh(scene_parser *p, source_line *line, const token *keyword)
 {
     char *path = NULL;
@@ -358,11 +360,59 @@ bool statement_mesh(scene_parser *p, source_line *line, const token *keyword)
     int material = -1;
     if (!read_asset_path(line, "the mesh", &path, &offset))
         return false;
+    if (scene_gltf_is_model_path(path)) {
+        free(path);
+        return fail_at(line, offset, "a glTF file is a model, not a mesh: place it with the gltf statement (gltf "
+                       "\"FILE\"), which imports its materials and node hierarchy too");
+    }
     source_position where = token_position(line, keyword);
     bool placed = read_shape_material(p, line, "the mesh", "meshes", &material) &&
                   builder_place_mesh(&p->builder, path, position_in(line, offset), material, &where);
     free(path);
     return placed;
+}
+
+/* Returns the reason of a gltf_load() message "PATH: REASON", or the whole message. */
+static const char *gltf_reason(const char *message, const char *path)
+{
+    size_t length = strlen(path);
+    return strncmp(message, path, length) == 0 && strncmp(message + length, ": ", 2) == 0 ? message + length + 2
+                                                                                         : message;
+}
+
+/* gltf "FILE.gltf" | "FILE.glb": places the model's meshes as its default scene's nodes
+ * do, in the current block (its transforms, material and volume apply as to a mesh); the
+ * file is read once however often it is placed. Its cameras and lights are not used. */
+bool statement_gltf(scene_parser *p, source_line *line, const token *keyword)
+{
+    char *path = NULL;
+    size_t offset = 0;
+    if (!read_asset_path(line, "the glTF model", &path, &offset))
+        return false;
+    source_position where = token_position(line, keyword);
+    int count = 0;
+    bool ok = expect_end_of_line(line, "the glTF model's path");
+    const scene_gltf_placement *placements = ok ? builder_find_import(&p->builder, path, &count) : NULL;
+    if (ok && placements == NULL) {
+        gltf_model model;
+        rt_error inner;
+        rt_status status = gltf_load(path, &model, &inner);
+        if (status == RT_ERROR_RUNTIME)
+            ok = fail_out_of_memory(line->file->report);
+        else if (status != RT_OK)
+            ok = fail_at(line, offset, "glTF '%s': %s", path, gltf_reason(inner.message, path));
+        else
+            ok = builder_import_model(&p->builder, &model, path, where);
+        gltf_model_free(&model);
+        placements = ok ? builder_find_import(&p->builder, path, &count) : NULL;
+    }
+    for (int i = 0; ok && i < count; i++) {
+        affine transform;
+        memcpy(transform.m, placements[i].object_to_world, sizeof transform.m);
+        ok = builder_place_object(&p->builder, placements[i].object, &transform, &where);
+    }
+    free(path);
+    return ok;
 }
 
 /* ------------------------------------------------------------------ blocks */

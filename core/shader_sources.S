@@ -7,7 +7,8 @@
  * THE MODULE TABLE is the one list of the fragment programs' sources, in the order they
  * are joined: a file may use what the files above it define. A new GLSL file is one line
  * here (a material among the materials, an integrator before glsl/integrators.glsl), its
- * programs being SHADER_PROGRAM_* bits of shader_sources.h. */
+ * programs being SHADER_PROGRAM_* bits of shader_sources.h. The material test program
+ * (gpu.h gpu_material_test) is the modules up to the table of materials and its main. */
 #include "shader_sources.h"
 
     /* module PATH, PROGRAMS: the file's text (NUL-terminated) and its path in .rodata, and
@@ -25,29 +26,32 @@
     .balign 16
     .global shader_modules
 shader_modules:
-    module "core/tracer_interface.h", SHADER_PROGRAM_TRACER|SHADER_PROGRAM_RANDOM_TEST /* ids, parameters */
-    module "core/packed_layout.h", SHADER_PROGRAM_TRACER            /* the packed scene's records */
-    module "glsl/random.glsl", SHADER_PROGRAM_TRACER|SHADER_PROGRAM_RANDOM_TEST
+    module "core/tracer_interface.h", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST /* ids, parameters */
+    module "core/packed_layout.h", SHADER_PROGRAM_SHADING           /* the packed scene's records */
+    module "glsl/random.glsl", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST
     module "glsl/random_test.frag", SHADER_PROGRAM_RANDOM_TEST
-    module "glsl/parameters.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/variant.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/work.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/sampling.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/camera.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/scene_access.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/intersect.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/traverse.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/textures.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/sky.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/surface.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/media.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/material.glsl", SHADER_PROGRAM_TRACER              /* the material interface */
-    module "glsl/material_lambertian.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/material_metal.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/material_dielectric.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/material_emissive.glsl", SHADER_PROGRAM_TRACER
-    module "glsl/material_phong.glsl", SHADER_PROGRAM_TRACER        /* Whitted's shading model */
-    module "glsl/material_table.glsl", SHADER_PROGRAM_TRACER        /* the table of materials */
+    module "glsl/parameters.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/variant.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/work.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/sampling.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/camera.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/scene_access.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/textures.glsl", SHADER_PROGRAM_SHADING             /* before intersect: alpha masks */
+    module "glsl/intersect.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/traverse.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/sky.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/surface.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/media.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/material.glsl", SHADER_PROGRAM_SHADING             /* the material interface */
+    module "glsl/material_lambertian.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/material_metal.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/material_dielectric.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/material_emissive.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/microfacet.glsl", SHADER_PROGRAM_SHADING           /* GGX, for pbr */
+    module "glsl/material_pbr.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/material_phong.glsl", SHADER_PROGRAM_SHADING       /* Whitted's shading model */
+    module "glsl/material_table.glsl", SHADER_PROGRAM_SHADING       /* the table of materials */
+    module "glsl/material_test.frag", SHADER_PROGRAM_MATERIAL_TEST
     module "glsl/light_groups.glsl", SHADER_PROGRAM_TRACER         /* --light-groups layers */
     module "glsl/lights.glsl", SHADER_PROGRAM_TRACER
     module "glsl/direct_light.glsl", SHADER_PROGRAM_TRACER

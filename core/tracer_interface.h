@@ -52,16 +52,25 @@
 #define TRACER_STATE_COUNTERS 4      /* the one integer (RGBA32UI) target; the others are RGBA32F */
 #define TRACER_STATE_ACCUMULATED 5
 #define TRACER_STATE_STATISTICS 6
-#define TRACER_STATE_COUNT 7
+#define TRACER_STATE_SQUARES 7       /* rgb: sums of the finished samples' squared radiance, */
+                                     /* per channel (render.c's variance layers) */
+#define TRACER_STATE_COUNT 8         /* llvmpipe has 8 draw buffers: this is all of them */
 
 /* ---- the AOV pass's outputs (glsl/aov.glsl) */
 #define TRACER_AOV_ALBEDO_DEPTH 0
 #define TRACER_AOV_NORMAL 1
 #define TRACER_AOV_COUNT 2
 
+/* ---- the material test program (gpu.h gpu_material_test, glsl/material_test.frag): its
+ * queries, MATERIAL_TEST_QUERY_TEXELS RGBA32F texels each in a buffer texture on unit
+ * MATERIAL_TEST_QUERY_UNIT, and its MATERIAL_TEST_OUTPUTS RGBA32F outputs (locations 0 on) */
+#define MATERIAL_TEST_QUERY_UNIT 0
+#define MATERIAL_TEST_QUERY_TEXELS 5
+#define MATERIAL_TEST_OUTPUTS 4
+
 /* ---- bindings: texture unit of the packed scene, uniform buffer of the parameter block,
  * atomic counter buffer (unfinished pixels at offset 0, finished samples at offset 4) */
-#define TRACER_PACKED_SCENE_UNIT 7
+#define TRACER_PACKED_SCENE_UNIT 8   /* after the state textures' units */
 #define TRACER_PARAMETER_BINDING 0
 #define TRACER_COUNTER_BINDING 0
 /* image unit of the light group layers (glsl/light_groups.glsl): an rgba32f 2D array */

@@ -31,7 +31,7 @@ void main()
             continue;
         }
         Surface surface = surface_at(hit, origin, direction, time);
-        albedo_sum += material_guide_albedo(material_at(surface.material, surface.position, surface.uv));
+        albedo_sum += material_guide_albedo(surface_material(surface, shading_frame(surface, direction)));
         normal_sum += dot(direction, surface.shading) < 0.0 ? surface.shading : -surface.shading;
         depth_sum += hit.t;
         hits += 1.0;

@@ -35,11 +35,7 @@ LightQuery no_light_query()
     q.frame.normal = vec3(0.0);
     q.frame.shading = vec3(0.0);
     q.frame.front_face = true;
-    q.material.index = 0u;
-    q.material.type = uint(MATERIAL_LAMBERTIAN);
-    q.material.albedo = vec3(0.0);
-    q.material.texel1 = uvec4(0u);
-    q.material.texel2 = uvec4(0u);
+    q.material = no_material();
     q.weight = vec3(0.0);
     return q;
 }

@@ -2,8 +2,8 @@
 // uses (INTEGRATOR_* of core/tracer_interface.h) over a pixel's paths for one pass.
 //
 // Every integrator traces paths segment by segment through the same loop (below): one
-// traversal per segment, scattering in media, crossing volume boundaries, emitters ending
-// the path, and direct light gathered once per segment. An integrator makes four choices
+// traversal per segment, scattering in media, crossing volume boundaries, emitters adding
+// their light, and direct light gathered once per segment. An integrator makes four choices
 // in it, one function each in glsl/integrator_NAME.glsl:
 //   bool NAME_samples_lights()    whether it gathers direct light from the lights
 //   float NAME_sky_weight(PixelState s)
@@ -94,17 +94,16 @@ void integrate(inout PixelState s)
                 cross_volume_boundary(s, surface, frame.front_face, hit.t);
             } else {
                 s.since_vertex = 0.0;
-                Material material = material_at(surface.material, surface.position, surface.uv);
-                if (material_emits(material)) {
+                Material material = surface_material(surface, frame);
+                // An emitter's light joins the path's; an emissive material then absorbs
+                // (its sample ends the path), a pbr one scatters on.
+                if (material_emits(material))
                     hit_emitter(s, hit, surface, material);
-                    path_done = true;
-                } else {
-                    BsdfSample sampled = material_sample(material, frame, s.direction, u);
-                    BsdfSample bsdf = integrator_shade(s, material, frame, surface.position, sampled, query);
-                    next_direction = bsdf.direction;
-                    s.throughput *= bsdf.weight;
-                    path_done = bsdf.absorbed;
-                }
+                BsdfSample sampled = material_sample(material, frame, s.direction, u);
+                BsdfSample bsdf = integrator_shade(s, material, frame, surface.position, sampled, query);
+                next_direction = bsdf.direction;
+                s.throughput *= bsdf.weight;
+                path_done = bsdf.absorbed;
             }
             if (!path_done) {
                 if (!leave_surface(s, surface.position, frame.normal, next_direction))

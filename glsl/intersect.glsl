@@ -71,8 +71,42 @@ float intersect_box(vec3 box_min, vec3 box_max, vec3 origin, vec3 inverse_direct
     return enter <= leave ? enter : INFINITY;
 }
 
+// Whether the hit at distance t along the ray (in the primitive's own coordinates; edge
+// coordinates as intersect_flat returns them) falls where an alpha-masked material
+// (MATERIAL_FLAG_ALPHA_MASK of core/packed_layout.h) has no surface: there alpha, the
+// material's factor times its alpha image's A channel at the hit's uv, is below the
+// cutoff. The material is resolved as surface_at resolves it (the primitive's own, else
+// the instance's, else the default). Only the variants with masks have this test, so
+// that other scenes pay nothing for it in the traversal.
+bool alpha_masked(uint slot, uvec4 record, uint type, vec4 sphere, vec3 origin, vec3 direction, float t,
+                  vec2 coordinates, uint instance)
+{
+    uint info = primitive_info(slot);
+    uint material = info & uint(PRIMITIVE_INFO_MATERIAL_MASK);
+    if (material == uint(PRIMITIVE_NO_MATERIAL)) {
+        uint instance_material = HAS_INSTANCES && instance != NONE
+                                 ? packed_texel(instance_offset + instance * uint(PACKED_INSTANCE_STRIDE)).y : NONE;
+        material = instance_material != NONE ? instance_material : default_material;
+    }
+    uint base = material_offset + material * uint(PACKED_MATERIAL_STRIDE);
+    if ((packed_texel(base).x & uint(MATERIAL_FLAG_ALPHA_MASK)) == 0u)
+        return false;
+    uvec4 mask = packed_texel(base + 5u);
+    float alpha = uintBitsToFloat(mask.x);
+    if (HAS_TEXTURES && mask.z != NONE) {
+        vec2 uv = coordinates;
+        if (HAS_SPHERES && type != uint(PRIMITIVE_TRIANGLE) && type != uint(PRIMITIVE_QUAD))
+            uv = sphere_uv((origin + t * direction - sphere.xyz) / sphere.w);
+        if (HAS_TRIANGLES && type == uint(PRIMITIVE_TRIANGLE) && (info & uint(PRIMITIVE_INFO_HAS_UVS)) != 0u)
+            uv = (1.0 - coordinates.x - coordinates.y) * vertex_uv(record.x) + coordinates.x * vertex_uv(record.y)
+                 + coordinates.y * vertex_uv(record.z);
+        alpha *= image_lookup_rgba(mask.z, uv).a;
+    }
+    return alpha < uintBitsToFloat(mask.y);
+}
+
 // Tests one primitive (by slot, its record already read) of the current level; on a
-// nearer hit updates hit.
+// nearer hit updates hit (a hit where an alpha mask has no surface is none).
 void intersect_primitive(uint slot, uvec4 record, uint type, vec3 origin, vec3 direction, float time, uint instance,
                          inout Hit hit)
 {
@@ -93,6 +127,9 @@ void intersect_primitive(uint slot, uvec4 record, uint type, vec3 origin, vec3 d
             t = intersect_flat(a.xyz, b.xyz, c.xyz, type == uint(PRIMITIVE_QUAD), origin, direction, hit.t,
                                coordinates);
     }
+    if (HAS_ALPHA_MASK && t < hit.t
+        && alpha_masked(slot, record, type, a, origin, direction, t, coordinates, instance))
+        t = INFINITY;
     if (t < hit.t) {
         hit.t = t;
         hit.primitive = slot;

@@ -209,7 +209,12 @@ bool spherical_rectangle(vec3 corner, vec3 edge_x, vec3 edge_y, vec3 p, out Sphe
     r.k = 2.0 * PI - g2 - g3;
     r.solid_angle = g0 + g1 - r.k;
     bool rectangle = HAS_RECTANGLE_LIGHTS && abs(dot(r.x, r.y)) < 1e-4;
-    return rectangle && r.z0 < 0.0 && r.solid_angle > RECTANGLE_MIN_SOLID_ANGLE;
+    // A point in the rectangle's own plane (within a ray offset: a pbr emitter's own
+    // surface, which scatters on) would see it as a whole hemisphere on either side, as the
+    // sign of float noise in z0 says: it sees the light edge-on, which area sampling gives
+    // (a density that is infinite there, so no light).
+    bool off_plane = -r.z0 > 4.0 * ray_offset(p);
+    return rectangle && off_plane && r.solid_angle > RECTANGLE_MIN_SOLID_ANGLE;
 }
 
 // The point of the rectangle at (u, v) of its solid-angle parametrization, in the frame
@@ -315,7 +320,7 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
             return false;
     }
     Material material = material_record(primitive_info(head.y) & uint(PRIMITIVE_INFO_MATERIAL_MASK));
-    emitted = emissive_emitted(material, x, uv);
+    emitted = emissive_emitted(material, x, uv) * emitted_side(material, direction, n);
     return true;
 }
 

@@ -10,6 +10,7 @@ layout(binding = TRACER_STATE_RADIANCE) uniform sampler2D state_radiance;
 layout(binding = TRACER_STATE_COUNTERS) uniform usampler2D state_counters;
 layout(binding = TRACER_STATE_ACCUMULATED) uniform sampler2D state_accumulated;
 layout(binding = TRACER_STATE_STATISTICS) uniform sampler2D state_statistics;
+layout(binding = TRACER_STATE_SQUARES) uniform sampler2D state_squares;
 
 layout(location = TRACER_STATE_ORIGIN) out vec4 out_origin;            // xyz: origin, w: since_vertex
 layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction, w: light_total
@@ -18,6 +19,7 @@ layout(location = TRACER_STATE_RADIANCE) out vec4 out_radiance;        // rgb: r
 layout(location = TRACER_STATE_COUNTERS) out uvec4 out_counters;       // samples_started, bounce, media
 layout(location = TRACER_STATE_ACCUMULATED) out vec4 out_accumulated;
 layout(location = TRACER_STATE_STATISTICS) out vec4 out_statistics;
+layout(location = TRACER_STATE_SQUARES) out vec4 out_squares;          // rgb: sums of squared radiance
 
 // Pixels with samples left, and samples finished in this pass (read by core/gpu_tracer.c).
 layout(binding = TRACER_COUNTER_BINDING, offset = 0) uniform atomic_uint unfinished_pixels;
@@ -42,6 +44,7 @@ PixelState read_state(ivec2 pixel)
     s.media = counters.z;
     s.accumulated = texelFetch(state_accumulated, pixel, 0);
     s.statistics = texelFetch(state_statistics, pixel, 0);
+    s.squares = texelFetch(state_squares, pixel, 0);
     s.finished_here = 0u;
     return s;
 }
@@ -55,6 +58,7 @@ void write_state(PixelState s)
     out_counters = uvec4(s.samples_started, s.bounce, s.media, 0u);
     out_accumulated = s.accumulated;
     out_statistics = s.statistics;
+    out_squares = s.squares;
 }
 
 void main()

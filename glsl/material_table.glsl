@@ -2,7 +2,8 @@
 // interface (glsl/material.glsl) of the record's type. A new material adds one line to
 // each (glsl/material.glsl lists the other steps). llvmpipe runs every line for every
 // pixel (docs/performance.md), so a material costs its code here whether a scene has it
-// or not; HAS_EMITTERS (glsl/variant.glsl) leaves the emitter out where there is none.
+// or not; HAS_EMITTERS and HAS_PBR (glsl/variant.glsl) leave the emitter and the pbr
+// material out where there is none.
 
 BsdfSample material_sample(Material m, ShadingFrame frame, vec3 direction, vec4 u)
 {
@@ -10,6 +11,7 @@ BsdfSample material_sample(Material m, ShadingFrame frame, vec3 direction, vec4 
     if (m.type == uint(MATERIAL_METAL)) return metal_sample(m, frame, direction, u);
     if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_sample(m, frame, direction, u);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_sample(m, frame, direction, u);
+    if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_sample(m, frame, direction, u);
     return absorbed_sample(direction);
 }
 
@@ -19,6 +21,7 @@ vec3 material_evaluate(Material m, ShadingFrame frame, vec3 view, vec3 to_light)
     if (m.type == uint(MATERIAL_METAL)) return metal_evaluate(m, frame, view, to_light);
     if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_evaluate(m, frame, view, to_light);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_evaluate(m, frame, view, to_light);
+    if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_evaluate(m, frame, view, to_light);
     return vec3(0.0);
 }
 
@@ -28,6 +31,7 @@ float material_pdf(Material m, ShadingFrame frame, vec3 view, vec3 to_light)
     if (m.type == uint(MATERIAL_METAL)) return metal_pdf(m, frame, view, to_light);
     if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_pdf(m, frame, view, to_light);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_pdf(m, frame, view, to_light);
+    if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_pdf(m, frame, view, to_light);
     return 0.0;
 }
 
@@ -37,18 +41,23 @@ vec3 material_guide_albedo(Material m)
     if (m.type == uint(MATERIAL_METAL)) return metal_guide_albedo(m);
     if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_guide_albedo(m);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_guide_albedo(m);
+    if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_guide_albedo(m);
     return m.albedo;
 }
 
-// Emitters: whether the material emits (then the path ends there, glsl/integrator_*.glsl),
-// and its radiance at p.
+// Emitters: whether the material emits (glsl/integrators.glsl adds its light; an emissive
+// material then absorbs, a pbr one scatters on), and its radiance at p. pbr emits what
+// emissive does: colour x strength times the emission texture (texel 1, texel 2's z).
 bool material_emits(Material m)
 {
-    return HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE);
+    bool pbr_emission = HAS_PBR && m.type == uint(MATERIAL_PBR) && any(greaterThan(uintBitsToFloat(m.texel1.xyz),
+                                                                                    vec3(0.0)));
+    return HAS_EMITTERS && (m.type == uint(MATERIAL_EMISSIVE) || pbr_emission);
 }
 
 vec3 material_emitted(Material m, vec3 p, vec2 uv)
 {
-    if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_emitted(m, p, uv);
+    if (HAS_EMITTERS && (m.type == uint(MATERIAL_EMISSIVE) || (HAS_PBR && m.type == uint(MATERIAL_PBR))))
+        return emissive_emitted(m, p, uv);
     return vec3(0.0);
 }

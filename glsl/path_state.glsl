@@ -22,6 +22,7 @@ struct PixelState {
     vec4 accumulated;       // rgb: sum over finished samples, a: finished samples
     vec4 statistics;        // x: path segments traced, y: traversal overflows,
                             // z: sum of squared luminance of finished samples
+    vec4 squares;           // rgb: sum of squared radiance of finished samples, per channel
     uint finished_here;     // samples finished in this pass
 };
 
@@ -55,6 +56,7 @@ void finish_sample(inout PixelState s)
     s.accumulated += vec4(s.radiance, 1.0);
     float luminance = dot(s.radiance, vec3(0.2126, 0.7152, 0.0722));
     s.statistics.z += luminance * luminance;
+    s.squares.rgb += s.radiance * s.radiance;
     s.bounce = 0u;
     s.finished_here++;
 }
@@ -106,7 +108,8 @@ void cross_volume_boundary(inout PixelState s, Surface surface, bool front_face,
 }
 
 // The path hit an emitter (surface): its radiance joins the path's, weighted by MIS when
-// light sampling could have found it too. The caller ends the path.
+// light sampling could have found it too. The material's sample then ends the path or,
+// for a pbr emitter, sends it on.
 void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material)
 {
     // MIS wants the path's last scattering vertex, origin - since_vertex * direction. But

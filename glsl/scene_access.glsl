@@ -25,6 +25,7 @@ uint image_offset;
 uint light_offset;
 uint light_count;    // the scene's lights; an integrator narrows it to what it samples
 uint environment_offset;
+uint color_offset;   // the vertex colour section, NONE when there is none
 
 // Reads the packed scene's header (packed_layout.h "header") into the globals above.
 void read_header()
@@ -46,6 +47,7 @@ void read_header()
     area_light_count = header4.w;
     vertex_offset = header5.y;
     uv_offset = header5.z;
+    color_offset = HAS_VERTEX_COLORS ? packed_texel(6u).x : NONE;
 }
 
 // A vertex normal from its octahedral encoding (core/pack.h packed_encode_normal).
@@ -118,4 +120,20 @@ vec2 vertex_uv(uint vertex)
 {
     uvec4 texel = packed_texel(uv_offset + vertex / 2u);
     return uintBitsToFloat((vertex & 1u) == 0u ? texel.xy : texel.zw);
+}
+
+// A vertex's colour (packed_layout.h "colours"); the caller checks color_offset != NONE.
+vec3 vertex_color(uint vertex)
+{
+    uvec4 texel = packed_texel(color_offset + vertex / 2u);
+    uvec2 words = (vertex & 1u) == 0u ? texel.xy : texel.zw;
+    return vec3(unpackUnorm2x16(words.x), unpackUnorm2x16(words.y).x);
+}
+
+// The texture coordinates of a point on a sphere with unit (object-space) normal n:
+// longitude and latitude as the books map spheres: u around +Y starting at -X, v from 0
+// at the bottom to 1 at the top.
+vec2 sphere_uv(vec3 n)
+{
+    return vec2(0.5 + atan(-n.z, n.x) / (2.0 * PI), acos(clamp(-n.y, -1.0, 1.0)) / PI);
 }

@@ -14,6 +14,7 @@ struct Surface {
     vec3 geometric;       // world, unit, outward (the side the primitive faces)
     vec3 shading;         // world, unit, outward (interpolated vertex normals, else geometric)
     vec2 uv;
+    vec3 color;           // the vertex colour (glsl/scene_access.glsl vertex_color), else white
     uint material;        // material index
     bool volume_boundary; // the hit is on a volume instance's boundary
     uint instance;
@@ -28,6 +29,7 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
     surface.position = origin + hit.t * direction;
     surface.instance = hit.instance;
     surface.volume_boundary = false;
+    surface.color = vec3(1.0);
     uvec4 record = packed_texel(primitive_offset + hit.primitive);
     uint info = primitive_info(hit.primitive);
     uint type = primitive_type(info);
@@ -69,10 +71,8 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
             center = mix(a.xyz, b.xyz, time);
         normal = (object_point - center) / a.w;
         shading_normal = normal;
-        // Longitude/latitude of the normal as the books map spheres: u around +Y starting
-        // at -X, v from 0 at the bottom to 1 at the top.
         if (HAS_TEXTURES)
-            uv = vec2(0.5 + atan(-normal.z, normal.x) / (2.0 * PI), acos(clamp(-normal.y, -1.0, 1.0)) / PI);
+            uv = sphere_uv(normal);
         tangent = vec3(normal.z, 0.0, -normal.x);
     }
     if (HAS_FLAT && flat_primitive) {
@@ -83,6 +83,9 @@ Surface surface_at(Hit hit, vec3 origin, vec3 direction, float time)
         if (HAS_TRIANGLES && type == uint(PRIMITIVE_TRIANGLE)) {
             // Vertex normals and uvs, interpolated by barycentrics.
             vec3 weights = vec3(1.0 - hit.barycentric.x - hit.barycentric.y, hit.barycentric);
+            if (HAS_VERTEX_COLORS && color_offset != NONE)
+                surface.color = weights.x * vertex_color(record.x) + weights.y * vertex_color(record.y)
+                                + weights.z * vertex_color(record.z);
             vec3 n0, n1, n2;
             if (vertex_normals(normal_words, n0, n1, n2)) {
                 vec3 interpolated = weights.x * n0 + weights.y * n1 + weights.z * n2;

@@ -1,30 +1,47 @@
 // textures.glsl: images (bilinear, wrapping), procedural noise, and the texture records
 // of the packed scene (core/packed_layout.h "textures", "images").
 
-// Bilinear lookup of image (index) at uv, wrapping. Texture coordinates follow OBJ and
-// the Ray Tracing books: u to the right, v UP, so v = 1 is the image's top row (images are
-// stored top row first).
-vec3 image_lookup(uint image, vec2 uv)
+// A texture coordinate folded into [0, 1] by an image's wrap mode (IMAGE_WRAP_*).
+float wrap_coordinate(float x, uint mode)
+{
+    if (mode == uint(IMAGE_WRAP_CLAMP))
+        return clamp(x, 0.0, 1.0);
+    if (mode == uint(IMAGE_WRAP_MIRROR))
+        return 1.0 - abs(fract(0.5 * x) * 2.0 - 1.0);
+    return fract(x);
+}
+
+// Bilinear lookup of image (index) at uv, its RGBA, folded by the image's wrap modes
+// (repeat unless a glTF sampler says otherwise). Texture coordinates follow OBJ and the
+// Ray Tracing books: u to the right, v UP, so v = 1 is the image's top row (images are stored top row
+// first). Across the top and bottom edges the filter clamps; across the left and right
+// ones it wraps when u repeats.
+vec4 image_lookup_rgba(uint image, vec2 uv)
 {
     uvec4 record = packed_texel(image_offset + image * uint(PACKED_IMAGE_STRIDE));
     uint first = record.x;
     int width = int(record.y), height = int(record.z);
     if (width == 0 || height == 0)
-        return vec3(1.0, 0.0, 1.0);
-    vec2 position = vec2(fract(uv.x), 1.0 - fract(uv.y)) * vec2(width, height) - 0.5;
+        return vec4(1.0, 0.0, 1.0, 1.0);
+    uint wrap_u = record.w & 3u, wrap_v = (record.w >> uint(IMAGE_WRAP_V_SHIFT)) & 3u;
+    vec2 position = vec2(wrap_coordinate(uv.x, wrap_u), 1.0 - wrap_coordinate(uv.y, wrap_v)) * vec2(width, height)
+                  - 0.5;
     ivec2 corner = ivec2(floor(position));
     vec2 weight = position - vec2(corner);
-    vec3 colour = vec3(0.0);
+    vec4 colour = vec4(0.0);
     for (int k = 0; k < 4; k++) {
         work++;
         ivec2 texel = corner + ivec2(k & 1, k >> 1);
-        texel.x = (texel.x % width + width) % width;
+        texel.x = wrap_u == uint(IMAGE_WRAP_REPEAT) ? (texel.x % width + width) % width : clamp(texel.x, 0, width - 1);
         texel.y = clamp(texel.y, 0, height - 1);
         float w = ((k & 1) != 0 ? weight.x : 1.0 - weight.x) * ((k >> 1) != 0 ? weight.y : 1.0 - weight.y);
-        colour += w * packed_vec4(first + uint(texel.y * width + texel.x)).rgb;
+        colour += w * packed_vec4(first + uint(texel.y * width + texel.x));
     }
     return colour;
 }
+
+// The same, its colour.
+vec3 image_lookup(uint image, vec2 uv) { return image_lookup_rgba(image, uv).rgb; }
 
 // Gradient noise in [-1, 1] with hashed gradients (Perlin's construction, hash instead
 // of a permutation table so that no table needs uploading).

@@ -20,9 +20,17 @@
 #   three-balls-anim  24 frames (--frames 0-23) at 320x180, 4 spp, one GPU context
 #   cornell        600x600, 4 spp; next-week 400x400 (half the book's), 2 spp;
 #   crystal-ball   640x480, 4 spp
+#   pbr-chart      scenes/pbr-chart.txt 640x360, 16 spp: the pbr material, every
+#                  roughness and metallic (issue 14)
 #   mesh-L         icospheres of level L (3 5 6 8: 1,280 / 20,480 / 81,920 / 1,310,720
 #                  triangles, the nearest levels to the issue's 1k/10k/100k/1M), 320x240,
 #                  16 spp, depth 8
+#   gltf-model     model.glb of scenes/generators/models.c (its camera, lights, textures),
+#                  320x213, 16 spp
+#   gltf-1M, ply-1M  a torus of 1,000,064 triangles as .glb and as binary PLY
+#                  (scenes/generators/models.c DIR big), framed as mesh-L, 320x240, 16
+#                  spp; their note is tests/bench/import_time.c's load and pack seconds
+#                  (issue 14's target: under 3 s, at most 100 packed bytes per triangle)
 # About 2 minutes on 2 idle cores, 5 with a test run alongside; most of it the weekend.
 #
 # Columns: wall s (the whole process, from peak_rss), cores (its CPU time / wall time:
@@ -98,6 +106,13 @@ build_tool "$work/plot" tests/bench/plot.cpp \
     $(pkg-config --libs OpenImageIO) -o "$work/plot"
 build_tool "$work/assets" scenes/generators/assets.c \
     "$CC" -std=c11 -O2 scenes/generators/assets.c -lm -o "$work/assets"
+build_tool "$work/models-generator" scenes/generators/models.c \
+    "$CC" -std=c11 -O2 scenes/generators/models.c -lm -o "$work/models-generator"
+# The import timer links the library the Makefile built (make bench builds it first).
+# shellcheck disable=SC2046 # pkg-config prints several flags, to be split into words
+build_tool "$work/import_time" tests/bench/import_time.c \
+    "$CC" -std=c11 -D_GNU_SOURCE -Wall -Wextra -O2 -Icore tests/bench/import_time.c build/librtspheres.a \
+    $(pkg-config --libs epoxy egl OpenImageIO tinyobjloader tinygltf cglm) -lstdc++ -lm -o "$work/import_time"
 
 # ---- measuring ------------------------------------------------------------------------
 # Prints N scaled by BENCH_SCALE, rounded, at least 1.
@@ -288,6 +303,8 @@ bench_animation three-balls-anim scenes/three-balls.txt 320x180 "$(scaled 4)" 24
 bench cornell scenes/cornell.txt 600x600 "$(scaled 4)" ""
 bench next-week scenes/next-week.txt 400x400 "$(scaled 2)" ""
 bench crystal-ball scenes/crystal-ball.txt 640x480 "$(scaled 4)" ""
+# The pbr material (issue 14): a chart of roughness by metallic under a sphere light.
+bench pbr-chart scenes/pbr-chart.txt 640x360 "$(scaled 16)" ""
 
 # Time to quality against Cycles (tests/bench/peers.sh): ladders of spp, RMSE against
 # each renderer's own cached high-spp reference. The issue's sizes: the Cornell box at
@@ -312,6 +329,30 @@ group material shiny {
 SCENE
     bench "mesh-$level" "$work/mesh-$level.txt" 320x240 "$(scaled 16)" ""
 done
+
+# Imported files (issue 14): a glTF scene by itself, and a million triangles as glTF and
+# PLY, each first timed loading and packing (import_time), then rendered.
+"$work/models-generator" "$work/models" >/dev/null
+bench gltf-model "$work/models/model.glb" 320x213 "$(scaled 16)" ""
+[ -f "$work/models/big.glb" ] || "$work/models-generator" "$work/models" big 1000000 >/dev/null
+cat >"$work/models/ply-1M.txt" <<'SCENE'
+render size 320 240 depth 8 seed 1
+camera from 0 2 3.2 at 0 0 0 up 0 1 0 fov 40
+sky gradient 1 1 1  0.5 0.7 1
+material shiny metal 0.9 0.8 0.7 fuzz 0.2
+mesh "big.ply" shiny
+SCENE
+import_note() {
+    if "$work/import_time" "$1" >"$work/$2-import.log" 2>&1; then
+        sed -n 's/^import: [^:]*: \(load .*\); .*/\1/p' "$work/$2-import.log"
+    else
+        echo "import_time FAILED"
+    fi
+}
+gltf_import=$(import_note "$work/models/big.glb" gltf-1M)
+ply_import=$(import_note "$work/models/ply-1M.txt" ply-1M)
+bench gltf-1M "$work/models/big.glb" 320x240 "$(scaled 16)" "$gltf_import"
+bench ply-1M "$work/models/ply-1M.txt" 320x240 "$(scaled 16)" "$ply_import"
 load_end=$(cut -d ' ' -f 1-3 /proc/loadavg 2>/dev/null || echo "-")
 
 # ---- the weekend images agree? (a sanity check of the reference, never a failure) ------
@@ -373,6 +414,15 @@ targets=$work/targets.tsv
         "$(value startup 13)"
     printf 'packed_bytes_per_triangle\t%s\t<=\t100\tB\tpacked bytes per triangle, mesh-%s\n' \
         "$(value "mesh-$last_level" 12)" "$last_level"
+    # issue 14: importing a million triangles
+    for label in gltf ply; do
+        import_log=$(cat "$work/$label-1M-import.log" 2>/dev/null || true)
+        printf '%s_1M_load_and_pack\t%s\t<\t3\ts\t%s-1M: load and pack, wall seconds (import_time; CPU %s s)\n' "$label" \
+            "$(field "$import_log" 's/.*together \([0-9.]*\) s.*/\1/p')" "$label" \
+            "$(field "$import_log" 's/.*(CPU \([0-9.]*\) s).*/\1/p')"
+        printf '%s_1M_packed_bytes_per_triangle\t%s\t<=\t100\tB\tpacked bytes per triangle, %s-1M\n' "$label" \
+            "$(value "$label-1M" 12)" "$label"
+    done
     # issue 13, against Blender Cycles (tests/bench/peers.sh)
     printf 'weekend_time_ratio_cycles\t%s\t<=\t0.5\tx\tweekend at equal spp, render s rtspheres / Cycles\n' \
         "$(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")"

@@ -28,10 +28,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "camera.h"
+#include "fuzz_support.h"
 #include "obj_load.h"
-#include "pack.h"
-#include "packed_traverse.h"
 #include "scene_assets.h"
 #include "scene_parse.h"
 
@@ -62,33 +60,17 @@ static void remove_fixtures(void)
     rmdir(directory);
 }
 
-/* Writes size bytes of data to path; aborts on failure (the harness would be useless). */
-static void write_file(const char *path, const void *data, size_t size)
-{
-    FILE *file = fopen(path, "wb");
-    if (file == NULL || (size > 0 && fwrite(data, 1, size, file) != size) || fclose(file) != 0) {
-        fprintf(stderr, "fuzz_obj_load: cannot write %s\n", path);
-        abort();
-    }
-}
-
 /* libFuzzer calls this once before the first input: makes the directory and scene file. */
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
-    const char *temporary = getenv("TMPDIR");
-    snprintf(directory, sizeof directory, "%s/rtspheres-fuzz-obj.XXXXXX",
-             temporary != NULL && temporary[0] != '\0' ? temporary : "/tmp");
-    if (mkdtemp(directory) == NULL) {
-        perror("fuzz_obj_load: mkdtemp");
-        abort();
-    }
+    fuzz_make_directory("rtspheres-fuzz-obj", directory, sizeof directory);
     snprintf(obj_path, sizeof obj_path, "%s/mesh.obj", directory);
     snprintf(mtl_path, sizeof mtl_path, "%s/m.mtl", directory);
     snprintf(scene_path, sizeof scene_path, "%s/scene.txt", directory);
     atexit(remove_fixtures);
-    write_file(scene_path, scene_text, sizeof scene_text - 1);
+    fuzz_write_file(scene_path, scene_text, sizeof scene_text - 1);
     return 0;
 }
 
@@ -139,26 +121,7 @@ static void load_pack_and_trace(void)
         scene_free(&s);
         return;
     }
-    packed_scene packed;
-    if (pack_scene(&s, NULL, &packed, &error) != RT_OK) {
-        if (error.message[0] == '\0')
-            abort();
-        scene_free(&s);
-        return;
-    }
-    camera_frame frame;
-    if (camera_frame_compute(&s.camera, s.render.width, s.render.height, &frame, &error) == RT_OK) {
-        static const float film[][2] = {{0.5f, 0.5f}, {0.3f, 0.6f}, {0.7f, 0.4f}, {0.5f, 0.2f}};
-        for (size_t i = 0; i < sizeof film / sizeof film[0]; i++) {
-            float origin[3], direction[3];
-            camera_frame_ray(&frame, film[i][0], film[i][1], 0.0f, 0.0f, origin, direction);
-            packed_hit hit;
-            if (packed_intersect_nearest(&packed, origin, direction, 1e-4f, 1e30f, &hit) &&
-                hit.primitive >= packed.primitive_count)
-                abort();
-        }
-    }
-    packed_scene_free(&packed);
+    fuzz_pack_and_trace(&s);
     scene_free(&s);
 }
 
@@ -181,9 +144,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     size_t after;
     size_t obj_size = find_separator(data, size, &after);
-    write_file(obj_path, data, obj_size);
+    fuzz_write_file(obj_path, data, obj_size);
     if (after < size || obj_size < size)
-        write_file(mtl_path, data + after, size - after);
+        fuzz_write_file(mtl_path, data + after, size - after);
     else
         unlink(mtl_path);
 

@@ -2,14 +2,15 @@
 # run.sh: replays the fuzz regression inputs, then fuzzes each harness for a while.
 #   usage: sh tests/fuzz/run.sh HARNESS_DIR SECONDS WORK_DIR
 # HARNESS_DIR holds the built harnesses (`make fuzz-build` puts them in build-fuzz/).
-# For each harness NAME (fuzz_scene_parse, fuzz_expression, fuzz_obj_load):
+# For each harness NAME (fuzz_scene_parse, fuzz_expression, fuzz_obj_load, fuzz_gltf_load,
+# fuzz_ply_load):
 #   1. every file in tests/fuzz/regressions/NAME/ is run once: each once crashed;
 #   2. NAME fuzzes for SECONDS, starting from its seed corpus (tests/fuzz/corpus/KIND/)
 #      and the regressions; inputs it finds go to WORK_DIR/corpus/NAME/ (so a WORK_DIR
 #      that is kept, as `make fuzz` keeps build-fuzz/, grows a corpus run after run),
 #      a crashing input to WORK_DIR/artifacts/NAME/. Inputs are cut at 4096 bytes
 #      (larger seeds too): at ten times the executions per second, that finds more.
-# The harnesses fuzz at the same time (three processes on two cores in CI). Prints "PASS name" /
+# The harnesses fuzz at the same time (five processes on two cores in CI). Prints "PASS name" /
 # "FAIL name: detail" lines and exits non-zero when any check failed.
 set -u
 harness_dir=$1
@@ -27,6 +28,8 @@ corpus_kind() {
         fuzz_scene_parse) echo scene ;;
         fuzz_expression) echo expression ;;
         fuzz_obj_load) echo obj ;;
+        fuzz_gltf_load) echo gltf ;;
+        fuzz_ply_load) echo ply ;;
     esac
 }
 
@@ -34,6 +37,8 @@ corpus_kind() {
 dictionary() {
     case $1 in
         fuzz_obj_load) echo "$fuzz_dir/obj.dict" ;;
+        fuzz_gltf_load) echo "$fuzz_dir/gltf.dict" ;;
+        fuzz_ply_load) echo "$fuzz_dir/ply.dict" ;;
         *) echo "$fuzz_dir/scene.dict" ;;
     esac
 }
@@ -46,7 +51,7 @@ report_crash() {
     echo "$summary${artifact:+ (input: $artifact)}"
 }
 
-harnesses="fuzz_scene_parse fuzz_expression fuzz_obj_load"
+harnesses="fuzz_scene_parse fuzz_expression fuzz_obj_load fuzz_gltf_load fuzz_ply_load"
 for name in $harnesses; do
     if [ ! -x "$harness_dir/$name" ]; then
         fail "fuzz $name" "$harness_dir/$name is not built (make fuzz-build)"

@@ -1,36 +1,37 @@
 #!/bin/sh
-# test-golden.sh: renders each golden scene small and compares it with golden/NAME.exr
-# using `rtspheres diff` at Blender's render-test tolerance (a pixel fails above 0.016,
-# the test fails when more than 1% of pixels fail). Goldens catch regressions only;
-# test-analytic.sh checks correctness. On failure the amplified difference image is
-# kept as golden-diff-NAME.png in the directory given by RTSPHERES_DIFF_DIR (default: the
-# scratch directory, which is removed; set it to keep the images).
+# test-golden.sh: the golden-image suite, tests/render/golden-scenes.txt, run by
+# `rtspheres check` (one process, one GPU context): each case is rendered and compared with
+# golden/NAME.exr by the z test (the difference must be within the samples' noise, so a
+# device that flips a few paths passes; docs/regression.md). Goldens catch regressions
+# only; test-analytic.sh checks correctness. One check per case, from check's line for it.
+# Set RTSPHERES_DIFF_DIR=dir to get the HTML report (reference, new image, difference and
+# z-score heat map of every case, failures first) in dir.
 #   usage: sh tests/render/test-golden.sh PROGRAM SCRATCH_DIR
 here=$(dirname "$0")
 . "$here/lib.sh"
-. "$here/golden-options.sh"
-diff_dir=${RTSPHERES_DIFF_DIR:-$scratch}
-mkdir -p "$diff_dir"
-grep -v '^#' "$here/golden-scenes.txt" | {
-    while read -r name scene extra; do
-        [ -n "$name" ] || continue
-        out="$scratch/$name.exr"
-        if [ ! -f "golden/$name.exr" ]; then
-            fail "golden $name" "golden/$name.exr is missing (make golden)"
-            continue
-        fi
-        # shellcheck disable=SC2086
-        if ! "$program" render "$scene" -o "$out" $golden_render_options $extra; then
-            fail "golden $name" "render of $scene failed"
-            continue
-        fi
-        if "$program" diff "$out" "golden/$name.exr" --fail 0.016 --failpercent 1 \
-            --diff-out "$diff_dir/golden-diff-$name.png" >"$scratch/$name.diff" 2>&1; then
-            pass "golden $name ($(grep '^pixels over' "$scratch/$name.diff"))"
-        else
-            cat "$scratch/$name.diff"
-            fail "golden $name" "differs from golden/$name.exr; difference image: $diff_dir/golden-diff-$name.png"
-        fi
-    done
-    finish
-}
+report=${RTSPHERES_DIFF_DIR:-}
+start=$(date +%s)
+"$program" check "$here/golden-scenes.txt" --junit "$scratch/golden.xml" ${report:+--report "$report"} \
+    >"$scratch/check.out" 2>"$scratch/check.err"
+code=$?
+seconds=$(($(date +%s) - start))
+if [ "$code" != 0 ] && [ "$code" != 1 ]; then
+    fail "golden suite" "rtspheres check exited $code: $(head -c 600 "$scratch/check.err")"
+fi
+# One line per case: "VERDICT NAME (T s): reason".
+grep '^case ' "$here/golden-scenes.txt" >"$scratch/cases"
+count=$(wc -l <"$scratch/cases" | tr -d ' ')
+while read -r _ name _; do
+    line=$(grep -E "^(pass|FAIL|ERROR) +$name \(" "$scratch/check.out")
+    case $line in
+    pass*) pass "golden $name (${line#*: })" ;;
+    "") fail "golden $name" "no line for it in the output of rtspheres check: $(head -c 300 "$scratch/check.out")" ;;
+    *) fail "golden $name" "${line#* }${report:+ (report: $report/index.html)}" ;;
+    esac
+done <"$scratch/cases"
+if grep -q "^check: $count passed, 0 failed, 0 errors, 0 not run of $count cases" "$scratch/check.out"; then
+    pass "golden suite: $(grep '^check: [0-9]* passed' "$scratch/check.out" | sed 's/^check: //') ($seconds s wall)"
+else
+    fail "golden suite summary" "$(tail -n 2 "$scratch/check.out" | tr '\n' ' ')"
+fi
+finish

@@ -55,6 +55,12 @@ check weekend-whitted scenes/weekend.txt --integrator whitted --max-depth 8
 check lights-whitted scenes/lights.txt --integrator whitted
 # Everything at once: environment light, point/spot/sun, textures, a volume, emitters.
 check loop-stress tests/render/scenes/loop-stress.txt --spp 16
+# The pbr material (and not its alpha masks or vertex colours), in both integrators; an
+# alpha mask with an image (the traversal's alpha test).
+check pbr-chart scenes/pbr-chart.txt
+check pbr-chart-whitted scenes/pbr-chart.txt --integrator whitted
+check pbr-lights tests/render/scenes/pbr-lights.txt
+check pbr-mask tests/render/scenes/pbr-mask.txt
 # The AOV pass and the denoiser use the render's variant too.
 check three-balls-aovs scenes/three-balls.txt --aovs
 

@@ -9,6 +9,8 @@
  *   make_image(width, height, channels, value)     an image with every sample = value
  *   assert_merge_metadata_equal(actual, expected)  every field of two merge_metadata
  *   splitmix64_next(&state)                        reproducible 64-bit test data
+ *   gpu_fixture_set_up / gpu_fixture_tear_down   a cmocka group setup/teardown pair making
+ *            gpu_fixture_context, the one GPU context of a test binary that renders
  *   scratch: make_scratch / remove_scratch (a cmocka setup/teardown pair), in_scratch,
  *            write_file, scratch_write             a fresh directory per test
  *   scratch_test(test)                             a test table entry with that pair
@@ -199,6 +201,33 @@ static inline const char *scratch_write(scratch *s, const char *name, const void
 static inline const char *write_file(scratch *s, const char *name, const char *text)
 {
     return scratch_write(s, name, text, strlen(text));
+}
+
+/* ---- a GPU context for the group -------------------------------------------------------- */
+
+#include "gpu.h"
+
+static gpu_context *gpu_fixture_context;
+
+/* Group setup: creates gpu_fixture_context (a failure fails the group with the message). */
+static inline int gpu_fixture_set_up(void **state)
+{
+    (void)state;
+    rt_error error;
+    if (gpu_create(NULL, &gpu_fixture_context, &error) != RT_OK) {
+        print_error("%s\n", error.message);
+        return -1;
+    }
+    return 0;
+}
+
+/* Group teardown: destroys gpu_fixture_context. */
+static inline int gpu_fixture_tear_down(void **state)
+{
+    (void)state;
+    gpu_destroy(gpu_fixture_context);
+    gpu_fixture_context = NULL;
+    return 0;
 }
 
 #endif

@@ -113,7 +113,7 @@ static void header_and_materials_round_trip(void **state)
             assert_true(packed_float(&packed, base, 1 + c) == m->albedo[c]);
             assert_true(packed_float(&packed, base + 1, c) == m->emission[c]);
         }
-        if (m->type == MATERIAL_EMISSIVE)   /* texel 1 .w: the emitter's light group, else the fuzz */
+        if (m->type != MATERIAL_METAL)   /* texel 1 .w: the metal's fuzz, else the light group */
             assert_int_equal(packed_uint(&packed, base + 1, 3), (uint32_t)m->light_group);
         else
             assert_true(packed_float(&packed, base + 1, 3) == m->fuzz);
@@ -257,7 +257,10 @@ static void empty_scene_packs_and_misses(void **state)
     assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
     assert_int_equal(packed.primitive_count, 0);
     assert_int_equal(packed.node_count, 0);
-    assert_int_equal(packed.texel_count, PACKED_HEADER_TEXELS + PACKED_MATERIAL_STRIDE);
+    /* The header and the default material, then the padding that puts the (empty) node
+     * section at 2 mod 4 texels (pack.c, plan_layout). */
+    uint32_t texels = PACKED_HEADER_TEXELS + PACKED_MATERIAL_STRIDE;
+    assert_int_equal(packed.texel_count, texels + (6 - texels % 4) % 4);
     float origin[3] = {0, 0, 0}, direction[3] = {0, 0, 1};
     packed_hit hit;
     assert_false(packed_intersect_nearest(&packed, origin, direction, 0, INFINITY, &hit));
@@ -929,6 +932,73 @@ static void mesh_vertices_are_stored_once(void **state)
     scene_free(&s);
 }
 
+/* A quad mesh (two triangles) with vertex colours, and a pbr material; the caller frees it. */
+static void coloured_quad(scene *s, bool material_asks)
+{
+    scene_defaults(s);
+    scene_material m = scene_material_defaults();
+    m.type = MATERIAL_PBR;
+    m.albedo[0] = m.albedo[1] = m.albedo[2] = 1;
+    m.vertex_colors = material_asks;
+    m.roughness = 1;
+    m.index_of_refraction = 1.5f;
+    assert_true(scene_add_material(s, &m) == 0);
+    scene_mesh mesh = {.default_material = 0, .vertex_count = 4, .triangle_count = 2};
+    const float positions[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const float colors[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0.25f, 0.5f, 2};
+    const uint32_t indices[6] = {0, 1, 2, 0, 2, 3};
+    mesh.positions = malloc(sizeof positions);
+    mesh.colors = malloc(sizeof colors);
+    mesh.indices = malloc(sizeof indices);
+    memcpy(mesh.positions, positions, sizeof positions);
+    memcpy(mesh.colors, colors, sizeof colors);
+    memcpy(mesh.indices, indices, sizeof indices);
+    int mesh_index = scene_add_mesh(s, &mesh);
+    scene_object object = {.mesh = mesh_index};
+    assert_true(scene_add_object(s, &object) >= 0);
+    scene_instance here = {.object = 0, .material = 0};
+    scene_identity_transform(here.object_to_world);
+    assert_true(scene_add_instance(s, &here) >= 0);
+}
+
+/* Vertex colours are packed (unorm16 pairs, packed_layout.h "colours") only when a pbr
+ * material asks for them and a mesh has them, each stored vertex with its own colour,
+ * clamped to 0..1; the header names the section, the summary says so. */
+static void vertex_colours_are_packed_when_asked_for(void **state)
+{
+    (void)state;
+    for (int asks = 0; asks < 2; asks++) {
+        scene s;
+        coloured_quad(&s, asks);
+        packed_scene packed;
+        assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+        assert_int_equal(packed_uint(&packed, PACKED_HEADER_COLOR_OFFSET / 4, PACKED_HEADER_COLOR_OFFSET % 4),
+                         asks ? packed.color_offset : PACKED_NONE);
+        assert_int_equal(packed.summary.vertex_colors, asks);
+        assert_true(packed.summary.pbr);
+        if (asks) {
+            assert_true(packed.color_offset >= packed.uv_offset + (packed.vertex_count + 1) / 2);
+            assert_true(packed.color_offset + (packed.vertex_count + 1) / 2 <= packed.node_offset);
+            assert_int_equal(packed.vertex_count, 4);
+            for (uint32_t v = 0; v < packed.vertex_count; v++) {
+                float position[3];
+                packed_vertex_position(&packed, v, position);
+                int m = position[0] == 0 ? (position[1] == 0 ? 0 : 3) : (position[1] == 0 ? 1 : 2);
+                const float expected[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.25f, 0.5f, 1}};
+                uint32_t rg = packed_uint(&packed, packed.color_offset + v / 2, (int)(2 * (v % 2)));
+                uint32_t ba = packed_uint(&packed, packed.color_offset + v / 2, (int)(2 * (v % 2) + 1));
+                const float got[4] = {(rg & 0xffff) / 65535.0f, (rg >> 16) / 65535.0f, (ba & 0xffff) / 65535.0f,
+                                      (ba >> 16) / 65535.0f};
+                for (int c = 0; c < 3; c++)
+                    assert_float_equal(got[c], expected[m][c], 1e-5);
+                assert_float_equal(got[3], 1, 0);
+            }
+        }
+        packed_scene_free(&packed);
+        scene_free(&s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -943,6 +1013,7 @@ int main(void)
         cmocka_unit_test(placed_emitters_become_lights),
         cmocka_unit_test(normals_survive_the_encoding),
         cmocka_unit_test(mesh_vertices_are_stored_once),
+        cmocka_unit_test(vertex_colours_are_packed_when_asked_for),
         cmocka_unit_test(degenerate_and_duplicate_triangles),
     };
     return cmocka_run_group_tests_name("pack", tests, NULL, NULL);

@@ -1,6 +1,7 @@
 /* test_pack_summary.c: what pack_scene() says a scene holds (pack.h, pack_summary), which
  * chooses the tracer variant: primitive kinds in either BVH level, instances, volumes,
- * emitters, textures and normal maps, lights by kind, the environment; and the texel hash
+ * emitters, textures and normal maps, pbr and alpha masks, lights by kind, the
+ * environment; and the texel hash
  * it hands on (hash.h). Small scenes from text, their images given stand-in pixels. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -31,11 +32,19 @@ static void assert_summary_matches_texels(const packed_scene *packed)
     for (uint32_t light = 0; light < packed->light_count; light++)
         light_types |= BIT(packed_uint(packed, packed->light_offset + light * PACKED_LIGHT_STRIDE, 0));
     bool emitters = false, textures = packed->texture_count > 0, normal_maps = false, volumes = false;
+    bool pbr = false, alpha_mask = false;
     for (uint32_t m = 0; m < packed->material_count; m++) {
         uint32_t base = packed->material_offset + m * PACKED_MATERIAL_STRIDE;
-        emitters |= packed_uint(packed, base, 0) == MATERIAL_EMISSIVE;
-        textures |= packed_uint(packed, base + 2, 1) != PACKED_NONE || packed_uint(packed, base + 2, 2) != PACKED_NONE;
+        uint32_t type = packed_uint(packed, base, 0) & MATERIAL_TYPE_MASK;
+        bool is_pbr = type == MATERIAL_PBR;
+        bool emission = packed_float(packed, base + 1, 0) > 0 || packed_float(packed, base + 1, 1) > 0
+                        || packed_float(packed, base + 1, 2) > 0;
+        emitters |= type == MATERIAL_EMISSIVE || (is_pbr && emission);
+        textures |= packed_uint(packed, base + 2, 1) != PACKED_NONE || packed_uint(packed, base + 2, 2) != PACKED_NONE
+                    || (is_pbr && packed_uint(packed, base + 4, 3) != PACKED_NONE);
         normal_maps |= packed_uint(packed, base + 2, 3) != PACKED_NONE;
+        pbr |= is_pbr;
+        alpha_mask |= (packed_uint(packed, base, 0) & MATERIAL_FLAG_ALPHA_MASK) != 0;
     }
     for (uint32_t i = 0; i < packed->instance_count; i++)
         volumes |= (packed_uint(packed, packed->instance_offset + i * PACKED_INSTANCE_STRIDE, 2) & INSTANCE_VOLUME) != 0;
@@ -45,6 +54,10 @@ static void assert_summary_matches_texels(const packed_scene *packed)
     assert_int_equal(packed->summary.textures, textures);
     assert_int_equal(packed->summary.normal_maps, normal_maps);
     assert_int_equal(packed->summary.volumes, volumes);
+    assert_int_equal(packed->summary.pbr, pbr);
+    assert_int_equal(packed->summary.alpha_mask, alpha_mask);
+    assert_int_equal(packed->summary.vertex_colors, packed_uint(packed, PACKED_HEADER_COLOR_OFFSET / 4,
+                                                                PACKED_HEADER_COLOR_OFFSET % 4) != PACKED_NONE);
 }
 
 /* Parses camera_line followed by body, gives every image 2x1 grey pixels (nothing is
@@ -80,7 +93,7 @@ typedef struct summary_case {
     const char *body;            /* after camera_line */
     bool keep_instances;         /* pack_options.keep_instances */
     uint32_t primitive_types, light_types;
-    bool volumes, emitters, textures, normal_maps;
+    bool volumes, emitters, textures, normal_maps, pbr, alpha_mask;
 } summary_case;
 
 #define GREY "material grey lambertian 0.5 0.5 0.5\n"
@@ -167,6 +180,30 @@ static const summary_case cases[] = {
      .body = "material bumpy lambertian 0.5 0.5 0.5 normal_map \"bumps.png\"\nsphere 0 0 0 1 bumpy\n",
      .primitive_types = BIT(PRIMITIVE_SPHERE),
      .normal_maps = true},
+    {.what = "a pbr material",
+     .body = "material plastic pbr 0.8 0.2 0.1 metallic 0 roughness 0.4\nsphere 0 0 0 1 plastic\n",
+     .primitive_types = BIT(PRIMITIVE_SPHERE),
+     .pbr = true},
+    /* pbr with an emission is a light; a one-sided emitter too (its back sends nothing). */
+    {.what = "a pbr emitter and a one-sided lamp",
+     .body = "material panel pbr 0 0 0 metallic 0 roughness 1 emission 1 1 1 strength 2\n"
+             "material lamp emissive 1 1 1 one_sided\n"
+             "quad 0 0 0  1 0 0  0 1 0 panel\nquad 0 0 -1  1 0 0  0 1 0 lamp\n",
+     .primitive_types = BIT(PRIMITIVE_QUAD),
+     .light_types = BIT(LIGHT_QUAD),
+     .emitters = true, .pbr = true},
+    /* An alpha-masked emitter emits where it is, but is no light (its holes would be). */
+    {.what = "an alpha-masked pbr emitter",
+     .body = "material sign pbr 1 1 1 metallic 0 roughness 1 emission 1 1 1 alpha 0.7 alpha_cutoff 0.5\n"
+             "quad 0 0 0  1 0 0  0 1 0 sign\n",
+     .primitive_types = BIT(PRIMITIVE_QUAD),
+     .emitters = true, .pbr = true, .alpha_mask = true},
+    /* A metallic-roughness map is an image the tracer looks up: the texture code. */
+    {.what = "a metallic-roughness map",
+     .body = "material worn pbr 1 1 1 metallic 1 roughness 1 metallic_roughness_map \"mr.png\"\n"
+             "sphere 0 0 0 1 worn\n",
+     .primitive_types = BIT(PRIMITIVE_SPHERE),
+     .textures = true, .pbr = true},
     {.what = "an unused texture",
      .body = "texture spare noise 4\n" GREY "sphere 0 0 0 1 grey\n",
      .primitive_types = BIT(PRIMITIVE_SPHERE),
@@ -186,10 +223,10 @@ static void each_scene_is_summarised(void **state)
             fail_msg("%s: primitive types %#x, light types %#x; expected %#x, %#x", c->what, got->primitive_types,
                      got->light_types, c->primitive_types, c->light_types);
         if (got->volumes != c->volumes || got->emitters != c->emitters || got->textures != c->textures
-            || got->normal_maps != c->normal_maps)
-            fail_msg("%s: volumes %d emitters %d textures %d normal maps %d; expected %d %d %d %d", c->what,
-                     got->volumes, got->emitters, got->textures, got->normal_maps, c->volumes, c->emitters,
-                     c->textures, c->normal_maps);
+            || got->normal_maps != c->normal_maps || got->pbr != c->pbr || got->alpha_mask != c->alpha_mask)
+            fail_msg("%s: volumes %d emitters %d textures %d normal maps %d pbr %d alpha masks %d; expected %d %d %d "
+                     "%d %d %d", c->what, got->volumes, got->emitters, got->textures, got->normal_maps, got->pbr,
+                     got->alpha_mask, c->volumes, c->emitters, c->textures, c->normal_maps, c->pbr, c->alpha_mask);
         packed_scene_free(&packed);
     }
 }

@@ -15,30 +15,12 @@
 
 #include "gpu.h"
 #include "tracer_interface.h"
+#include "support.h"
 
 #define WIDTH 256
 #define HEIGHT 128
 #define COUNT ((size_t)WIDTH * HEIGHT * 4)
 
-static gpu_context *context;
-
-static int set_up(void **state)
-{
-    (void)state;
-    rt_error error;
-    if (gpu_create(NULL, &context, &error) != RT_OK) {
-        print_error("%s\n", error.message);
-        return -1;
-    }
-    return 0;
-}
-
-static int tear_down(void **state)
-{
-    (void)state;
-    gpu_destroy(context);
-    return 0;
-}
 
 /* The sampler the per-pixel checks below run with (both, in turn: see main()). */
 static int sampler_under_test;
@@ -51,7 +33,7 @@ static float *draw(uint32_t sample_index, uint32_t seed, uint32_t dimension)
     rt_error error;
     gpu_random_request request = {.width = WIDTH, .height = HEIGHT, .sample_index = sample_index, .seed = seed,
                                   .dimension = dimension, .sampler = sampler_under_test};
-    assert_int_equal(gpu_random_numbers(context, &request, numbers, &error), RT_OK);
+    assert_int_equal(gpu_random_numbers(gpu_fixture_context, &request, numbers, &error), RT_OK);
     return numbers;
 }
 
@@ -66,7 +48,7 @@ static float *draw_range(int sampler, uint32_t start, uint32_t count, int x, int
     gpu_random_request request = {.width = 64, .height = (int)(count / 64), .sample_index = start, .seed = seed,
                                   .dimension = dimension, .sampler = sampler, .over_samples = true,
                                   .fixed_pixel = {x, y}};
-    assert_int_equal(gpu_random_numbers(context, &request, numbers, &error), RT_OK);
+    assert_int_equal(gpu_random_numbers(gpu_fixture_context, &request, numbers, &error), RT_OK);
     return numbers;
 }
 
@@ -314,5 +296,5 @@ int main(void)
         cmocka_unit_test(sobol_pairs_dimensions_and_pixels_are_independent),
         cmocka_unit_test(sobol_integrates_a_disc_better),
     };
-    return cmocka_run_group_tests_name("sample values (on the device)", tests, set_up, tear_down);
+    return cmocka_run_group_tests_name("sample values (on the device)", tests, gpu_fixture_set_up, gpu_fixture_tear_down);
 }

@@ -151,6 +151,26 @@ static void output_names(void **state)
     assert_string_equal(partial, "a.b/c.partial.exr");
 }
 
+/* --camera is a glTF scene's, and a glTF scene takes no -D (but --frames' $frame). */
+static void gltf_scene_rules(void **state)
+{
+    (void)state;
+    char message[1024];
+    render_job job = job_for("out.png");
+    job.camera = "front";
+    snprintf(message, sizeof message, "--camera picks a camera of a glTF file (.gltf, .glb); '%s' is a scene file, "
+             "whose camera statement sets the camera", scene_path);
+    refused(&job, message);
+    job.scene_path = "model.glb";
+    first_output_is(&job, "out.png");
+    scene_define define = {.name = "size", .value = "2"};
+    job.defines = &define;
+    job.define_count = 1;
+    refused(&job, "-D size: a glTF scene ('model.glb') has no variables");
+    define.optional = true;
+    first_output_is(&job, "out.png");
+}
+
 static void output_rules(void **state)
 {
     (void)state;
@@ -640,6 +660,7 @@ int main(void)
         cmocka_unit_test(defaults_are_zero),
         cmocka_unit_test(output_names),
         cmocka_unit_test(output_rules),
+        cmocka_unit_test(gltf_scene_rules),
         cmocka_unit_test(part_rules),
         cmocka_unit_test(shards),
         cmocka_unit_test(image_samples),

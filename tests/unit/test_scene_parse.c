@@ -523,7 +523,7 @@ static void test_unknown_statement(void **state)
     (void)state;
     assert_parse_error("spere 0 0 0 1 m", "s.txt:1:1: ",
                        "unknown statement 'spere' (expected include, set, camera, render, sky, ambient, light, "
-                       "texture, material, sphere, moving_sphere, triangle, quad, box, mesh, group, instance, "
+                       "texture, material, sphere, moving_sphere, triangle, quad, box, mesh, gltf, group, instance, "
                        "volume, translate, rotate, scale or matrix)");
     assert_parse_error("\n\n   Camera fov 30", "s.txt:3:4: ", "unknown statement 'Camera'");
     assert_parse_error("\"camera\"", "s.txt:1:1: ", "unknown statement the string \"camera\"");
@@ -541,12 +541,12 @@ static void test_unknown_clause(void **state)
     assert_parse_error("material m metal 1 1 1 shine 2", "s.txt:1:24: ",
                        "unknown metal material clause 'shine' (expected fuzz, normal_map, phong or specular)");
     assert_parse_error("material m emissive 1 1 1 fuzz 2", "s.txt:1:27: ",
-                       "unknown emissive material clause 'fuzz' (expected strength or group)");
+                       "unknown emissive material clause 'fuzz' (expected strength, one_sided or group)");
     assert_parse_error("sky rainbow 1 1 1", "s.txt:1:5: ",
                        "expected a sky type (gradient, constant, box or environment), found 'rainbow'");
     assert_parse_error("sky constant 1 1 1 rotate 3", "s.txt:1:20: ", "unknown sky clause 'rotate' (expected intensity or group)");
     assert_parse_error("material m plastic 1 1 1", "s.txt:1:12: ",
-                       "expected a material type (lambertian, metal, dielectric or emissive), found 'plastic'");
+                       "expected a material type (lambertian, metal, dielectric, emissive or pbr), found 'plastic'");
 }
 
 static void test_repeated_clause(void **state)
@@ -1241,7 +1241,89 @@ static void test_material_textures_and_normal_maps(void **state)
     assert_parse_error("material m dielectric 1.5 normal_map \"a.png\" normal_map \"b.png\"", "s.txt:1:46: ",
                        "clause 'normal_map' given twice");
     assert_parse_error("material m emissive 1 1 1 normal_map \"a.png\"", "s.txt:1:27: ",
-                       "unknown emissive material clause 'normal_map' (expected strength or group)");
+                       "unknown emissive material clause 'normal_map' (expected strength, one_sided or group)");
+}
+
+/* The pbr material: every clause, the defaults (ior 1.5, opaque, no emission), emission
+ * as colour x strength, maps as data images, and its errors. */
+static void test_pbr_material(void **state)
+{
+    (void)state;
+    scene s;
+    parse_ok("texture base image \"maps/base.png\"\n"
+             "material plain pbr 0.8 0.6 0.4 metallic 0 roughness 0.5\n"
+             "material all pbr @base roughness 0.25 metallic 1 ior 1.33 transmission 0.75 emission 1 0.5 0.25 "
+             "strength 4 one_sided alpha 0.5 alpha_cutoff 0.25 vertex_colors normal_map \"maps/n.png\" "
+             "metallic_roughness_map \"maps/mr.png\"\n"
+             "material glow pbr 1 1 1 metallic 0 roughness 1 emission @base\n"
+             "material cut pbr 1 1 1 metallic 0 roughness 1 alpha_cutoff 0.3\n"
+             "material lamp emissive 1 1 1 one_sided\n", NULL, &s);
+    assert_int_equal(s.material_count, 5);
+    const scene_material *plain = &s.materials[0], *all = &s.materials[1];
+    assert_int_equal(plain->type, MATERIAL_PBR);
+    assert_vector_equal(plain->albedo, 0.8, 0.6, 0.4);
+    assert_double_equal(plain->metallic, 0, 0);
+    assert_double_equal(plain->roughness, 0.5, 0);
+    assert_double_equal(plain->index_of_refraction, 1.5, 0);
+    assert_double_equal(plain->transmission, 0, 0);
+    assert_vector_equal(plain->emission, 0, 0, 0);
+    assert_int_equal(plain->alpha_mode, SCENE_ALPHA_OPAQUE);
+    assert_double_equal(plain->alpha, 1, 0);
+    assert_false(plain->one_sided || plain->vertex_colors);
+    assert_int_equal(plain->albedo_texture, -1);
+    assert_int_equal(plain->metallic_roughness_texture, -1);
+    assert_int_equal(plain->normal_map, -1);
+
+    assert_int_equal(all->albedo_texture, 0);
+    assert_vector_equal(all->albedo, 1, 1, 1);
+    assert_double_equal(all->metallic, 1, 0);
+    assert_double_equal(all->roughness, 0.25, 0);
+    assert_double_equal(all->index_of_refraction, 1.33, 1e-6);
+    assert_double_equal(all->transmission, 0.75, 0);
+    assert_vector_equal(all->emission, 4, 2, 1);
+    assert_true(all->one_sided && all->vertex_colors);
+    assert_int_equal(all->alpha_mode, SCENE_ALPHA_MASK);
+    assert_double_equal(all->alpha, 0.5, 0);
+    assert_double_equal(all->alpha_cutoff, 0.25, 0);
+    assert_int_equal(s.image_count, 3);
+    assert_int_equal(all->normal_map, 1);
+    assert_int_equal(all->metallic_roughness_texture, 2);
+    assert_false(s.images[0].data);                 /* the base colour: sRGB-decoded */
+    assert_true(s.images[1].data && s.images[2].data);
+    assert_string_equal(s.images[2].path, "maps/mr.png");
+
+    assert_int_equal(s.materials[2].emission_texture, 0);    /* emission @texture, strength 1 */
+    assert_vector_equal(s.materials[2].emission, 1, 1, 1);
+    assert_int_equal(s.materials[3].alpha_mode, SCENE_ALPHA_MASK);   /* the cutoff alone masks */
+    assert_double_equal(s.materials[3].alpha_cutoff, 0.3, 1e-7);
+    assert_double_equal(s.materials[3].alpha, 1, 0);
+    assert_int_equal(s.materials[4].type, MATERIAL_EMISSIVE);
+    assert_true(s.materials[4].one_sided);
+    scene_free(&s);
+
+    assert_parse_error("material m pbr 1 1 1 metallic 0", "s.txt:1:12: ",
+                       "the pbr material 'm' needs metallic M and roughness R, each from 0 to 1");
+    assert_parse_error("material m pbr 1 1 1 roughness 0", "s.txt:1:12: ", "needs metallic M and roughness R");
+    assert_parse_error("material m pbr 1 1 1 metallic 1.5 roughness 0", "s.txt:1:31: ",
+                       "the metallic of material 'm' must be between 0 and 1, found 1.5");
+    assert_parse_error("material m pbr 1 1 1 metallic 0 roughness -0.1", "s.txt:1:43: ",
+                       "the roughness of material 'm' must be between 0 and 1, found -0.1");
+    assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 ior 0", "s.txt:1:49: ", "the ior of material 'm' must be > 0, found 0");
+    assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 strength -1", "s.txt:1:54: ",
+                       "the strength of material 'm' must be >= 0, found -1");
+    assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 fuzz 1", "s.txt:1:45: ",
+                       "unknown pbr material clause 'fuzz' (expected metallic, roughness, ior, transmission, "
+                       "emission, strength, one_sided, alpha, alpha_cutoff, vertex_colors, normal_map, "
+                       "metallic_roughness_map or group)");
+    assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 metallic 1", "s.txt:1:45: ",
+                       "pbr material clause 'metallic' given twice");
+    assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 emission @nothing", "s.txt:1:54: ",
+                       "texture 'nothing' is not defined");
+    assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 normal_map", "s.txt:1:55: ",
+                       "expected a quoted path for the normal_map of the pbr material");
+    assert_parse_error("material m pbr 1 1 metallic 0 roughness 0", "s.txt:1:20: ",
+                       "the blue component of material 'm'");
+    assert_parse_error("material m metal 1 1 1 one_sided", "s.txt:1:24: ", "unknown metal material clause 'one_sided'");
 }
 
 static void test_sky_images_intensity_and_rotation(void **state)
@@ -2560,7 +2642,7 @@ static void test_material_phong_and_specular(void **state)
     assert_parse_error("material g dielectric 1.5 phong 8", "s.txt:1:27: ",
                        "unknown dielectric material clause 'phong' (expected normal_map)");
     assert_parse_error("material l emissive 1 1 1 specular 1 1 1", "s.txt:1:27: ",
-                       "unknown emissive material clause 'specular' (expected strength or group)");
+                       "unknown emissive material clause 'specular' (expected strength, one_sided or group)");
 }
 
 /* The example in docs/scene-format.md's light section, exactly. */
@@ -2730,6 +2812,7 @@ int main(void)
         cmocka_unit_test(test_textures),
         cmocka_unit_test(test_texture_errors),
         cmocka_unit_test(test_material_textures_and_normal_maps),
+        cmocka_unit_test(test_pbr_material),
         cmocka_unit_test(test_sky_images_intensity_and_rotation),
         cmocka_unit_test(test_camera_shutter),
         cmocka_unit_test(test_top_level_shapes_form_one_world_object),
