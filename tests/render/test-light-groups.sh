@@ -22,9 +22,9 @@ sums() {
     fi
 }
 
-grep -v '^#' "$here/golden-scenes.txt" | {
-    while read -r name scene extra; do
-        [ -n "$name" ] || continue
+# The golden suite's cases: `case NAME SCENE GOLDEN [OPTIONS...]` (a suite file of check).
+grep '^case ' "$here/golden-scenes.txt" | {
+    while read -r _ name scene _ extra; do
         # shellcheck disable=SC2086 # $extra is a list of options; the later --size wins
         if "$program" render "$scene" -o "$scratch/$name.exr" --quiet $extra --size 32x18 --spp 4 --light-groups \
             2>"$scratch/stderr"; then
