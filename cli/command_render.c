@@ -32,6 +32,7 @@ typedef struct presentation {
     char label[64];              /* "frame N " with frames, else "" */
     double last_draw;
     double first_pass;           /* seconds from the command's start to its first pass's end */
+    int compiles;                /* images whose tracer program was compiled (not cached) */
 } presentation;
 
 /* render_job_callbacks.render_started: a new bar for the image. */
@@ -100,19 +101,21 @@ static void show_checkpoint(void *user, const render_job_image *image, uint64_t 
 static void show_summary(void *user, const render_job_image *image, const render_result *result)
 {
     presentation *shown = user;
+    shown->compiles += result->compiled_program;
     if (shown->arguments->verbose) {
         uint64_t geometry_bytes = result->packed_bytes - result->image_bytes;
         fprintf(stderr,
                 "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights; BVH depth %d, "
                 "built in %.3f s; packed %llu bytes (%.1f per triangle without images)%s; first pass "
                 "done %.3f s after start (context, parse, BVH, upload, compile); after it %.3f s for "
-                "%llu samples (%.3g us/sample)\n",
+                "%llu samples (%.3g us/sample); tracer program %s\n",
                 result->primitive_count, result->triangle_count, result->instance_count, result->light_count,
                 result->bvh_depth, result->bvh_build_seconds, (unsigned long long)result->packed_bytes,
                 result->triangle_count ? (double)geometry_bytes / result->triangle_count : 0.0,
                 result->reused_scene ? ", already on the device" : "", shown->first_pass, result->steady_seconds,
                 (unsigned long long)result->steady_samples,
-                result->steady_samples ? result->steady_seconds / (double)result->steady_samples * 1e6 : 0.0);
+                result->steady_samples ? result->steady_seconds / (double)result->steady_samples * 1e6 : 0.0,
+                result->compiled_program ? "compiled" : "from the context's cache");
     }
     if (!shown->arguments->quiet)
         fprintf(stderr,
@@ -179,9 +182,14 @@ static int run_job(gpu_context *context, const render_arguments *arguments, doub
     else if (status != RT_OK && summary.failure != RENDER_JOB_FAILURE_STOPPED)
         fprintf(stderr, "rtspheres render: %s\n", error.message);
     int rendered = summary.images_started;
-    if (arguments->job.frame_count > 0 && !arguments->quiet && rendered > 0)
-        fprintf(stderr, "rtspheres: %d frame%s in %.2f s (%.3g frames/s)\n", rendered, rendered == 1 ? "" : "s",
-                summary.seconds, rendered / summary.seconds);
+    bool list = arguments->job.frame_count > 0 || arguments->job.sweep != NULL;
+    const char *unit = arguments->job.sweep != NULL ? "sweep row" : "frame";
+    if (list && !arguments->quiet && rendered > 0)
+        fprintf(stderr, "rtspheres: %d %s%s in %.2f s (%.3g %ss/s)\n", rendered, unit, rendered == 1 ? "" : "s",
+                summary.seconds, rendered / summary.seconds, unit);
+    if (list && arguments->verbose)
+        fprintf(stderr, "rtspheres: the tracer program was compiled %d time%s for %d image%s\n", shown.compiles,
+                shown.compiles == 1 ? "" : "s", rendered, rendered == 1 ? "" : "s");
     return exit_code_for_status(status);
 }
 

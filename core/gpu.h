@@ -236,6 +236,11 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
  * compiled tracer program is always kept by the context between tracers. */
 bool gpu_tracer_reused_scene(const gpu_tracer *tracer);
 
+/* True when gpu_tracer_create() compiled the tracer program for this tracer; false when
+ * the context's program cache already held its variant (frames and sweep rows after the
+ * first, whose variant does not change). */
+bool gpu_tracer_compiled_program(const gpu_tracer *tracer);
+
 /* Frees the tracer's GL objects (not the context's program and packed scene). NULL is
  * ignored. */
 void gpu_tracer_destroy(gpu_tracer *tracer);

@@ -25,6 +25,7 @@ struct gpu_tracer {
     int current;                 /* which state set holds the latest pass */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
     bool reused_scene;           /* the packed scene was already on the device */
+    bool compiled_program;       /* its program was compiled for it (not in the cache) */
 };
 
 /* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
@@ -245,6 +246,7 @@ static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *
     GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
+    tracer->compiled_program = true;
     int slot = context->tracer_program_count;
     if (slot == GPU_PROGRAM_CACHE_SIZE) {
         slot = context->next_eviction;
@@ -670,6 +672,11 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
 bool gpu_tracer_reused_scene(const gpu_tracer *tracer)
 {
     return tracer->reused_scene;
+}
+
+bool gpu_tracer_compiled_program(const gpu_tracer *tracer)
+{
+    return tracer->compiled_program;
 }
 
 void gpu_tracer_destroy(gpu_tracer *tracer)

@@ -552,6 +552,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (status != RT_OK)
         return status;
     result->reused_scene = gpu_tracer_reused_scene(tracer);
+    result->compiled_program = gpu_tracer_compiled_program(tracer);
     int width = region[2] - region[0], height = region[3] - region[1];
 
     render_progress progress = {

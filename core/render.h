@@ -117,6 +117,8 @@ typedef struct render_result {
     uint32_t triangle_count;     /* triangles stored (a mesh once however often placed) */
     uint32_t primitive_count, instance_count, light_count;
     bool reused_scene;           /* the device already held this packed scene (frames) */
+    bool compiled_program;       /* the tracer program was compiled for this render (not
+                                  * found in the context's cache) */
     uint64_t scene_hash;         /* FNV-1a of what decides the image apart from the samples:
                                   * packed scene, camera, sky, full size, max depth. Parts of
                                   * one render share it; `merge` refuses mixed hashes. */

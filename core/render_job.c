@@ -21,6 +21,7 @@ typedef struct job_run {
     render_job_plan plan;
     render_job_callbacks callbacks;      /* the caller's, or all NULL */
     render_job_failure failure;          /* where the run stopped short */
+    int sweep_row;                       /* the sweep row being rendered, -1: none */
 } job_run;
 
 /* One image being rendered: its scene (render settings after the job's overrides and
@@ -36,7 +37,8 @@ typedef struct job_image {
 static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
 {
     const render_job *job = run->job;
-    scene_define *defines = malloc(((size_t)job->define_count + 2) * sizeof *defines);
+    int columns = job->sweep != NULL && run->sweep_row >= 0 ? job->sweep->column_count : 0;
+    scene_define *defines = malloc(((size_t)job->define_count + 2 + (size_t)columns) * sizeof *defines);
     if (defines == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory for the scene's variables");
     run->failure = RENDER_JOB_FAILURE_SCENE;
@@ -44,12 +46,29 @@ static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
     scene_parse_options parse_options = scene_parse_options_defaults();
     parse_options.defines = defines;
     parse_options.define_count = render_job_scene_defines(job, frame, defines, &values);
+    for (int c = 0; c < columns; c++)
+        defines[parse_options.define_count++] = (scene_define){
+            .name = job->sweep->names[c],
+            .value = job->sweep->values[(size_t)run->sweep_row * columns + c],
+        };
     /* A glTF file is a scene by itself (scene_gltf.h); render_job_check() refused defines
      * for it, and its frames' $frame and $time are optional. */
     rt_status status = scene_gltf_is_model_path(job->scene_path)
                            ? scene_gltf_load_file(job->scene_path, job->camera, s, error)
                            : scene_load_file(job->scene_path, &parse_options, s, error);
     free(defines);
+    /* A column the scene does not use is the table's mistake: say where. */
+    for (int c = 0; c < columns && status == RT_ERROR_INPUT; c++) {
+        char expected[2 * SWEEP_NAME_MAX + 64];
+        snprintf(expected, sizeof expected, "-D %s: the scene never sets or uses $%s", job->sweep->names[c],
+                 job->sweep->names[c]);
+        if (strstr(error->message, expected) != NULL) {
+            status = rt_error_set(error, RT_ERROR_INPUT, "%s:%d: column '%s': the scene never sets or uses $%s",
+                                  job->sweep->path, job->sweep->header_line, job->sweep->names[c],
+                                  job->sweep->names[c]);
+            run->failure = RENDER_JOB_FAILURE_IMAGE;
+        }
+    }
     if (status == RT_OK) {
         status = scene_load_assets(s, error);
         if (status != RT_OK)
@@ -321,7 +340,7 @@ static rt_status run_image(job_run *run, int frame, const char *output, rt_error
     run->failure = RENDER_JOB_FAILURE_IMAGE;
     scene *s = &image->scene;
     /* Asset warnings (a missing MTL file, ...): once, with the first frame of the list. */
-    bool first_frame = frame < 0 || frame == job->frames[0];
+    bool first_frame = frame < 0 ? run->sweep_row <= 0 : frame == job->frames[0];
     for (int i = 0; i < s->warning_count && first_frame && run->callbacks.warning != NULL; i++)
         run->callbacks.warning(run->callbacks.user, s->warnings[i].message);
     render_job_apply_overrides(job, &s->render);
@@ -375,6 +394,31 @@ static rt_status run_frames(job_run *run, render_job_summary *summary, rt_error 
     return status;
 }
 
+/* Renders the job's sweep rows (those of its shard) in order. */
+static rt_status run_sweep(job_run *run, render_job_summary *summary, rt_error *error)
+{
+    const render_job *job = run->job;
+    rt_status status = RT_OK;
+    for (int row = 0; row < job->sweep->row_count && status == RT_OK && !stop_requested(job); row++) {
+        if (!render_job_includes_frame(job, &run->plan, row))
+            continue;
+        char name[RENDER_JOB_PATH_MAX];
+        run->failure = RENDER_JOB_FAILURE_IMAGE;
+        status = sweep_output_name(job->output, job->sweep, row, name, sizeof name, error);
+        if (status != RT_OK)
+            break;
+        summary->images_started++;
+        run->sweep_row = row;
+        status = run_image(run, -1, name, error);
+    }
+    run->sweep_row = -1;
+    if (status == RT_OK && stop_requested(job)) {
+        run->failure = RENDER_JOB_FAILURE_STOPPED;
+        status = rt_error_set(error, RT_ERROR_INTERRUPTED, "interrupted between sweep rows; every row begun is written");
+    }
+    return status;
+}
+
 rt_status render_job_run(gpu_context *context, const render_job *job, const render_job_callbacks *callbacks,
                          render_job_summary *summary, rt_error *error)
 {
@@ -382,7 +426,7 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
     if (summary == NULL)
         summary = &ignored;
     memset(summary, 0, sizeof *summary);
-    job_run run = {.context = context, .job = job};
+    job_run run = {.context = context, .job = job, .sweep_row = -1};
     if (callbacks != NULL)
         run.callbacks = *callbacks;
     rt_status status = render_job_check(job, &run.plan, error);
@@ -391,7 +435,9 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
         return status;
     }
     double start = clock_seconds();
-    if (job->frame_count == 0) {
+    if (job->sweep != NULL) {
+        status = run_sweep(&run, summary, error);
+    } else if (job->frame_count == 0) {
         summary->images_started = 1;
         status = run_image(&run, -1, run.plan.first_output, error);
     } else {

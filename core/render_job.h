@@ -47,6 +47,10 @@
  *                           stop_requested, resume and checkpoint fields itself.
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
+ *   sweep                   NULL: none; else a sweep table (sweep.h): one image per row,
+ *                           each row's values as defines after the job's, the output
+ *                           pattern formatted per row (sweep_output_name); rows shard
+ *                           as frames do; not with frames or resume
  *
  * ## Planning
  * render_job_check() checks the fields against each other and against the file system
@@ -85,6 +89,7 @@
 #include "scene.h"
 #include "scene_parse.h"
 #include "status.h"
+#include "sweep.h"
 
 #define RENDER_JOB_PATH_MAX 4096
 #define RENDER_JOB_DEFAULT_FRAMES_PER_SECOND 24.0
@@ -126,6 +131,7 @@ typedef struct render_job {
     double exposure;
     render_options tracer;
     const volatile sig_atomic_t *stop_requested;
+    const sweep_table *sweep;
 } render_job;
 
 /* What render_job_check() found: the first output name and the shard resolved. */
@@ -207,7 +213,8 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * without EXR; variance without EXR; variance with resume; resume with several frames;
  * shard_by without shard; a shard by frames without frames, or with no frame; light groups
  * (see the job); a shard by samples with a sample range; a shard by tiles with crop or
- * tile; light groups with a shard not by frames. */
+ * tile; light groups with a shard not by frames; a sweep with frames, resume or a define
+ * of one of its columns, two of its rows writing one file (the table's file:line). */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 
 /* True when the frame at position index of job->frames is this job's to render (always,

@@ -4,6 +4,7 @@
 #include "render_job.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "batch.h"
@@ -55,7 +56,9 @@ static rt_status plan_first_output(const render_job *job, render_job_plan *plan,
     }
     int first_frame = job->frame_count > 0 ? job->frames[0] : -1;
     rt_status status =
-        render_job_output_name(job, plan, first_frame, plan->first_output, sizeof plan->first_output, error);
+        job->sweep != NULL
+            ? sweep_output_name(job->output, job->sweep, 0, plan->first_output, sizeof plan->first_output, error)
+            : render_job_output_name(job, plan, first_frame, plan->first_output, sizeof plan->first_output, error);
     if (status != RT_OK)
         return status;
     if (job->frame_count > 1 && !output_pattern_has_frame(job->output))
@@ -105,6 +108,41 @@ static rt_status check_light_groups(const render_job *job, const char *output, r
     return RT_OK;
 }
 
+/* Checks a sweep against the job: no frames, no resume, no define of a column, and every
+ * row's output its own file that is not the scene (the table's file:line of the row). */
+static rt_status check_sweep(const render_job *job, rt_error *error)
+{
+    const sweep_table *table = job->sweep;
+    if (table == NULL)
+        return RT_OK;
+    if (job->frame_count > 0)
+        return rt_error_set(error, RT_ERROR_INPUT, "--sweep and --frames both make a list of images; give one");
+    if (job->resume_path != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT, "--resume continues one image, not a sweep's rows");
+    for (int c = 0; c < table->column_count; c++)
+        if (last_define(job, table->names[c]) != NULL)
+            return rt_error_set(error, RT_ERROR_INPUT, "%s:%d: column '%s' and -D %s both set $%s; give one",
+                                table->path, table->header_line, table->names[c], table->names[c], table->names[c]);
+    char(*names)[RENDER_JOB_PATH_MAX] = malloc((size_t)table->row_count * sizeof *names);
+    if (names == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory for the sweep's output names");
+    rt_status status = RT_OK;
+    for (int r = 0; r < table->row_count && status == RT_OK; r++) {
+        status = sweep_output_name(job->output, table, r, names[r], sizeof names[r], error);
+        if (status == RT_OK && path_same_file(names[r], job->scene_path))
+            status = rt_error_set(error, RT_ERROR_INPUT, "%s:%d: row %d's output '%s' is the scene file",
+                                  table->path, table->lines[r], r + 1, names[r]);
+        for (int k = 0; k < r && status == RT_OK; k++)
+            if (strcmp(names[k], names[r]) == 0)
+                status = rt_error_set(error, RT_ERROR_INPUT,
+                                      "%s:%d: row %d writes '%s', as row %d (line %d) does; put {NAME} or %%d "
+                                      "in the output pattern", table->path, table->lines[r], r + 1, names[r], k + 1,
+                                      table->lines[k]);
+    }
+    free(names);
+    return status;
+}
+
 /* Resolves the shard (its kind, and for tiles the band) into plan and checks it against
  * the other ways of choosing frames, samples and region. */
 static rt_status plan_shard(const render_job *job, render_job_plan *plan, rt_error *error)
@@ -115,16 +153,19 @@ static rt_status plan_shard(const render_job *job, render_job_plan *plan, rt_err
     if (job->shard_count == 0)
         return RT_OK;
     render_job_shard_kind by = job->shard_by;
+    /* A sweep's rows shard as frames do. */
+    int images = job->sweep != NULL ? job->sweep->row_count : job->frame_count;
+    const char *unit = job->sweep != NULL ? "sweep row" : "frame";
     if (by == RENDER_SHARD_AUTO)
-        by = job->frame_count > 1 ? RENDER_SHARD_FRAMES : RENDER_SHARD_SAMPLES;
+        by = images > 1 ? RENDER_SHARD_FRAMES : RENDER_SHARD_SAMPLES;
     plan->shard_by = by;
-    if (by == RENDER_SHARD_FRAMES && job->frame_count == 0)
+    if (by == RENDER_SHARD_FRAMES && images == 0)
         return rt_error_set(error, RT_ERROR_INPUT, "--shard-by frames needs --frames");
     /* As with an empty sample shard or tile: a part with nothing to render is an error,
      * not a silent success that writes nothing. */
-    if (by == RENDER_SHARD_FRAMES && job->shard_index >= job->frame_count)
-        return rt_error_set(error, RT_ERROR_INPUT, "shard %d/%d of %d frame%s is empty; use fewer shards",
-                            job->shard_index, job->shard_count, job->frame_count, job->frame_count == 1 ? "" : "s");
+    if (by == RENDER_SHARD_FRAMES && job->shard_index >= images)
+        return rt_error_set(error, RT_ERROR_INPUT, "shard %d/%d of %d %s%s is empty; use fewer shards",
+                            job->shard_index, job->shard_count, images, unit, images == 1 ? "" : "s");
     if (by == RENDER_SHARD_SAMPLES && job->sample_count > 0)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--shard by samples and --samples both choose the samples; give one");
@@ -175,6 +216,8 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--resume continues one image; render the frames one at a time");
     status = check_light_groups(job, plan->first_output, error);
+    if (status == RT_OK)
+        status = check_sweep(job, error);
     if (status != RT_OK)
         return status;
     status = plan_shard(job, plan, error);
