@@ -130,13 +130,13 @@ static rt_status check_sweep(const render_job *job, rt_error *error)
     for (int r = 0; r < table->row_count && status == RT_OK; r++) {
         status = sweep_output_name(job->output, table, r, names[r], sizeof names[r], error);
         if (status == RT_OK && path_same_file(names[r], job->scene_path))
-            status = rt_error_set(error, RT_ERROR_INPUT, "%s:%d: row %d's output '%s' is the scene file",
-                                  table->path, table->lines[r], r + 1, names[r]);
+            status = rt_error_set(error, RT_ERROR_INPUT, "%s:%d: this row's output '%s' is the scene file",
+                                  table->path, table->lines[r], names[r]);
         for (int k = 0; k < r && status == RT_OK; k++)
             if (strcmp(names[k], names[r]) == 0)
                 status = rt_error_set(error, RT_ERROR_INPUT,
-                                      "%s:%d: row %d writes '%s', as row %d (line %d) does; put {NAME} or %%d "
-                                      "in the output pattern", table->path, table->lines[r], r + 1, names[r], k + 1,
+                                      "%s:%d: this row writes '%s', as the row of line %d does; put {NAME} or "
+                                      "%%d in the output pattern", table->path, table->lines[r], names[r],
                                       table->lines[k]);
     }
     free(names);

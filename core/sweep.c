@@ -230,7 +230,7 @@ rt_status sweep_output_name(const char *pattern, const sweep_table *table, int r
             /* The value is text of the name, never a conversion: its '%' are doubled. */
             for (const char *v = table->values[(size_t)row * table->column_count + column]; *v != '\0'; v++) {
                 if (used + 2 >= sizeof expanded)
-                    return rt_error_set(error, RT_ERROR_INPUT, "the output name of row %d is too long", row + 1);
+                    return rt_error_set(error, RT_ERROR_INPUT, "the output name of row %d is too long", row);
                 if (*v == '%')
                     expanded[used++] = '%';
                 expanded[used++] = *v;
@@ -239,10 +239,10 @@ rt_status sweep_output_name(const char *pattern, const sweep_table *table, int r
             continue;
         }
         if (used + length >= sizeof expanded)
-            return rt_error_set(error, RT_ERROR_INPUT, "the output name of row %d is too long", row + 1);
+            return rt_error_set(error, RT_ERROR_INPUT, "the output name of row %d is too long", row);
         memcpy(expanded + used, insert, length);
         used += length;
     }
     expanded[used] = '\0';
-    return output_pattern_format(expanded, row + 1, name, size, error);
+    return output_pattern_format(expanded, row, name, size, error);
 }

@@ -7,7 +7,8 @@
  * other line is the header: variable names (letters, digits and '_', not starting with
  * a digit), each once, at most SWEEP_MAX_COLUMNS. Every following line is a row with
  * exactly one non-empty value per column (a number or an expression, as -D takes). At
- * most SWEEP_MAX_ROWS rows; rows are numbered from 1 in the order written.
+ * most SWEEP_MAX_ROWS rows; rows are numbered from 0 in the order written (as a shell
+ * loop counts: `light-%02d.png` names the first row's image light-00.png).
  *
  * Output patterns: `{NAME}` is replaced by the row's value of column NAME, then a `%d`
  * conversion (batch.h) by the row number: `light-{light_x}.png`, `row-%03d.exr`.
@@ -47,7 +48,7 @@ rt_status sweep_table_parse(const char *text, const char *path, char separator, 
 /* Frees the rows and zeroes *table. */
 void sweep_table_free(sweep_table *table);
 
-/* Formats pattern for row (0-based; its number is row + 1) into name (size bytes): {NAME}
+/* Formats pattern for row (0-based, its number) into name (size bytes): {NAME}
  * by the row's value, then %d by the row number. A {NAME} of no column, an unclosed {,
  * or a bad % conversion: RT_ERROR_INPUT. */
 rt_status sweep_output_name(const char *pattern, const sweep_table *table, int row, char *name, size_t size,

@@ -17,13 +17,13 @@ mkdir -p "$scratch/sweep"
 "$program" render "$scene" -o "$scratch/sweep/row-%d-x{light_x}.exr" $render_options --sweep "$scratch/lights.tsv" \
     --verbose >"$scratch/stdout" 2>"$scratch/verbose"
 files_are "a row per image, named by {NAME} and %d" "$scratch/sweep" \
-    "row-1-x3.exr row-2-x-1.5.exr row-3-x-1.5.exr"
+    "row-0-x3.exr row-1-x-1.5.exr row-2-x-1.5.exr"
 if grep -q "the tracer program was compiled 1 time for 3 images" "$scratch/verbose"; then
     pass "the tracer is compiled once for the sweep"
 else
     fail "the tracer is compiled once for the sweep" "$(grep 'compiled' "$scratch/verbose" | head -c 300)"
 fi
-row=1
+row=0
 for values in "3 0" "-1.5 2.6" "-1.5 (-2.6)"; do
     x=${values% *} z=${values#* }
     render "$scratch/single-$row.exr" -D "light_x=$x" -D "light_z=$z"
@@ -31,13 +31,13 @@ for values in "3 0" "-1.5 2.6" "-1.5 (-2.6)"; do
     row=$((row + 1))
 done
 
-# Shards split the rows as they split frames: 0/2 takes rows 1 and 3, 1/2 row 2.
+# Shards split the rows as they split frames: 0/2 takes rows 0 and 2, 1/2 row 1.
 mkdir -p "$scratch/shard0" "$scratch/shard1"
 render "$scratch/shard0/r%d.exr" --sweep "$scratch/lights.tsv" --shard 0/2
 render "$scratch/shard1/r%d.exr" --sweep "$scratch/lights.tsv" --shard 1/2
-files_are "shard 0/2 renders rows 1 and 3" "$scratch/shard0" "r1.exr r3.exr"
-files_are "shard 1/2 renders row 2" "$scratch/shard1" "r2.exr"
-same "a shard's row equals the whole sweep's" "$scratch/shard1/r2.exr" "$scratch/sweep/row-2-x-1.5.exr"
+files_are "shard 0/2 renders rows 0 and 2" "$scratch/shard0" "r0.exr r2.exr"
+files_are "shard 1/2 renders row 1" "$scratch/shard1" "r1.exr"
+same "a shard's row equals the whole sweep's" "$scratch/shard1/r1.exr" "$scratch/sweep/row-1-x-1.5.exr"
 
 # Bad tables: exit 2, the table's file:line, nothing written.
 mkdir -p "$scratch/out"
@@ -51,7 +51,7 @@ printf 'light_x,light_z\n1,2\n-1, \n' >"$scratch/empty.csv"
 expect_refusal "an empty value" "empty.csv:3: no value for column 'light_z'" "$scratch/out" \
     "$program" render "$scene" -o "$scratch/out/r%d.png" --sweep "$scratch/empty.csv"
 printf 'light_x\tlight_z\n1\t2\n1\t3\n' >"$scratch/same.tsv"
-expect_refusal "two rows writing one file" "same.tsv:3: row 2 writes '.*r1.png', as row 1 \\(line 2\\) does" \
+expect_refusal "two rows writing one file" "same.tsv:3: this row writes '.*r1.png', as the row of line 2 does" \
     "$scratch/out" "$program" render "$scene" -o "$scratch/out/r{light_x}.png" --sweep "$scratch/same.tsv"
 expect_refusal "a column also given by -D" "lights.tsv:1: column 'light_x' and -D light_x both set" "$scratch/out" \
     "$program" render "$scene" -o "$scratch/out/r%d.png" --sweep "$scratch/lights.tsv" -D light_x=1
