@@ -9,7 +9,8 @@
 #   light_x = 4*cos(2*pi*i/FRAMES)    light_z = 4*sin(2*pi*i/FRAMES)
 # (rtspheres evaluates the values as expressions, as -D does, and knows pi), written to
 # OUTDIR/light-00.png, light-01.png, ...; then OUTDIR/contact-sheet.png shows them all,
-# row by row. Run it from the top of the repository.
+# row by row, each with its light_x and light_z written under it. Run it from the top of
+# the repository.
 #
 # Environment:
 #   RTSPHERES        the program (default ./rtspheres)
@@ -44,5 +45,6 @@ while [ "$i" -lt "$frames" ]; do
 done
 "$program" render "$scene" -o "$outdir/light-%02d.png" --sweep "$table" --size "$size" --spp "$spp" --quiet
 
-"$program" montage "$@" -o "$outdir/contact-sheet.png" --quiet
+# Each frame labelled with its row's values (the built-in 5x7 font of core/bitmap_font.h).
+"$program" montage "$@" -o "$outdir/contact-sheet.png" --label-table "$table" --quiet
 echo "sweep-light.sh: $frames frames and $outdir/contact-sheet.png"
