@@ -35,6 +35,8 @@ static void print_help(FILE *stream)
             "      --frames LIST      render frames, e.g. 1-60 or 1-10,15,20-30:2; each frame\n"
             "                         sets $frame and $time (= frame / --fps)\n"
             "      --fps F            frames per second for $time (default 24)\n"
+            "      --display HOST:PORT  stream the image to the tev viewer as it converges (every\n"
+            "                         second, and when done); no viewer there is a warning\n"
             "      --sweep TABLE      one image per row of TABLE (.tsv or .csv: a header of\n"
             "                         variable names, then a row of values each), set as -D;\n"
             "                         the output may use {NAME} and %%d (the row number)\n"
@@ -86,7 +88,7 @@ static void print_help(FILE *stream)
 
 enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
-    OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_SWEEP, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
+    OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_SWEEP, OPTION_DISPLAY, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
     OPTION_LIGHT_GROUPS, OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
     OPTION_CAMERA,
@@ -339,6 +341,7 @@ static int take_option(int option, const char *value, render_arguments *argument
     switch (option) {
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
+    case OPTION_DISPLAY: arguments->display = value; break;
     case OPTION_CAMERA: job->camera = value; break;
     case OPTION_AOVS: job->aovs = true; break;
     case OPTION_LIGHT_GROUPS: job->light_groups = true; break;
@@ -398,6 +401,7 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
         {"roulette-depth", required_argument, NULL, OPTION_ROULETTE_DEPTH},
         {"frames", required_argument, NULL, OPTION_FRAMES},
         {"sweep", required_argument, NULL, OPTION_SWEEP},
+        {"display", required_argument, NULL, OPTION_DISPLAY},
         {"fps", required_argument, NULL, OPTION_FPS},
         {"samples", required_argument, NULL, OPTION_SAMPLES},
         {"crop", required_argument, NULL, OPTION_CROP},

@@ -434,7 +434,7 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
                             int height, uint32_t initial_budget, double start, render_progress *progress,
                             bool *interrupted, render_result *result, rt_error *error)
 {
-    double last_checkpoint = clock_seconds();
+    double last_checkpoint = clock_seconds(), last_preview = clock_seconds();
     double first_pass_end = 0;
     bool adaptive = options->pass_work_budget == 0;
     gpu_info device;
@@ -485,6 +485,17 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
             if (status != RT_OK)
                 return status;
             last_checkpoint = clock_seconds();
+        }
+        if (options->preview != NULL && options->preview_seconds > 0
+            && clock_seconds() - last_preview >= options->preview_seconds) {
+            rt_image partial;
+            uint64_t partial_samples;
+            status = read_image(tracer, width, height, &partial, NULL, NULL, &partial_samples, error);
+            if (status != RT_OK)
+                return status;
+            options->preview(options->preview_context, &partial);
+            image_free(&partial);
+            last_preview = clock_seconds();
         }
     }
 }

@@ -83,6 +83,11 @@ typedef struct render_options {
     rt_status (*checkpoint)(void *checkpoint_context, const rt_image *partial, uint64_t samples, uint64_t scene_hash,
                             rt_error *error);
     void *checkpoint_context;
+    /* Every preview_seconds (0: never), between passes, preview() receives the image so far
+     * (the same layout as the result: means and samples); for a live view (--display). */
+    double preview_seconds;
+    void (*preview)(void *preview_context, const rt_image *partial);
+    void *preview_context;
 } render_options;
 
 typedef struct render_result {
