@@ -472,30 +472,29 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
             *interrupted = true;
             return RT_OK;
         }
-        if (options->checkpoint != NULL && options->checkpoint_seconds > 0
-            && clock_seconds() - last_checkpoint >= options->checkpoint_seconds) {
+        /* Checkpoints and previews (--display) share one read-back when both are due. */
+        bool checkpoint_due = options->checkpoint != NULL && options->checkpoint_seconds > 0
+                              && clock_seconds() - last_checkpoint >= options->checkpoint_seconds;
+        bool preview_due = options->preview != NULL && options->preview_seconds > 0
+                           && clock_seconds() - last_preview >= options->preview_seconds;
+        if (checkpoint_due || preview_due) {
             rt_image partial;
             uint64_t partial_samples;
             status = read_image(tracer, width, height, &partial, NULL, NULL, &partial_samples, error);
             if (status != RT_OK)
                 return status;
-            status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, result->scene_hash,
-                                         error);
+            if (checkpoint_due) {
+                status = options->checkpoint(options->checkpoint_context, &partial, partial_samples,
+                                             result->scene_hash, error);
+                last_checkpoint = clock_seconds();
+            }
+            if (preview_due && status == RT_OK) {
+                options->preview(options->preview_context, &partial);
+                last_preview = clock_seconds();
+            }
             image_free(&partial);
             if (status != RT_OK)
                 return status;
-            last_checkpoint = clock_seconds();
-        }
-        if (options->preview != NULL && options->preview_seconds > 0
-            && clock_seconds() - last_preview >= options->preview_seconds) {
-            rt_image partial;
-            uint64_t partial_samples;
-            status = read_image(tracer, width, height, &partial, NULL, NULL, &partial_samples, error);
-            if (status != RT_OK)
-                return status;
-            options->preview(options->preview_context, &partial);
-            image_free(&partial);
-            last_preview = clock_seconds();
         }
     }
 }
