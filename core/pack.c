@@ -9,6 +9,10 @@
 #include "hash.h"
 #include "pack_internal.h"
 
+/* The shader's traversal stack keeps a leaf's primitive count in the 32 - PACKED_FIRST_BITS
+ * top bits of a word, beside the counts 6 and 7 that mark instances (glsl/traverse.glsl). */
+_Static_assert(BVH_MAX_LEAF_SIZE < 6 && 32 - PACKED_FIRST_BITS >= 3, "a leaf's count must fit below the instance marks");
+
 pack_options pack_options_defaults(void)
 {
     return (pack_options){0};
@@ -49,12 +53,18 @@ static void place_trees(packer *p)
 }
 
 /* Plans where every section of packed_layout.h starts, in its order, and how large the
- * whole is. A scene that 32-bit indices cannot reach is RT_ERROR_INPUT. */
+ * whole is. A scene that 32-bit indices (or the tracer's PACKED_FIRST_BITS) cannot reach
+ * is RT_ERROR_INPUT. */
 static rt_status plan_layout(packer *p, rt_error *error)
 {
     const scene *s = p->scene;
     pack_layout *layout = &p->layout;
     place_trees(p);
+    if (layout->node_count >= (1ull << PACKED_FIRST_BITS) || layout->primitive_count >= (1ull << PACKED_FIRST_BITS))
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "PACK: %llu BVH nodes and %llu primitives, more than the %llu the tracer can name",
+                            (unsigned long long)layout->node_count, (unsigned long long)layout->primitive_count,
+                            (unsigned long long)(1ull << PACKED_FIRST_BITS) - 1);
     uint32_t vertex_count = 0;
     rt_status status = pack_order_vertices(p, &vertex_count, error);
     if (status != RT_OK)

@@ -69,13 +69,20 @@ static void write_primitive(packer *p, const pending_primitive *item, uint64_t g
     p->out->summary.primitive_types |= 1u << item->type;
 }
 
-/* Writes the nodes of one BVH, its child and leaf indices moved to where it landed. */
+/* The packed first of a node of one BVH: its child or leaf index moved to where the BVH
+ * landed. */
+static uint32_t packed_first(const built_tree *built, const bvh_node *node)
+{
+    return node->count ? node->first + built->primitive_base : node->first + built->node_base;
+}
+
+/* Writes the nodes of one BVH. */
 static void write_nodes(packer *p, const built_tree *built)
 {
     for (uint32_t n = 0; n < built->tree.node_count; n++) {
         const bvh_node *node = &built->tree.nodes[n];
         uint64_t base = p->layout.node_offset + ((uint64_t)built->node_base + n) * PACKED_NODE_STRIDE;
-        uint32_t first = node->count ? node->first + built->primitive_base : node->first + built->node_base;
+        uint32_t first = packed_first(built, node);
         put_texel(p->texels, base + 0, float_bits(node->box.min[0]), float_bits(node->box.min[1]),
                   float_bits(node->box.min[2]), first);
         put_texel(p->texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
@@ -161,7 +168,8 @@ void pack_write_vertices(packer *p)
 
 rt_status pack_write_instances(packer *p, rt_error *error)
 {
-    /* Each: the object's root, material, world-to-object matrix, volume. */
+    /* Each: the (first, count) of the object's root node, material, world-to-object
+     * matrix, volume. */
     const scene *s = p->scene;
     for (int i = 0; i < s->instance_count; i++) {
         uint32_t packed_index = p->instance_of_scene[i];
@@ -172,9 +180,11 @@ rt_status pack_write_instances(packer *p, rt_error *error)
         if (!pack_invert_affine(instance->object_to_world, world_to_object))
             return rt_error_set(error, RT_ERROR_INPUT, "PACK: instance %d has a transform that cannot be inverted", i);
         uint64_t base = p->layout.instance_offset + (uint64_t)packed_index * PACKED_INSTANCE_STRIDE;
-        put_texel(p->texels, base, p->objects[instance->object].node_base,
+        const built_tree *object = &p->objects[instance->object];
+        const bvh_node *root = &object->tree.nodes[0];
+        put_texel(p->texels, base, packed_first(object, root),
                   instance->material >= 0 ? (uint32_t)instance->material : PACKED_NONE,
-                  instance->volume ? INSTANCE_VOLUME : 0, 0);
+                  instance->volume ? INSTANCE_VOLUME : 0, root->count);
         for (int r = 0; r < 3; r++)
             put_texel(p->texels, base + 1 + r, float_bits(world_to_object[r][0]), float_bits(world_to_object[r][1]),
                       float_bits(world_to_object[r][2]), float_bits(world_to_object[r][3]));

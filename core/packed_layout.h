@@ -41,7 +41,7 @@
 #define RT_PACKED_LAYOUT_H
 
 /* Bumped whenever a record below changes meaning. */
-#define PACKED_LAYOUT_VERSION 4
+#define PACKED_LAYOUT_VERSION 5
 #define PACKED_NONE 4294967295u
 
 /* ---- header (7 texels), field i is component i % 4 of texel i / 4 */
@@ -151,11 +151,16 @@
  *   texel 0 = (box_min.x, box_min.y, box_min.z, first)
  *   texel 1 = (box_max.x, box_max.y, box_max.z, count)
  * count == 0: interior node, children are nodes first and first + 1.
- * count  > 0: leaf, primitives first .. first + count - 1 of the primitive section. */
+ * count  > 0: leaf, primitives first .. first + count - 1 of the primitive section.
+ * first is below 2^PACKED_FIRST_BITS (the packer refuses larger scenes): the shader's
+ * traversal stack keeps first and count in one word (glsl/traverse.glsl). */
 #define PACKED_NODE_STRIDE 2
+#define PACKED_FIRST_BITS 29
 
 /* ---- instances: 5 texels
- *   texel 0 = (root node of the object's BVH, material override or PACKED_NONE, flags, 0)
+ *   texel 0 = (first, material override or PACKED_NONE, flags, count): first and count
+ *             are those of the root node of the object's BVH (see nodes), so that entering
+ *             the object needs no fetch of its root
  *   texels 1-3 = rows of the 3x4 world-to-object matrix (object = M * (world, 1))
  *   texel 4 = (volume density, volume albedo.rgb) */
 #define PACKED_INSTANCE_STRIDE 5

@@ -1,7 +1,6 @@
-/* packed_traverse.c: see packed_traverse.h. The traversal follows the tracer's
- * (glsl/intersect.glsl, glsl/traverse.glsl: intersection, BVH walk, instances) operation
- * for operation, so that CPU and shader
- * agree on what a ray hits. */
+/* packed_traverse.c: see packed_traverse.h. The traversal follows the shader's
+ * (glsl/intersect.glsl, glsl/traverse.glsl: intersection, BVH walk, instances, shadow
+ * rays) operation for operation, so that CPU and shader agree on what a ray hits. */
 #include "packed_traverse.h"
 
 #include <math.h>
@@ -169,23 +168,65 @@ static void ray_set(moving_ray *ray, vec3 origin, vec3 direction)
     glm_vec3_div(GLM_VEC3_ONE, direction, ray->inverse_direction);
 }
 
-/* glsl/intersect.glsl intersect_box, the slab test: where the ray enters node's box within
+/* glsl/intersect.glsl intersect_box, the slab test: where the ray enters the box (texels lo, hi) within
  * (0, t_max), or INFINITY when it misses. */
-static float intersect_box(const packed_scene *packed, uint32_t node, const moving_ray *ray, float t_max)
+static float intersect_box(const packed_scene *packed, uint32_t lo, uint32_t hi, const moving_ray *ray, float t_max)
 {
-    uint32_t base = packed->node_offset + node * PACKED_NODE_STRIDE;
     float enter = 0, leave = t_max;
     for (int axis = 0; axis < 3; axis++) {
-        float t0 = (packed_float(packed, base, axis) - ray->origin[axis]) * ray->inverse_direction[axis];
-        float t1 = (packed_float(packed, base + 1, axis) - ray->origin[axis]) * ray->inverse_direction[axis];
+        float t0 = (packed_float(packed, lo, axis) - ray->origin[axis]) * ray->inverse_direction[axis];
+        float t1 = (packed_float(packed, hi, axis) - ray->origin[axis]) * ray->inverse_direction[axis];
         enter = fmaxf(enter, fminf(t0, t1));
         leave = fminf(leave, fmaxf(t0, t1));
     }
     return enter <= leave ? enter : INFINITY;
 }
 
-bool packed_intersect_nearest(const packed_scene *packed, const float origin[3], const float direction[3], float time,
-                              float t_max, packed_hit *hit)
+/* The shader's stack entries (glsl/traverse.glsl): a node record's (first, count) pair, or
+ * an instance marker. */
+enum { STACK = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE, ENTER_INSTANCE = 6, LEAVE_INSTANCE = 7 };
+
+typedef struct walk_item {
+    uint32_t first, count;
+    float entry;
+} walk_item;
+
+/* Tests one primitive of the level being walked; on a hit nearer than hit->t, updates
+ * *hit and returns true. */
+static bool test_primitive(const packed_scene *packed, const packed_primitive *primitive, uint32_t slot,
+                           const moving_ray *ray, float time, uint32_t instance, packed_hit *hit)
+{
+    float t = INFINITY;
+    if (primitive->type == PRIMITIVE_SPHERE)
+        t = intersect_sphere((float *)primitive->data[0], primitive->data[0][3], (float *)ray->origin,
+                             (float *)ray->direction, hit->t);
+    else if (primitive->type == PRIMITIVE_MOVING_SPHERE) {
+        vec3 motion, center;
+        glm_vec3_sub((float *)primitive->data[1], (float *)primitive->data[0], motion);
+        glm_vec3_scale(motion, time, motion);
+        glm_vec3_add((float *)primitive->data[0], motion, center);
+        t = intersect_sphere(center, primitive->data[0][3], (float *)ray->origin, (float *)ray->direction, hit->t);
+    } else
+        t = intersect_flat((packed_primitive *)primitive, (float *)ray->origin, (float *)ray->direction, hit->t);
+    (void)packed;
+    if (!(t < hit->t))
+        return false;
+    hit->t = t;
+    hit->primitive = slot;
+    hit->instance = instance;
+    return true;
+}
+
+/* The walk of glsl/traverse.glsl trace_rays for one ray, step for step: the current item
+ * is a node record's (first, count) pair (the root's box is not tested, its children's
+ * are), nearer child first, instances entered through markers on the stack, the object's
+ * root pair read from the instance record. shadow: the shader's shadow ray, which stops
+ * at the first hit that is not light_slot (a world primitive) nor, when volumes, on the
+ * boundary of a volume instance; returns whether it stopped so (blocked). Otherwise
+ * returns false; *hit holds the nearest hit (or, for a shadow ray, the nearest of those
+ * that do not block), t = t_max when none. */
+static bool walk(const packed_scene *packed, const float origin[3], const float direction[3], float time, float t_max,
+                 bool shadow, uint32_t light_slot, bool volumes, packed_hit *hit)
 {
     hit->t = t_max;
     hit->primitive = PACKED_NONE;
@@ -197,97 +238,87 @@ bool packed_intersect_nearest(const packed_scene *packed, const float origin[3],
     glm_vec3_copy((float *)direction, world_direction);
     moving_ray ray;
     ray_set(&ray, world_origin, world_direction);
-    if (intersect_box(packed, 0, &ray, INFINITY) == INFINITY)
-        return false;
-    enum { STACK = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE };
-    uint32_t stack_node[STACK];
-    float stack_entry[STACK];
+    walk_item stack[STACK];
     int stack_size = 0;
-    uint32_t node = 0, current_instance = PACKED_NONE;
-    float node_entry = 0;
+    walk_item item = {packed_uint(packed, packed->node_offset, 3), packed_uint(packed, packed->node_offset + 1, 3),
+                      -INFINITY};
+    uint32_t instance = PACKED_NONE;
+    bool volume_instance = false;
     for (;;) {
-        if (node == PACKED_NONE) {
-            /* Leaving an instance: back to the world ray. */
+        if (item.count == LEAVE_INSTANCE) {
             ray_set(&ray, world_origin, world_direction);
-            current_instance = PACKED_NONE;
-        } else if (node_entry < hit->t) {
-            uint32_t base = packed->node_offset + node * PACKED_NODE_STRIDE;
-            uint32_t first = packed_uint(packed, base, 3), count = packed_uint(packed, base + 1, 3);
-            if (count > 0) {
-                for (uint32_t slot = first; slot < first + count; slot++) {
+            instance = PACKED_NONE;
+            volume_instance = false;
+        } else if (item.count == ENTER_INSTANCE) {
+            /* Into the object's coordinates: the direction is not renormalised, so t stays
+             * the world ray's parameter. */
+            instance = item.first;
+            uint32_t base = packed->instance_offset + instance * PACKED_INSTANCE_STRIDE;
+            volume_instance = (packed_uint(packed, base, 2) & INSTANCE_VOLUME) != 0;
+            vec3 object_origin, object_direction;
+            for (int r = 0; r < 3; r++) {
+                vec4 row;
+                for (int c = 0; c < 4; c++)
+                    row[c] = packed_float(packed, base + 1 + r, c);
+                object_origin[r] = glm_vec3_dot(row, world_origin) + row[3];
+                object_direction[r] = glm_vec3_dot(row, world_direction);
+            }
+            ray_set(&ray, object_origin, object_direction);
+            item = (walk_item){packed_uint(packed, base, 0), packed_uint(packed, base, 3), -INFINITY};
+            continue;
+        } else if (item.entry < hit->t) {
+            if (item.count > 0) {
+                for (uint32_t slot = item.first; slot < item.first + item.count; slot++) {
                     packed_primitive primitive = packed_primitive_at(packed, slot);
-                    float t = INFINITY;
                     if (primitive.type == PRIMITIVE_INSTANCE) {
                         /* Visited after this leaf: a marker that restores the world ray,
-                         * under an entry that moves the ray into the instance. */
+                         * under one that moves the ray into the instance. */
                         if (stack_size + 2 > STACK)
                             continue;
-                        stack_node[stack_size] = PACKED_NONE;
-                        stack_entry[stack_size] = -INFINITY;
-                        stack_size++;
-                        stack_node[stack_size] = primitive.instance | 0x80000000u;
-                        stack_entry[stack_size] = -INFINITY;
-                        stack_size++;
+                        stack[stack_size++] = (walk_item){0, LEAVE_INSTANCE, -INFINITY};
+                        stack[stack_size++] = (walk_item){primitive.instance, ENTER_INSTANCE, -INFINITY};
                         continue;
                     }
-                    if (primitive.type == PRIMITIVE_SPHERE)
-                        t = intersect_sphere(primitive.data[0], primitive.data[0][3], ray.origin, ray.direction, hit->t);
-                    else if (primitive.type == PRIMITIVE_MOVING_SPHERE) {
-                        vec3 motion, center;
-                        glm_vec3_sub(primitive.data[1], primitive.data[0], motion);
-                        glm_vec3_scale(motion, time, motion);
-                        glm_vec3_add(primitive.data[0], motion, center);
-                        t = intersect_sphere(center, primitive.data[0][3], ray.origin, ray.direction, hit->t);
-                    } else
-                        t = intersect_flat(&primitive, ray.origin, ray.direction, hit->t);
-                    if (t < hit->t) {
-                        hit->t = t;
-                        hit->primitive = slot;
-                        hit->instance = current_instance;
-                    }
+                    if (!test_primitive(packed, &primitive, slot, &ray, time, instance, hit) || !shadow)
+                        continue;
+                    bool passable = instance == PACKED_NONE ? slot == light_slot : volumes && volume_instance;
+                    if (!passable)
+                        return true;
                 }
             } else {
-                float left = intersect_box(packed, first, &ray, hit->t);
-                float right = intersect_box(packed, first + 1, &ray, hit->t);
-                uint32_t near_node = right < left ? first + 1 : first;
-                float near_entry = fminf(left, right), far_entry = fmaxf(left, right);
-                if (near_entry < INFINITY) {
-                    if (far_entry < INFINITY && stack_size < STACK) {
-                        stack_node[stack_size] = near_node == first ? first + 1 : first;
-                        stack_entry[stack_size] = far_entry;
-                        stack_size++;
-                    }
-                    node = near_node;
-                    node_entry = near_entry;
+                uint32_t base = packed->node_offset + item.first * PACKED_NODE_STRIDE;
+                float left = intersect_box(packed, base, base + 1, &ray, hit->t);
+                float right = intersect_box(packed, base + 2, base + 3, &ray, hit->t);
+                bool right_nearer = right < left;
+                walk_item near = {packed_uint(packed, base + (right_nearer ? 2 : 0), 3),
+                                  packed_uint(packed, base + (right_nearer ? 3 : 1), 3), fminf(left, right)};
+                walk_item far = {packed_uint(packed, base + (right_nearer ? 0 : 2), 3),
+                                 packed_uint(packed, base + (right_nearer ? 1 : 3), 3), fmaxf(left, right)};
+                if (near.entry < INFINITY) {
+                    if (far.entry < INFINITY && stack_size < STACK)
+                        stack[stack_size++] = far;
+                    item = near;
                     continue;
                 }
             }
         }
         if (stack_size == 0)
-            break;
-        stack_size--;
-        node = stack_node[stack_size];
-        node_entry = stack_entry[stack_size];
-        if (node != PACKED_NONE && (node & 0x80000000u)) {
-            /* Entering an instance: move the ray into its object's coordinates. The
-             * direction is not renormalised, so t stays the world ray's parameter. */
-            uint32_t instance = node & 0x7fffffffu;
-            uint32_t instance_base = packed->instance_offset + instance * PACKED_INSTANCE_STRIDE;
-            node = packed_uint(packed, instance_base, 0);
-            vec3 object_origin, object_direction;
-            for (int r = 0; r < 3; r++) {
-                vec4 row;
-                for (int c = 0; c < 4; c++)
-                    row[c] = packed_float(packed, instance_base + 1 + r, c);
-                object_origin[r] = glm_vec3_dot(row, world_origin) + row[3];
-                object_direction[r] = glm_vec3_dot(row, world_direction);
-            }
-            ray_set(&ray, object_origin, object_direction);
-            current_instance = instance;
-            node_entry = intersect_box(packed, node, &ray, hit->t);
-        }
+            return false;
+        item = stack[--stack_size];
     }
+}
+
+bool packed_intersect_nearest(const packed_scene *packed, const float origin[3], const float direction[3], float time,
+                              float t_max, packed_hit *hit)
+{
+    walk(packed, origin, direction, time, t_max, false, PACKED_NONE, false, hit);
     return hit->primitive != PACKED_NONE;
+}
+
+bool packed_shadow_blocked(const packed_scene *packed, const float origin[3], const float direction[3], float time,
+                           float t_max, uint32_t light_slot, bool volumes, packed_hit *hit)
+{
+    return walk(packed, origin, direction, time, t_max, true, light_slot, volumes, hit);
 }
 
 uint32_t packed_media_at(const packed_scene *packed, const float point[3])

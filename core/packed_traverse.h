@@ -60,6 +60,17 @@ void packed_decode_normal(uint32_t bits, float normal[3]);
 bool packed_intersect_nearest(const packed_scene *packed, const float origin[3], const float direction[3],
                               float time, float t_max, packed_hit *hit);
 
+/* The shader's shadow ray (glsl/traverse.glsl trace_rays) from origin along direction
+ * (any length) at the given time, walked as the shader walks it: true (blocked) when it
+ * met, with t in (0, t_max), something other than the world primitive light_slot
+ * (PACKED_NONE: none is the light) and, when volumes, the boundaries of volume instances;
+ * it stops at the first such blocker it meets, in the walk's order, not the nearest.
+ * Otherwise false, and *hit is the nearest of what it passed (t = t_max and primitive
+ * PACKED_NONE when nothing). Hits beyond a passable one already met are not looked for,
+ * so the shader steps through volume boundaries one at a time (glsl/media.glsl). */
+bool packed_shadow_blocked(const packed_scene *packed, const float origin[3], const float direction[3], float time,
+                           float t_max, uint32_t light_slot, bool volumes, packed_hit *hit);
+
 /* The volumes containing point, packed as the shader keeps a path's media: the volume
  * instance number + 1 of the innermost in the low 16 bits, of the next one out in the high
  * 16 bits; 0 when the point is in no volume. Found by walking a ray from the point and

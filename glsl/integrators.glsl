@@ -60,62 +60,138 @@ bool integrator_survives(inout PixelState s)
 
 // Runs the pixel's paths for one pass: segment after segment while the work budget
 // lasts, starting new samples as paths end.
+//
+// Each iteration makes ONE traversal (glsl/traverse.glsl trace_rays) for two rays: the
+// path's next segment and the shadow ray that the previous segment's direct light left
+// pending (both start at the same vertex); the shadow ray's light is added when it
+// returns. So a path's shadow rays ride along with its segments, and the last one of a
+// sample with the next sample's camera ray. When the shadow ray is not done after one
+// trace (it stopped at a volume boundary, glsl/media.glsl), the path's hit is held and
+// shaded in a later iteration; a sample whose path ended is finished when its shadow ray
+// returns. None of that is kept between passes: a pass ends only when nothing is
+// pending, and once the budget is spent no new segment is traced. Whitted, which samples
+// every light at a point, gathers its direct light in place instead
+// (glsl/direct_light.glsl gathers_in_place).
 void integrate(inout PixelState s)
 {
     if (!HAS_DIRECT_LIGHT || !integrator_samples_lights())
         light_count = 0u;       // nothing to sample
+    PendingShadow shadow = no_pending_shadow();
+    LightQuery query = no_light_query();
+    Hit held_hit = no_hit(INFINITY);
+    bool holding = false;                  // held_hit is a segment still to be shaded
+    bool finishing = false;                // a sample whose path ended waits for its shadow ray
+    vec3 finishing_radiance = vec3(0.0);
     for (;;) {
-        if (!begin_segment(s))
+        bool busy = shadow.pending || holding;
+        bool trace_path;
+        if (!begin_segment(s, busy, !holding, trace_path))
             break;
+        trace_path = trace_path && !holding;
         float time = ray_time();
-        Hit hit;
-        bool hit_something = trace(s.origin, s.direction, time, INFINITY, hit);
-        s.statistics.x += 1.0;
+        bool blocked;
+        Hit shadow_hit, path_hit;
+        trace_rays(HAS_DIRECT_LIGHT && !gathers_in_place() && shadow.pending, shadow.ray, trace_path, s.origin,
+                   s.direction, time, INFINITY, blocked, shadow_hit, path_hit);
+        if (trace_path)
+            s.statistics.x += 1.0;
+        if (holding)
+            path_hit = held_hit;
+
+        // The shadow ray: its light arrives, or it goes on through a volume boundary.
+        bool crossing = false;
+        if (HAS_DIRECT_LIGHT && shadow.pending) {
+            crossing = shadow_at_boundary(shadow.ray, blocked, shadow_hit);
+            if (!crossing) {
+                vec3 light = shadow_arrived(shadow.transit, shadow.ray, blocked, shadow_hit) * shadow.contribution;
+                add_to_light_group(shadow.light_group, light);
+                shadow.pending = false;
+                if (finishing) {
+                    finish_sample(s, finishing_radiance + light);
+                    finishing = false;
+                } else {
+                    s.radiance += light;
+                }
+            }
+        }
+
+        // The path's segment, once nothing of its last vertex is pending.
+        bool shade = (trace_path || holding) && !shadow.pending;
+        holding = (trace_path || holding) && !shade;
+        held_hit = path_hit;
         bool path_done = false;
+        bool at_surface = false;
         vec4 u = random4(s.bounce, 1u);
         uint segment_bounce = s.bounce;     // the steps below may move bounce and direction on
         vec3 incoming = s.direction;
-        // Direct light is gathered once per segment, after the steps below decide where
-        // (one call site: glsl/direct_light.glsl).
-        LightQuery query = no_light_query();
-
-        if (scatter_in_medium(s, hit.t, u, query, path_done)) {
-            // scattered before the surface: done there
-        } else if (!hit_something) {
-            vec3 sky = s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
-            s.radiance += sky;
-            add_to_light_group(sky_light_group, sky);
-            path_done = true;
-        } else {
-            Surface surface = surface_at(hit, s.origin, s.direction, time);
-            ShadingFrame frame = shading_frame(surface, s.direction);
-            vec3 next_direction = s.direction;
-            if (surface.volume_boundary) {
-                cross_volume_boundary(s, surface, frame.front_face, hit.t);
+        if (shade) {
+            // Direct light is gathered after the steps below decide where.
+            query = no_light_query();
+            if (scatter_in_medium(s, path_hit.t, u, query, path_done)) {
+                // scattered before the surface: done there
+            } else if (path_hit.t == INFINITY) {
+                vec3 sky = s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
+                s.radiance += sky;
+                add_to_light_group(sky_light_group, sky);
+                path_done = true;
             } else {
-                s.since_vertex = 0.0;
-                Material material = surface_material(surface, frame);
-                // An emitter's light joins the path's; an emissive material then absorbs
-                // (its sample ends the path), a pbr one scatters on.
-                if (material_emits(material))
-                    hit_emitter(s, hit, surface, material);
-                BsdfSample sampled = material_sample(material, frame, s.direction, u);
-                BsdfSample bsdf = integrator_shade(s, material, frame, surface.position, sampled, query);
-                next_direction = bsdf.direction;
-                s.throughput *= bsdf.weight;
-                path_done = bsdf.absorbed;
-            }
-            if (!path_done) {
-                if (!leave_surface(s, surface.position, frame.normal, next_direction))
-                    path_done = true;
-                else if (!integrator_survives(s))
-                    path_done = true;
+                at_surface = true;
             }
         }
-        if (HAS_DIRECT_LIGHT && query.wanted)
-            s.radiance += query.weight * direct_light(query, -incoming, s.media, time, segment_bounce, s.light_total);
-        if (path_done)
-            finish_sample(s);
+        if (crossing || at_surface) {
+            // One surface_at for both: the shadow ray's volume boundary, or the path's hit.
+            Hit hit = crossing ? shadow_hit : path_hit;
+            vec3 from = crossing ? shadow.ray.origin : s.origin, along = crossing ? shadow.ray.direction : s.direction;
+            Surface surface = surface_at(hit, from, along, crossing ? shadow.ray.time : time);
+            if (crossing) {
+                shadow.pending = shadow_cross(shadow.ray, shadow.transit, hit, surface);
+            } else {
+                ShadingFrame frame = shading_frame(surface, s.direction);
+                vec3 next_direction = s.direction;
+                if (surface.volume_boundary) {
+                    cross_volume_boundary(s, surface, frame.front_face, hit.t);
+                } else {
+                    s.since_vertex = 0.0;
+                    Material material = surface_material(surface, frame);
+                    // An emitter's light joins the path's; an emissive material then absorbs
+                    // (its sample ends the path), a pbr one scatters on.
+                    if (material_emits(material))
+                        hit_emitter(s, hit, surface, material);
+                    BsdfSample sampled = material_sample(material, frame, s.direction, u);
+                    BsdfSample bsdf = integrator_shade(s, material, frame, surface.position, sampled, query);
+                    next_direction = bsdf.direction;
+                    s.throughput *= bsdf.weight;
+                    path_done = bsdf.absorbed;
+                }
+                if (!path_done) {
+                    if (!leave_surface(s, surface.position, frame.normal, next_direction))
+                        path_done = true;
+                    else if (!integrator_survives(s))
+                        path_done = true;
+                }
+            }
+        }
+        if (HAS_DIRECT_LIGHT && shade && query.wanted) {
+            begin_direct_light(query, -incoming, s.media, time, segment_bounce, s.radiance);
+            if (gathers_in_place())
+                direct_light_in_place(query, s.light_total, s.radiance);
+            else if (direct_light_pending(query))   // one light sample: the shadow ray for the next iteration
+                shadow = next_shadow_ray(query, s.light_total);
+        }
+        if (path_done) {
+            s.bounce = 0u;
+            if (HAS_DIRECT_LIGHT && shadow.pending) {
+                finishing = true;
+                finishing_radiance = s.radiance;
+            } else {
+                finish_sample(s, s.radiance);
+            }
+        }
+        // The ended path's shadow ray passed one volume boundary too many: nothing comes.
+        if (finishing && !shadow.pending) {
+            finish_sample(s, finishing_radiance);
+            finishing = false;
+        }
         if (overflow)
             break;
     }

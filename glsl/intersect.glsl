@@ -8,15 +8,32 @@ struct Hit {
     vec2 barycentric; // triangles: (b1, b2) of v1, v2; quads: (a, b) along the edges
 };
 
-// Nearest root of |origin + t*direction - center| = radius with t in (0, t_max), or
-// INFINITY, for a direction of any length (instances scale it). The discriminant is
-// computed from the squared distance of the centre to the ray's closest point, which
-// keeps float32 precise for the radius-1000 ground sphere (Haines et al., Ray Tracing
-// Gems, ch. 7).
-float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direction, float t_max)
+// A ray in the coordinates of the BVH level being walked (the world's, or an instance's
+// object's: there the direction is not unit length), with what the box and sphere tests
+// derive from its direction, computed once per ray and level.
+struct TraversalRay {
+    vec3 origin;
+    vec3 direction;
+    vec3 inverse_direction;   // 1 / direction, for the box tests
+    vec3 unit;                // direction / direction_length, for the sphere tests
+    float direction_length;
+};
+
+TraversalRay traversal_ray(vec3 origin, vec3 direction)
 {
-    float direction_length = length(direction);
-    vec3 unit = direction / direction_length;
+    TraversalRay ray;
+    ray.origin = origin;
+    ray.direction = direction;
+    ray.inverse_direction = 1.0 / direction;
+    ray.direction_length = length(direction);
+    ray.unit = direction / ray.direction_length;
+    return ray;
+}
+
+// intersect_sphere for a direction given as its unit vector and length: a traversal
+// computes those once per ray (TraversalRay), not once per sphere.
+float intersect_sphere_along(vec3 center, float radius, vec3 origin, vec3 unit, float direction_length, float t_max)
+{
     vec3 to_origin = origin - center;
     float b = dot(to_origin, unit);
     vec3 closest_offset = to_origin - b * unit;
@@ -34,6 +51,17 @@ float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direction, f
     if (t_far > 0.0 && t_far < t_max)
         return t_far;
     return INFINITY;
+}
+
+// Nearest root of |origin + t*direction - center| = radius with t in (0, t_max), or
+// INFINITY, for a direction of any length (instances scale it). The discriminant is
+// computed from the squared distance of the centre to the ray's closest point, which
+// keeps float32 precise for the radius-1000 ground sphere (Haines et al., Ray Tracing
+// Gems, ch. 7).
+float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direction, float t_max)
+{
+    float direction_length = length(direction);
+    return intersect_sphere_along(center, radius, origin, direction / direction_length, direction_length, t_max);
 }
 
 // Moller-Trumbore for a triangle (corner, edge1, edge2), or the parallelogram spanned by
@@ -107,7 +135,7 @@ bool alpha_masked(uint slot, uvec4 record, uint type, vec4 sphere, vec3 origin, 
 
 // Tests one primitive (by slot, its record already read) of the current level; on a
 // nearer hit updates hit (a hit where an alpha mask has no surface is none).
-void intersect_primitive(uint slot, uvec4 record, uint type, vec3 origin, vec3 direction, float time, uint instance,
+void intersect_primitive(uint slot, uvec4 record, uint type, TraversalRay ray, float time, uint instance,
                          inout Hit hit)
 {
     vec4 a, b, c;
@@ -116,19 +144,19 @@ void intersect_primitive(uint slot, uvec4 record, uint type, vec3 origin, vec3 d
     float t = INFINITY;
     vec2 coordinates = vec2(0.0);
     if (ONLY_SPHERES) {
-        t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
+        t = intersect_sphere_along(a.xyz, a.w, ray.origin, ray.unit, ray.direction_length, hit.t);
     } else {
         bool flat_primitive = type == uint(PRIMITIVE_TRIANGLE) || type == uint(PRIMITIVE_QUAD);
         if (HAS_MOVING_SPHERES && type == uint(PRIMITIVE_MOVING_SPHERE))
             a.xyz = mix(a.xyz, b.xyz, time);
         if (HAS_SPHERES && !flat_primitive)
-            t = intersect_sphere(a.xyz, a.w, origin, direction, hit.t);
+            t = intersect_sphere_along(a.xyz, a.w, ray.origin, ray.unit, ray.direction_length, hit.t);
         if (HAS_FLAT && flat_primitive)
-            t = intersect_flat(a.xyz, b.xyz, c.xyz, type == uint(PRIMITIVE_QUAD), origin, direction, hit.t,
+            t = intersect_flat(a.xyz, b.xyz, c.xyz, type == uint(PRIMITIVE_QUAD), ray.origin, ray.direction, hit.t,
                                coordinates);
     }
     if (HAS_ALPHA_MASK && t < hit.t
-        && alpha_masked(slot, record, type, a, origin, direction, t, coordinates, instance))
+        && alpha_masked(slot, record, type, a, ray.origin, ray.direction, t, coordinates, instance))
         t = INFINITY;
     if (t < hit.t) {
         hit.t = t;
@@ -138,12 +166,19 @@ void intersect_primitive(uint slot, uvec4 record, uint type, vec3 origin, vec3 d
     }
 }
 
-// Moves a world ray into an instance's object coordinates (the direction is not
-// renormalised, so t keeps meaning the world ray's parameter).
+// Moves a world ray into object coordinates by the rows of a world-to-object matrix (the
+// direction is not renormalised, so t keeps meaning the world ray's parameter).
+void apply_world_to_object(vec4 row0, vec4 row1, vec4 row2, vec3 origin, vec3 direction, out vec3 object_origin,
+                           out vec3 object_direction)
+{
+    object_origin = vec3(dot(row0.xyz, origin) + row0.w, dot(row1.xyz, origin) + row1.w, dot(row2.xyz, origin) + row2.w);
+    object_direction = vec3(dot(row0.xyz, direction), dot(row1.xyz, direction), dot(row2.xyz, direction));
+}
+
+// Moves a world ray into an instance's object coordinates.
 void to_object(uint instance, vec3 origin, vec3 direction, out vec3 object_origin, out vec3 object_direction)
 {
     uint base = instance_offset + instance * uint(PACKED_INSTANCE_STRIDE);
-    vec4 row0 = packed_vec4(base + 1u), row1 = packed_vec4(base + 2u), row2 = packed_vec4(base + 3u);
-    object_origin = vec3(dot(row0.xyz, origin) + row0.w, dot(row1.xyz, origin) + row1.w, dot(row2.xyz, origin) + row2.w);
-    object_direction = vec3(dot(row0.xyz, direction), dot(row1.xyz, direction), dot(row2.xyz, direction));
+    apply_world_to_object(packed_vec4(base + 1u), packed_vec4(base + 2u), packed_vec4(base + 3u), origin, direction,
+                          object_origin, object_direction);
 }

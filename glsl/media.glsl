@@ -54,44 +54,66 @@ const float PHASE_PDF = 1.0 / (4.0 * PI);
 
 vec3 sample_phase(vec2 u) { return random_unit_vector(u); }
 
-// The fraction of light that gets from p to the light primitive at distance along
-// direction: 0 behind an opaque surface; through volume boundaries it goes on, losing
-// exp(-density * length) in each medium, as the path itself would.
-vec3 shadow_transmittance(vec3 p, vec3 direction, float distance, uint light_slot, uint media, float time)
+// A shadow ray's way to its light through volume boundaries (in the variants with
+// volumes): it goes on through each, losing exp(-density * length) in each medium, as
+// the path itself would; at most SHADOW_CROSSINGS of them, then it is taken as blocked.
+const int SHADOW_CROSSINGS = 8;
+
+struct ShadowTransit {
+    float distance;      // to the light from where the ray started
+    float travelled;     // through the boundaries passed so far
+    vec3 transmittance;  // through the media passed so far
+    uint media;          // at the ray's origin
+    int crossings;       // boundaries passed
+};
+
+ShadowTransit shadow_transit(float distance, uint media)
 {
-    if (!HAS_VOLUMES) {
-        // No medium anywhere: every surface in the way is opaque.
-        Hit blocker;
-        bool blocked = trace(p, direction, time, distance * (1.0 - 1e-4), blocker);
-        return blocked && !(blocker.instance == NONE && blocker.primitive == light_slot) ? vec3(0.0) : vec3(1.0);
-    }
-    vec3 transmittance = vec3(1.0);
-    float travelled = 0.0;
-    vec3 origin = p;
-    for (int crossing = 0; crossing < 8; crossing++) {
-        work++;
-        Hit hit;
-        float remaining = distance - travelled;
-        // Hits within 1e-4 of the light's distance are the light itself (or beyond it):
-        // the traversal need not look that far.
-        bool any = trace(origin, direction, time, remaining * (1.0 - 1e-4), hit);
-        float segment = any ? hit.t : remaining;
-        uint medium = media_inner(media);
-        if (medium != 0u)
-            transmittance *= exp(-medium_record(medium).x * segment);
-        if (!any || (hit.instance == NONE && hit.primitive == light_slot))
-            return transmittance;
-        if (hit.instance == NONE)
-            return vec3(0.0);
-        uint instance_base = instance_offset + hit.instance * uint(PACKED_INSTANCE_STRIDE);
-        if ((packed_texel(instance_base).z & uint(INSTANCE_VOLUME)) == 0u)
-            return vec3(0.0);
-        Surface surface = surface_at(hit, origin, direction, time);
-        bool entering = dot(direction, surface.geometric) < 0.0;
-        media = entering ? media_enter(media, hit.instance) : media_leave(media, hit.instance);
-        float step = hit.t + ray_offset(surface.position);
-        origin += step * direction;
-        travelled += step;
-    }
-    return vec3(0.0);
+    ShadowTransit transit;
+    transit.distance = distance;
+    transit.travelled = 0.0;
+    transit.transmittance = vec3(1.0);
+    transit.media = media;
+    transit.crossings = 0;
+    return transit;
+}
+
+// Whether a traced shadow ray (glsl/traverse.glsl trace_rays: blocked, hit) stopped at a
+// volume boundary short of its light, which it must pass (shadow_cross) to go on.
+bool shadow_at_boundary(ShadowRay ray, bool blocked, Hit hit)
+{
+    return HAS_VOLUMES && !blocked && hit.t < ray.t_max && hit.instance != NONE;
+}
+
+// The fraction of the light that a traced shadow ray that did not stop at a boundary
+// brings: none when blocked, else what the media let through, the last stretch in the
+// medium it is in (to the light, or to the light's own surface when the trace met it).
+vec3 shadow_arrived(ShadowTransit transit, ShadowRay ray, bool blocked, Hit hit)
+{
+    if (blocked)
+        return vec3(0.0);
+    if (!HAS_VOLUMES)
+        return vec3(1.0);
+    float segment = hit.t < ray.t_max ? hit.t : transit.distance - transit.travelled;
+    uint medium = media_inner(transit.media);
+    return medium != 0u ? transit.transmittance * exp(-medium_record(medium).x * segment) : transit.transmittance;
+}
+
+// Moves a shadow ray past the volume boundary it stopped at (hit, surface there), into or
+// out of that medium, losing what the medium before it took. False when that was one
+// boundary too many.
+bool shadow_cross(inout ShadowRay ray, inout ShadowTransit transit, Hit hit, Surface surface)
+{
+    uint medium = media_inner(transit.media);
+    if (medium != 0u)
+        transit.transmittance *= exp(-medium_record(medium).x * hit.t);
+    bool entering = dot(ray.direction, surface.geometric) < 0.0;
+    transit.media = entering ? media_enter(transit.media, hit.instance) : media_leave(transit.media, hit.instance);
+    float step = hit.t + ray_offset(surface.position);
+    ray.origin += step * ray.direction;
+    transit.travelled += step;
+    // Hits within 1e-4 of the light's distance are the light itself (or beyond it).
+    ray.t_max = (transit.distance - transit.travelled) * (1.0 - 1e-4);
+    transit.crossings++;
+    return transit.crossings < SHADOW_CROSSINGS;
 }

@@ -26,14 +26,19 @@ struct PixelState {
     uint finished_here;     // samples finished in this pass
 };
 
-// Prepares the next segment: starts a sample (its camera ray) when no path is in flight,
-// and counts the segment's work. False when the pixel stops for this pass: no samples
-// left, or its work budget spent.
-bool begin_segment(inout PixelState s)
+// Prepares the next iteration of the segment loop: starts a sample (its camera ray) when
+// no path is in flight and may_start, and counts the iteration's work. trace_path is set
+// when the path's next segment is to be traced now. False when the pixel stops for this
+// pass: no samples left or its work budget spent, and nothing busy (a shadow ray still
+// to trace, a hit to shade) that must end in this pass, since the pass state keeps
+// neither.
+bool begin_segment(inout PixelState s, bool busy, bool may_start, out bool trace_path)
 {
-    if (s.bounce == 0u) {
-        if (s.samples_started >= samples_per_pixel || work >= pass_work_budget)
-            return false;
+    bool budget_left = work < pass_work_budget;
+    trace_path = false;
+    if (!busy && !budget_left)
+        return false;
+    if (s.bounce == 0u && may_start && budget_left && s.samples_started < samples_per_pixel) {
         rng_sample = sample_start + s.samples_started;
         s.samples_started++;
         camera_ray(s.origin, s.direction);
@@ -44,20 +49,20 @@ bool begin_segment(inout PixelState s)
         s.since_vertex = 0.0;
         s.bounce = 1u;
     }
-    if (work >= pass_work_budget)
+    if (s.bounce == 0u && !busy)
         return false;
+    trace_path = s.bounce != 0u && budget_left;
     work += SEGMENT_WORK;
     return true;
 }
 
-// Ends the path in flight: its radiance joins the pixel's sums.
-void finish_sample(inout PixelState s)
+// Ends a sample: its radiance joins the pixel's sums.
+void finish_sample(inout PixelState s, vec3 radiance)
 {
-    s.accumulated += vec4(s.radiance, 1.0);
-    float luminance = dot(s.radiance, vec3(0.2126, 0.7152, 0.0722));
+    s.accumulated += vec4(radiance, 1.0);
+    float luminance = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
     s.statistics.z += luminance * luminance;
-    s.squares.rgb += s.radiance * s.radiance;
-    s.bounce = 0u;
+    s.squares.rgb += radiance * radiance;
     s.finished_here++;
 }
 

@@ -1,89 +1,149 @@
-// traverse.glsl: the nearest hit along a ray, through the two-level BVH of the packed
-// scene (core/packed_layout.h "nodes", "instances").
+// traverse.glsl: the BVH walk of the packed scene (core/packed_layout.h "nodes",
+// "instances"): the nearest hit of a path ray and whether a shadow ray gets through, both
+// in ONE loop. GLSL inlines every call, and llvmpipe runs all of a loop's code on every
+// iteration of it (docs/performance.md): a second traversal loop for shadow rays would
+// be paid in full on every segment, so the segment loop (glsl/integrators.glsl) hands
+// each trace its path ray and the shadow ray it has pending, and this one loop walks one
+// after the other.
 
 const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 
-// Finds the nearest hit closer than t_max along the ray by walking the top-level BVH and,
-// through instance records, the objects' BVHs, nearer child first, with one explicit
-// stack. work counts node visits and primitive tests; overflow is set when the hard cap
-// cut the traversal.
-//
-// The loop carries the current node as the (first, count) pair of its record rather than
-// its index: both children's records are fetched anyway to test their boxes, and their w
-// components are those pairs, so a node is never fetched twice (4 fetches per interior
-// node instead of 6). Stack entries are such pairs too, with two markers for instances:
-// count ENTER_INSTANCE (first = the instance) moves the ray into the instance's object,
-// count LEAVE_INSTANCE restores the world ray.
-const uint ENTER_INSTANCE_MARK = 0xfffffffeu;
-const uint LEAVE_INSTANCE_MARK = 0xffffffffu;
+// The loop carries the current item as the (first, count) pair of its node record rather
+// than its index: both children's records are fetched anyway to test their boxes, and
+// their w components are those pairs, so a node is never fetched twice (4 fetches per
+// interior node instead of 6). A stack entry is such a pair in one word, count in the top
+// bits (a leaf holds at most BVH_MAX_LEAF_SIZE primitives; the packer keeps first below
+// 2^PACKED_FIRST_BITS), and the entry distance: two arrays, not three, since llvmpipe
+// writes and reads a per-lane array index one lane at a time. Two counts mark instances:
+// ENTER_INSTANCE (first = the instance) moves the ray into the instance's object and
+// goes on at its root, LEAVE_INSTANCE restores the world ray. Entering is an iteration of
+// its own whose four texels (the instance's head and matrix) are fetched by the same
+// calls as an interior node's four: llvmpipe pays for every fetch call in the loop on
+// every iteration, wanted or not.
+const uint STACK_FIRST_BITS = uint(PACKED_FIRST_BITS);
+const uint STACK_FIRST_MASK = (1u << STACK_FIRST_BITS) - 1u;
+const uint ENTER_INSTANCE_MARK = 6u;
+const uint LEAVE_INSTANCE_MARK = 7u;
 
-bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out Hit hit)
+uint stack_word(uint first, uint count) { return first | (count << STACK_FIRST_BITS); }
+
+// A shadow ray: from origin towards a light, which it reaches at t_max (just short of
+// the light, so that the light itself is not in the way).
+struct ShadowRay {
+    vec3 origin;
+    vec3 direction;
+    float t_max;
+    uint light_slot;   // the area light's world primitive, not a blocker; NONE for others
+    float time;
+};
+
+// No hit closer than t_max.
+Hit no_hit(float t_max)
 {
+    Hit hit;
     hit.t = t_max;
     hit.primitive = 0u;
     hit.instance = NONE;
     hit.barycentric = vec2(0.0);
-    if (node_count == 0u)
-        return false;
-    vec3 origin = world_origin;
-    vec3 direction = world_direction;
-    vec3 inverse_direction = 1.0 / direction;
-    uint instance = NONE;
-    uvec4 root_low = packed_texel(node_offset), root_high = packed_texel(node_offset + 1u);
-    float node_entry = intersect_box(packed_xyz(root_low), packed_xyz(root_high), origin, inverse_direction, t_max);
-    if (node_entry == INFINITY)
-        return false;
-    uint first = root_low.w, count = root_high.w;
+    return hit;
+}
 
-    uint stack_first[STACK_SIZE];
-    uint stack_count[STACK_SIZE];
+// Walks the shadow ray (when shadow_wanted) and then the path ray (when path_wanted)
+// through the top-level BVH and, through instance records, the objects' BVHs, nearer
+// child first, with one explicit stack. The path ray gets its nearest hit closer than
+// path_t_max in path_hit (t = path_t_max: none). The shadow ray stops at the first
+// blocker (blocked); what else it hits is not in the way: the light (light_slot) and, in
+// the variants with volumes, the boundaries of volume instances, the nearest of which
+// comes back in shadow_hit (t = its t_max: none) for the caller to step through
+// (glsl/media.glsl). work counts node visits and primitive tests; overflow is set when the
+// hard cap cut the walk.
+void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 path_origin, vec3 path_direction,
+                float path_time, float path_t_max, out bool blocked, out Hit shadow_hit, out Hit path_hit)
+{
+    blocked = false;
+    shadow_hit = no_hit(shadow.t_max);
+    path_hit = no_hit(path_t_max);
+    if (node_count == 0u || !(shadow_wanted || path_wanted))
+        return;
+    TraversalRay shadow_world = traversal_ray(shadow.origin, shadow.direction);
+    TraversalRay path_world = traversal_ray(path_origin, path_direction);
+    uvec4 root_low = packed_texel(node_offset), root_high = packed_texel(node_offset + 1u);
+
+    bool shadow_phase = shadow_wanted;   // false: the path ray's turn
+    TraversalRay world = shadow_phase ? shadow_world : path_world;
+    TraversalRay ray = world;
+    float time = shadow_phase ? shadow.time : path_time;
+    Hit hit = shadow_phase ? shadow_hit : path_hit;
+    uint instance = NONE;
+    bool volume_instance = false;
+    // The root's box is not tested: its children's are, in the first iteration.
+    uint first = root_low.w, count = root_high.w;
+    float node_entry = -INFINITY;
+    bool stop = false;   // the shadow ray is blocked
+    uint stack_node[STACK_SIZE];
     float stack_entry[STACK_SIZE];
     int stack_size = 0;
     for (;;) {
         if (!count_work())
             break;
+        bool entering = HAS_INSTANCES && count == ENTER_INSTANCE_MARK;
+        uint base = entering ? instance_offset + first * uint(PACKED_INSTANCE_STRIDE)
+                             : node_offset + first * uint(PACKED_NODE_STRIDE);
+        uvec4 texel0 = packed_texel(base), texel1 = packed_texel(base + 1u);
+        uvec4 texel2 = packed_texel(base + 2u), texel3 = packed_texel(base + 3u);
         if (HAS_INSTANCES && count == LEAVE_INSTANCE_MARK) {
-            origin = world_origin;
-            direction = world_direction;
-            inverse_direction = 1.0 / direction;
+            ray = world;
             instance = NONE;
+            volume_instance = false;
+        } else if (entering) {
+            // texel0: the object's root pair and the instance's flags; 1-3: world-to-object.
+            instance = first;
+            volume_instance = (texel0.z & uint(INSTANCE_VOLUME)) != 0u;
+            vec3 object_origin, object_direction;
+            apply_world_to_object(uintBitsToFloat(texel1), uintBitsToFloat(texel2), uintBitsToFloat(texel3),
+                                  world.origin, world.direction, object_origin, object_direction);
+            ray = traversal_ray(object_origin, object_direction);
+            first = texel0.x;
+            count = texel0.w;
+            node_entry = -INFINITY;
+            continue;
         } else if (node_entry < hit.t) {
             if (count > 0u) {
-                for (uint slot = first; slot < first + count && count_work(); slot++) {
+                for (uint slot = first; slot < first + count && !stop && count_work(); slot++) {
                     uvec4 record = packed_texel(primitive_offset + slot);
                     uint type = record_type(record);
                     if (HAS_INSTANCES && type == uint(PRIMITIVE_INSTANCE)) {
                         if (stack_size + 2 <= STACK_SIZE) {
-                            stack_count[stack_size] = LEAVE_INSTANCE_MARK;
+                            stack_node[stack_size] = stack_word(0u, LEAVE_INSTANCE_MARK);
                             stack_entry[stack_size] = -INFINITY;
-                            stack_first[stack_size + 1] = record.x;
-                            stack_count[stack_size + 1] = ENTER_INSTANCE_MARK;
+                            stack_node[stack_size + 1] = stack_word(record.x, ENTER_INSTANCE_MARK);
                             stack_entry[stack_size + 1] = -INFINITY;
                             stack_size += 2;
                         } else {
                             overflow = true;   // reported as an error, never skipped silently
                         }
                     } else {
-                        intersect_primitive(slot, record, type, origin, direction, time, instance, hit);
+                        float before = hit.t;
+                        intersect_primitive(slot, record, type, ray, time, instance, hit);
+                        // A shadow ray's blocker: anything but its light and volume boundaries.
+                        bool passable = instance == NONE ? slot == shadow.light_slot : HAS_VOLUMES && volume_instance;
+                        if (shadow_phase && hit.t < before && !passable)
+                            stop = true;
                     }
                 }
             } else {
-                uint base = node_offset + first * uint(PACKED_NODE_STRIDE);
-                uvec4 left_low = packed_texel(base), left_high = packed_texel(base + 1u);
-                uvec4 right_low = packed_texel(base + 2u), right_high = packed_texel(base + 3u);
-                float left_entry = intersect_box(packed_xyz(left_low), packed_xyz(left_high), origin,
-                                                 inverse_direction, hit.t);
-                float right_entry = intersect_box(packed_xyz(right_low), packed_xyz(right_high), origin,
-                                                  inverse_direction, hit.t);
+                float left_entry = intersect_box(packed_xyz(texel0), packed_xyz(texel1), ray.origin,
+                                                 ray.inverse_direction, hit.t);
+                float right_entry = intersect_box(packed_xyz(texel2), packed_xyz(texel3), ray.origin,
+                                                  ray.inverse_direction, hit.t);
                 bool right_nearer = right_entry < left_entry;
-                uvec2 near_node = right_nearer ? uvec2(right_low.w, right_high.w) : uvec2(left_low.w, left_high.w);
-                uvec2 far_node = right_nearer ? uvec2(left_low.w, left_high.w) : uvec2(right_low.w, right_high.w);
+                uvec2 near_node = right_nearer ? uvec2(texel2.w, texel3.w) : uvec2(texel0.w, texel1.w);
+                uvec2 far_node = right_nearer ? uvec2(texel0.w, texel1.w) : uvec2(texel2.w, texel3.w);
                 float near_entry = min(left_entry, right_entry), far_entry = max(left_entry, right_entry);
                 if (near_entry < INFINITY) {
                     if (far_entry < INFINITY) {
                         if (stack_size < STACK_SIZE) {
-                            stack_first[stack_size] = far_node.x;
-                            stack_count[stack_size] = far_node.y;
+                            stack_node[stack_size] = stack_word(far_node.x, far_node.y);
                             stack_entry[stack_size] = far_entry;
                             stack_size++;
                         } else {
@@ -97,23 +157,49 @@ bool trace(vec3 world_origin, vec3 world_direction, float time, float t_max, out
                 }
             }
         }
-        if (stack_size == 0)
-            break;
-        stack_size--;
-        first = stack_first[stack_size];
-        count = stack_count[stack_size];
-        node_entry = stack_entry[stack_size];
-        if (HAS_INSTANCES && count == ENTER_INSTANCE_MARK) {
-            instance = first;
-            to_object(instance, world_origin, world_direction, origin, direction);
-            inverse_direction = 1.0 / direction;
-            uint root = node_offset + packed_texel(instance_offset + instance * uint(PACKED_INSTANCE_STRIDE)).x
-                                      * uint(PACKED_NODE_STRIDE);
-            uvec4 low = packed_texel(root), high = packed_texel(root + 1u);
-            first = low.w;
-            count = high.w;
-            node_entry = intersect_box(packed_xyz(low), packed_xyz(high), origin, inverse_direction, hit.t);
+        if (stack_size == 0 || stop) {
+            // This ray is done: the path ray's turn, or the end.
+            if (!shadow_phase) {
+                path_hit = hit;
+                break;
+            }
+            shadow_hit = hit;
+            blocked = stop;
+            if (!path_wanted)
+                break;
+            shadow_phase = false;
+            world = path_world;
+            ray = world;
+            time = path_time;
+            hit = path_hit;
+            instance = NONE;
+            volume_instance = false;
+            stop = false;
+            first = root_low.w;
+            count = root_high.w;
+            node_entry = -INFINITY;
+            stack_size = 0;
+            continue;
         }
+        stack_size--;
+        uint word = stack_node[stack_size];
+        first = word & STACK_FIRST_MASK;
+        count = word >> STACK_FIRST_BITS;
+        node_entry = stack_entry[stack_size];
     }
+}
+
+// The nearest hit closer than t_max along a ray (no shadow ray). True when there is one.
+bool trace(vec3 origin, vec3 direction, float time, float t_max, out Hit hit)
+{
+    ShadowRay none;
+    none.origin = origin;
+    none.direction = direction;
+    none.t_max = 0.0;
+    none.light_slot = NONE;
+    none.time = time;
+    bool blocked;
+    Hit shadow_hit;
+    trace_rays(false, none, true, origin, direction, time, t_max, blocked, shadow_hit, hit);
     return hit.t < t_max;
 }

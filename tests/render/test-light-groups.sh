@@ -6,7 +6,7 @@
 # for a scene with every kind of light in its own group with light sampling on and off;
 # relight writes 8-bit outputs tone-mapped as render does; bad input is exit 2. The
 # statistics (a layer is its light alone, relight by k is the light times k) are
-# tests/unit/test_light_groups.c. About 40 s on an idle machine.
+# tests/unit/test_light_groups.c. About 85 s in `make test` on the loaded machine (43 s of CPU).
 #   usage: sh tests/render/test-light-groups.sh PROGRAM SCRATCH_DIR
 here=$(dirname "$0")
 . "$here/lib.sh"

@@ -76,4 +76,19 @@ for variant in path whitted full; do
         fail "loop stress ($variant)" "render failed"
     fi
 done
+
+# A Whitted vertex's shadow rays to 16 lights through foggy balls, at the largest budget
+# (see the scene): the render must not reach the work cap, and gives the image of the
+# smallest budget.
+for budget in 300 50000; do
+    "$program" render tests/render/scenes/lights-behind-volumes.txt -o "$scratch/lights-volumes-$budget.exr" \
+        --integrator whitted --pass-budget $budget --quiet 2>"$scratch/lights-volumes-$budget.log" ||
+        fail "lights behind volumes, pass budget $budget" "render failed: $(tr '\n' ' ' <"$scratch/lights-volumes-$budget.log")"
+done
+if "$program" diff "$scratch/lights-volumes-50000.exr" "$scratch/lights-volumes-300.exr" --fail 0 --failpercent 0 \
+    >"$scratch/lights-volumes.diff" 2>&1; then
+    pass "lights behind volumes (whitted): the largest pass budget renders the image of the smallest"
+else
+    fail "lights behind volumes (whitted)" "$(tr '\n' ' ' <"$scratch/lights-volumes.diff")"
+fi
 finish

@@ -15,44 +15,7 @@
 #include "pack.h"
 #include "packed_traverse.h"
 #include "support.h"
-
-/* A number in [0, 1) from the splitmix64 sequence of support.h (the test data). */
-static uint64_t random_state;
-static double random_unit(void)
-{
-    return (double)(splitmix64_next(&random_state) >> 11) / 9007199254740992.0;
-}
-
-static void add_material(scene *s, const char *name, int type, float r, float g, float b)
-{
-    scene_material m = scene_material_defaults();
-    snprintf(m.name, sizeof m.name, "%s", name);
-    m.type = type;
-    m.albedo[0] = r, m.albedo[1] = g, m.albedo[2] = b;
-    m.fuzz = 0.25f;
-    m.index_of_refraction = 1.5f;
-    m.emission[0] = 4 * r, m.emission[1] = 4 * g, m.emission[2] = 4 * b;
-    assert_true(scene_add_material(s, &m) >= 0);
-}
-
-static void random_scene(scene *s, int sphere_count, uint64_t seed)
-{
-    scene_defaults(s);
-    random_state = seed;
-    add_material(s, "a", MATERIAL_LAMBERTIAN, 0.1f, 0.2f, 0.3f);
-    add_material(s, "b", MATERIAL_METAL, 0.4f, 0.5f, 0.6f);
-    add_material(s, "c", MATERIAL_DIELECTRIC, 1, 1, 1);
-    add_material(s, "d", MATERIAL_EMISSIVE, 0.7f, 0.8f, 0.9f);
-    for (int i = 0; i < sphere_count; i++) {
-        scene_sphere sphere = {
-            .center = {(float)(random_unit() * 20 - 10), (float)(random_unit() * 20 - 10),
-                       (float)(random_unit() * 20 - 10)},
-            .radius = (float)(0.05 + random_unit() * 1.5),
-            .material = i % 4,
-        };
-        assert_true(scene_add_sphere(s, &sphere) >= 0);
-    }
-}
+#include "pack_test_scenes.h"
 
 static void header_and_materials_round_trip(void **state)
 {
@@ -346,18 +309,31 @@ static double shape_hit(const scene_shape *shape, double time, const double o[3]
     return inside ? t : INFINITY;
 }
 
-/* Brute force over the whole scene in double: world spheres, and every instance's shapes
- * and mesh triangles in object coordinates. Returns the nearest t (INFINITY: none). */
-static double brute_force(const scene *s, double time, const double o[3], const double d[3])
+/* What brute_force_of() looks at. */
+typedef enum brute_force_set {
+    ALL_SHAPES,       /* everything */
+    BLOCKERS,         /* all but one world sphere (a shadow ray's light) and volume instances */
+    VOLUME_SHAPES,    /* the shapes of volume instances */
+} brute_force_set;
+
+/* Brute force over the scene in double: world spheres, and every instance's shapes and
+ * mesh triangles in object coordinates, of the set (skip_sphere: the world sphere that
+ * BLOCKERS leaves out). Returns the nearest t (INFINITY: none). */
+static double brute_force_of(const scene *s, double time, const double o[3], const double d[3], brute_force_set set,
+                             int skip_sphere)
 {
     double best = INFINITY;
-    for (int i = 0; i < s->sphere_count; i++) {
+    for (int i = 0; i < s->sphere_count && set != VOLUME_SHAPES; i++) {
+        if (set == BLOCKERS && i == skip_sphere)
+            continue;
         scene_shape shape = {.type = SHAPE_SPHERE, .radius = s->spheres[i].radius};
         memcpy(shape.points[0], s->spheres[i].center, sizeof shape.points[0]);
         best = fmin(best, shape_hit(&shape, time, o, d));
     }
     for (int i = 0; i < s->instance_count; i++) {
         const scene_instance *instance = &s->instances[i];
+        if ((set == BLOCKERS && instance->volume) || (set == VOLUME_SHAPES && !instance->volume))
+            continue;
         /* Invert the affine placement in double. */
         const float (*m)[4] = instance->object_to_world;
         double a[3][3], inverse[3][3];
@@ -394,6 +370,12 @@ static double brute_force(const scene *s, double time, const double o[3], const 
             best = fmin(best, shape_hit(&s->shapes[object->first_shape + k], time, object_origin, object_direction));
     }
     return best;
+}
+
+/* The nearest t of anything in the scene (INFINITY: none). */
+static double brute_force(const scene *s, double time, const double o[3], const double d[3])
+{
+    return brute_force_of(s, time, o, d, ALL_SHAPES, -1);
 }
 
 /* A random shape within a few units of the origin. */
@@ -459,26 +441,34 @@ static void instanced_scene(scene *s, uint64_t seed)
     instanced_scene_placed(s, seed, false);
 }
 
+/* A random ray for the brute-force tests: an origin in the 30-unit cube around the scene
+ * and a unit direction, in float (of, df) and the same values in double (o, d). */
+static void random_test_ray(double o[3], double d[3], float of[3], float df[3])
+{
+    double length = 0;
+    for (int i = 0; i < 3; i++) {
+        o[i] = random_unit() * 30 - 15;
+        d[i] = random_unit() * 2 - 1;
+        length += d[i] * d[i];
+    }
+    length = sqrt(length);
+    for (int i = 0; i < 3; i++) {
+        of[i] = (float)o[i];
+        df[i] = (float)(d[i] / length);
+        o[i] = of[i];
+        d[i] = df[i];
+    }
+}
+
 /* The packed traversal of one packed scene s finds the brute-force nearest hit (in
  * double, every placed shape in its object's coordinates) for random rays. */
 static void traversal_matches_brute_force(const scene *s, const packed_scene *packed, uint64_t seed)
 {
     int hits = 0, grazes = 0;
     for (int r = 0; r < 3000; r++) {
-        double o[3], d[3], length = 0;
-        for (int i = 0; i < 3; i++) {
-            o[i] = random_unit() * 30 - 15;
-            d[i] = random_unit() * 2 - 1;
-            length += d[i] * d[i];
-        }
-        length = sqrt(length);
+        double o[3], d[3];
         float of[3], df[3];
-        for (int i = 0; i < 3; i++) {
-            of[i] = (float)o[i];
-            df[i] = (float)(d[i] / length);
-            o[i] = of[i];
-            d[i] = df[i];
-        }
+        random_test_ray(o, d, of, df);
         double time = random_unit();
         double expected = brute_force(s, (float)time, o, d);
         packed_hit hit;
@@ -531,6 +521,82 @@ static void instanced_traversal_matches_brute_force(void **state)
             packed_scene_free(&packed);
             scene_free(&s);
         }
+    }
+}
+
+/* The shader's shadow rays (packed_shadow_blocked, mirrored from glsl/traverse.glsl)
+ * against brute force on instanced scenes with two volume instances: towards a world sphere
+ * (the light, passable) or nothing, up to a random t_max. With the volume passable too,
+ * whatever passes nearest is P and the nearest blocker B: B before P must block; when
+ * the ray is not blocked, its hit is P (none when P is beyond t_max). As a plain shadow
+ * ray (volumes not passable), it is blocked exactly when a blocker or volume comes before
+ * the light and t_max. Near-ties within float precision are skipped. */
+static void shadow_rays_match_brute_force(void **state)
+{
+    (void)state;
+    for (uint64_t seed = 40; seed < 43; seed++) {
+        scene s;
+        instanced_scene(&s, seed);
+        for (int i = 1; i <= 2; i++) { /* two of object 1's transformed placements */
+            s.instances[i].volume = true;
+            s.instances[i].density = 0.5f;
+        }
+        packed_scene packed;
+        assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+        int blocked_count = 0, through = 0, to_volume = 0;
+        for (int r = 0; r < 3000; r++) {
+            double o[3], d[3];
+            float of[3], df[3];
+            random_test_ray(o, d, of, df);
+            float t_max = (float)(random_unit() * 40);
+            /* The light: a world sphere (world primitives keep the scene's order first). */
+            int light = r % 2 ? (int)(random_unit() * s.sphere_count) : -1;
+            uint32_t light_slot = PACKED_NONE;
+            for (uint32_t slot = 0; light >= 0 && slot < packed.primitive_count; slot++) {
+                packed_primitive primitive = packed_primitive_at(&packed, slot);
+                if (primitive.type == PRIMITIVE_SPHERE && primitive.data[0][3] == s.spheres[light].radius
+                    && memcmp(primitive.data[0], s.spheres[light].center, sizeof s.spheres[light].center) == 0)
+                    light_slot = slot;
+            }
+            if (light >= 0)
+                assert_int_not_equal(light_slot, PACKED_NONE);
+            double t_light = INFINITY;
+            if (light >= 0) {
+                scene_shape shape = {.type = SHAPE_SPHERE, .radius = s.spheres[light].radius};
+                memcpy(shape.points[0], s.spheres[light].center, sizeof shape.points[0]);
+                t_light = shape_hit(&shape, 0, o, d);
+            }
+            double blocker = brute_force_of(&s, 0, o, d, BLOCKERS, light);
+            double volume = brute_force_of(&s, 0, o, d, VOLUME_SHAPES, -1);
+            double passable = fmin(t_light, volume);
+            double tolerance = 2e-4 * (1 + fmin(fmin(blocker, passable), t_max));
+            if (fabs(blocker - passable) < tolerance || fabs(blocker - t_max) < tolerance
+                || fabs(passable - t_max) < tolerance || fabs(t_light - volume) < tolerance)
+                continue;
+            packed_hit hit;
+            bool blocked = packed_shadow_blocked(&packed, of, df, 0, t_max, light_slot, true, &hit);
+            if (blocker < passable && blocker < t_max && !blocked)
+                fail_msg("seed %llu ray %d: a blocker at %g before %g, not blocked", (unsigned long long)seed, r,
+                         blocker, fmin(passable, (double)t_max));
+            if (blocked) {
+                assert_true(blocker < t_max);
+                blocked_count++;
+            } else if (passable < t_max) {
+                assert_true(fabs(hit.t - passable) <= tolerance);
+                assert_true(hit.instance != PACKED_NONE || hit.primitive == light_slot);
+                to_volume += hit.instance != PACKED_NONE;
+            } else {
+                assert_true(hit.t == t_max && hit.primitive == PACKED_NONE);
+                through++;
+            }
+            /* A plain shadow ray: anything but the light blocks. */
+            double first = fmin(blocker, volume);
+            bool plain = packed_shadow_blocked(&packed, of, df, 0, t_max, light_slot, false, &hit);
+            assert_int_equal(plain, first < t_light && first < t_max);
+        }
+        assert_true(blocked_count > 150 && through > 200 && to_volume > 20);
+        packed_scene_free(&packed);
+        scene_free(&s);
     }
 }
 
@@ -639,7 +705,15 @@ static void instance_records_and_materials(void **state)
         if (instance->object == 0)
             continue;
         uint32_t base = packed.instance_offset + (uint32_t)packed_index++ * PACKED_INSTANCE_STRIDE;
-        assert_true(packed_uint(&packed, base, 0) < packed.node_count);
+        /* texel 0 holds the (first, count) of the object's root node record */
+        uint32_t first = packed_uint(&packed, base, 0), count = packed_uint(&packed, base, 3);
+        bool root_found = false;
+        for (uint32_t n = 0; n < packed.node_count && !root_found; n++) {
+            uint32_t node = packed.node_offset + n * PACKED_NODE_STRIDE;
+            root_found = packed_uint(&packed, node, 3) == first && packed_uint(&packed, node + 1, 3) == count;
+        }
+        assert_true(root_found);
+        assert_true(count == 0 ? first + 1 < packed.node_count : first + count <= packed.primitive_count);
         assert_int_equal(packed_uint(&packed, base, 1),
                          instance->material >= 0 ? (uint32_t)instance->material : PACKED_NONE);
         for (int r = 0; r < 3; r++)
@@ -682,143 +756,6 @@ static void singular_instance_is_an_error(void **state)
     assert_int_equal(pack_scene(&s, NULL, &packed, &error), RT_ERROR_INPUT);
     assert_non_null(strstr(error.message, "cannot be inverted"));
     assert_null(packed.texels);
-    scene_free(&s);
-}
-
-/* Every emissive world sphere is a light, knows its light index, and the selection
- * probabilities (cdf steps) are proportional to emission luminance x area. */
-static void emissive_spheres_become_lights(void **state)
-{
-    (void)state;
-    scene s;
-    random_scene(&s, 60, 40);
-    packed_scene packed;
-    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
-    int emissive = 0;
-    double total_power = 0;
-    for (int i = 0; i < s.sphere_count; i++)
-        if (s.materials[s.spheres[i].material].type == MATERIAL_EMISSIVE) {
-            emissive++;
-            const float *e = s.materials[s.spheres[i].material].emission;
-            total_power += (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]) * s.spheres[i].radius * s.spheres[i].radius;
-        }
-    assert_int_equal(packed.light_count, emissive);
-    float previous = 0;
-    for (uint32_t l = 0; l < packed.light_count; l++) {
-        uint32_t base = packed.light_offset + l * PACKED_LIGHT_STRIDE;
-        assert_int_equal(packed_uint(&packed, base, 0), LIGHT_SPHERE);
-        uint32_t slot = packed_uint(&packed, base, 1);
-        packed_primitive primitive = packed_primitive_at(&packed, slot);
-        /* Area lights come first and in slot order: the shader's binary search. */
-        assert_true(l < packed.area_light_count);
-        if (l > 0)
-            assert_true(slot > packed_uint(&packed, base - PACKED_LIGHT_STRIDE, 1));
-        const float *e = s.materials[primitive.material].emission;
-        double power = (0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]) * primitive.data[0][3] * primitive.data[0][3];
-        float cdf = packed_float(&packed, base + 1, 3);
-        assert_float_equal(cdf - previous, power / total_power, 1e-5);
-        previous = cdf;
-    }
-    assert_float_equal(previous, 1.0, 1e-6);
-    packed_scene_free(&packed);
-    scene_free(&s);
-}
-
-/* Emitters of placed objects become lights: the placement is baked into the world (the
- * object's shapes moved by its transform) when something of it emits under it, even
- * with keep_instances, except spheres under more than a similarity, which stay
- * instanced. */
-static void placed_emitters_become_lights(void **state)
-{
-    (void)state;
-    scene s;
-    scene_defaults(&s);
-    add_material(&s, "grey", MATERIAL_LAMBERTIAN, 0.5f, 0.5f, 0.5f);
-    add_material(&s, "glow", MATERIAL_EMISSIVE, 1, 1, 1);
-    /* Object 0: an emissive quad and a grey triangle. Object 1: an emissive sphere.
-     * Object 2: a triangle without a material (the placement's). */
-    scene_shape quad = {.type = SHAPE_QUAD, .material = 1, .points = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}}};
-    scene_shape triangle = {.type = SHAPE_TRIANGLE, .material = 0, .points = {{0, 1, 0}, {1, 1, 0}, {0, 1, 1}}};
-    scene_shape sphere = {.type = SHAPE_SPHERE, .material = 1, .radius = 0.5f, .points = {{1, 2, 3}}};
-    scene_shape bare = {.type = SHAPE_TRIANGLE, .material = -1, .points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
-    scene_object objects[3] = {{.first_shape = 0, .shape_count = 2, .mesh = -1},
-                               {.first_shape = 2, .shape_count = 1, .mesh = -1},
-                               {.first_shape = 3, .shape_count = 1, .mesh = -1}};
-    assert_true(scene_add_shape(&s, &quad) >= 0 && scene_add_shape(&s, &triangle) >= 0);
-    assert_true(scene_add_shape(&s, &sphere) >= 0 && scene_add_shape(&s, &bare) >= 0);
-    for (int o = 0; o < 3; o++)
-        assert_true(scene_add_object(&s, &objects[o]) >= 0);
-    /* The quad's object stretched and turned: baked. */
-    scene_instance stretched = {.object = 0, .material = -1,
-                                .object_to_world = {{0, -2, 0, 5}, {3, 0, 0, 6}, {0, 0, 1, 7}}};
-    /* The sphere turned, and moved and scaled by 2: baked (a similarity keeps it a
-     * sphere). Stretched: stays an instance. */
-    scene_instance turned = {.object = 1, .material = -1,
-                             .object_to_world = {{0, -1, 0, 0}, {1, 0, 0, 0}, {0, 0, 1, 0}}};
-    scene_instance scaled = {.object = 1, .material = -1,
-                             .object_to_world = {{2, 0, 0, 10}, {0, 2, 0, 0}, {0, 0, 2, 0}}};
-    scene_instance oval = {.object = 1, .material = -1,
-                           .object_to_world = {{1, 0, 0, 0}, {0, 3, 0, 0}, {0, 0, 1, 0}}};
-    /* The bare triangle glows only under this placement's material: baked; grey: not,
-     * with keep_instances. */
-    scene_instance glowing = {.object = 2, .material = 1,
-                              .object_to_world = {{1, 0, 0, 0}, {0, 1, 0, 20}, {0, 0, 1, 0}}};
-    scene_instance grey = {.object = 2, .material = 0,
-                           .object_to_world = {{1, 0, 0, 0}, {0, 1, 0, 30}, {0, 0, 1, 0}}};
-    scene_instance placements[6] = {stretched, turned, scaled, oval, glowing, grey};
-    for (int i = 0; i < 6; i++)
-        assert_true(scene_add_instance(&s, &placements[i]) >= 0);
-    packed_scene packed;
-    pack_options options = {.keep_instances = true};
-    assert_int_equal(pack_scene(&s, &options, &packed, NULL), RT_OK);
-    assert_int_equal(packed.instance_count, 2);   /* oval and grey */
-    assert_int_equal(packed.light_count, 4);      /* the quad, both spheres, the glowing triangle */
-    bool seen_quad = false, seen_sphere = false, seen_turned = false, seen_triangle = false;
-    for (uint32_t l = 0; l < packed.light_count; l++) {
-        uint32_t base = packed.light_offset + l * PACKED_LIGHT_STRIDE;
-        packed_primitive light = packed_primitive_at(&packed, packed_uint(&packed, base, 1));
-        assert_int_equal(light.material, 1);
-        if (light.type == PRIMITIVE_QUAD) {
-            /* Corner (0,0,0) -> (5,6,7); edges (1,0,0) -> (0,3,0) and (0,0,1) -> (0,0,1). */
-            const float expected[3][3] = {{5, 6, 7}, {0, 3, 0}, {0, 0, 1}};
-            for (int k = 0; k < 3; k++)
-                for (int i = 0; i < 3; i++)
-                    assert_float_equal(light.data[k][i], expected[k][i], 1e-6);
-            seen_quad = true;
-        } else if (light.type == PRIMITIVE_SPHERE && light.data[0][3] == 1) {
-            /* Centre (1, 2, 3) scaled by 2 and moved by (10, 0, 0); radius 0.5 x 2. */
-            assert_float_equal(light.data[0][0], 12, 1e-6);
-            assert_float_equal(light.data[0][1], 4, 1e-6);
-            assert_float_equal(light.data[0][2], 6, 1e-6);
-            seen_sphere = true;
-        } else if (light.type == PRIMITIVE_SPHERE) {
-            /* Turned a quarter about z: (1, 2, 3) -> (-2, 1, 3), radius kept. */
-            assert_float_equal(light.data[0][0], -2, 1e-6);
-            assert_float_equal(light.data[0][1], 1, 1e-6);
-            assert_float_equal(light.data[0][2], 3, 1e-6);
-            assert_float_equal(light.data[0][3], 0.5, 1e-6);
-            seen_turned = true;
-        } else {
-            assert_int_equal(light.type, PRIMITIVE_TRIANGLE);
-            assert_float_equal(light.data[0][1], 20, 1e-6);
-            seen_triangle = true;
-        }
-    }
-    assert_true(seen_quad && seen_sphere && seen_turned && seen_triangle);
-    /* The baked copies are hit where the placed shapes are: the quad's middle, (0.5, 0,
-     * 0.5) in the object's coordinates, is (5, 7.5, 7.5) in the world, on the plane x = 5. */
-    float origin[3] = {20, 7.5f, 7.5f}, direction[3] = {-1, 0, 0};
-    packed_hit hit;
-    assert_true(packed_intersect_nearest(&packed, origin, direction, 0, INFINITY, &hit));
-    assert_float_equal(hit.t, 15, 1e-4);
-    assert_int_equal(hit.instance, PACKED_NONE);
-    packed_scene_free(&packed);
-    /* By default the grey triangle is baked too (placed once, it costs no memory), and is
-     * no light; the oval sphere stays an instance. */
-    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
-    assert_int_equal(packed.instance_count, 1);
-    assert_int_equal(packed.light_count, 4);
-    packed_scene_free(&packed);
     scene_free(&s);
 }
 
@@ -1007,10 +944,9 @@ int main(void)
         cmocka_unit_test(packed_traversal_matches_brute_force),
         cmocka_unit_test(empty_scene_packs_and_misses),
         cmocka_unit_test(instanced_traversal_matches_brute_force),
+        cmocka_unit_test(shadow_rays_match_brute_force),
         cmocka_unit_test(instance_records_and_materials),
         cmocka_unit_test(singular_instance_is_an_error),
-        cmocka_unit_test(emissive_spheres_become_lights),
-        cmocka_unit_test(placed_emitters_become_lights),
         cmocka_unit_test(normals_survive_the_encoding),
         cmocka_unit_test(mesh_vertices_are_stored_once),
         cmocka_unit_test(vertex_colours_are_packed_when_asked_for),
