@@ -10,6 +10,7 @@
 #include "clock.h"
 #include "commands.h"
 #include "gpu.h"
+#include "display_tev.h"
 #include "render_arguments.h"
 #include "render_job.h"
 
@@ -24,6 +25,9 @@ static void on_stop_signal(int signal_number)
 }
 
 /* What the command shows of a running job. */
+/* How often --display sends the image so far (and once more when it is done). */
+#define DISPLAY_PREVIEW_SECONDS 1.0
+
 typedef struct presentation {
     const render_arguments *arguments;
     bool tty;                    /* stderr is a terminal and not --quiet: draw the bar */
@@ -32,12 +36,34 @@ typedef struct presentation {
     char label[64];              /* "frame N " with frames, else "" */
     double last_draw;
     double first_pass;           /* seconds from the command's start to its first pass's end */
+    int compiles;                /* images whose tracer program was compiled (not cached) */
+    display_tev *display;        /* --display's viewer, or NULL */
+    const char *output;          /* the image being rendered: its name in the viewer */
 } presentation;
+
+/* Sends image to the --display viewer as the image being rendered, and says once, as a
+ * warning, when the viewer is not there or went away (the render goes on). */
+static void show_on_display(presentation *shown, const rt_image *image)
+{
+    if (shown->display == NULL || shown->output == NULL)
+        return;
+    display_tev_send(shown->display, shown->output, image);
+    char warning[600];
+    if (display_tev_take_warning(shown->display, warning, sizeof warning))
+        fprintf(stderr, "rtspheres render: warning: %s\n", warning);
+}
+
+/* render_options.preview: the image so far, to the viewer. */
+static void send_preview(void *user, const rt_image *partial)
+{
+    show_on_display(user, partial);
+}
 
 /* render_job_callbacks.render_started: a new bar for the image. */
 static void start_bar(void *user, const render_job_image *image)
 {
     presentation *shown = user;
+    shown->output = image->output;
     shown->label[0] = '\0';
     if (image->frame >= 0)
         snprintf(shown->label, sizeof shown->label, "frame %d ", image->frame);
@@ -100,19 +126,22 @@ static void show_checkpoint(void *user, const render_job_image *image, uint64_t 
 static void show_summary(void *user, const render_job_image *image, const render_result *result)
 {
     presentation *shown = user;
+    shown->compiles += result->compiled_program;
+    show_on_display(shown, &result->image);
     if (shown->arguments->verbose) {
         uint64_t geometry_bytes = result->packed_bytes - result->image_bytes;
         fprintf(stderr,
                 "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights; BVH depth %d, "
                 "built in %.3f s; packed %llu bytes (%.1f per triangle without images)%s; first pass "
                 "done %.3f s after start (context, parse, BVH, upload, compile); after it %.3f s for "
-                "%llu samples (%.3g us/sample)\n",
+                "%llu samples (%.3g us/sample); tracer program %s\n",
                 result->primitive_count, result->triangle_count, result->instance_count, result->light_count,
                 result->bvh_depth, result->bvh_build_seconds, (unsigned long long)result->packed_bytes,
                 result->triangle_count ? (double)geometry_bytes / result->triangle_count : 0.0,
                 result->reused_scene ? ", already on the device" : "", shown->first_pass, result->steady_seconds,
                 (unsigned long long)result->steady_samples,
-                result->steady_samples ? result->steady_seconds / (double)result->steady_samples * 1e6 : 0.0);
+                result->steady_samples ? result->steady_seconds / (double)result->steady_samples * 1e6 : 0.0,
+                result->compiled_program ? "compiled" : "from the context's cache");
     }
     if (!shown->arguments->quiet)
         fprintf(stderr,
@@ -164,10 +193,17 @@ static int open_gpu(const render_arguments *arguments, gpu_context **context)
 }
 
 /* Runs the job on context and says how it ended. Returns the exit code. */
-static int run_job(gpu_context *context, const render_arguments *arguments, double command_start)
+static int run_job(gpu_context *context, const render_arguments *arguments, display_tev *display,
+                   double command_start)
 {
     presentation shown = {.arguments = arguments, .tty = !arguments->quiet && isatty(STDERR_FILENO),
-                          .command_start = command_start, .last_draw = -1};
+                          .command_start = command_start, .last_draw = -1, .display = display};
+    render_job job = arguments->job;
+    if (display != NULL) {
+        job.tracer.preview = send_preview;
+        job.tracer.preview_context = &shown;
+        job.tracer.preview_seconds = DISPLAY_PREVIEW_SECONDS;
+    }
     render_job_callbacks callbacks = {
         .user = &shown,
         .warning = show_warning,
@@ -179,15 +215,20 @@ static int run_job(gpu_context *context, const render_arguments *arguments, doub
     };
     render_job_summary summary;
     rt_error error = {{0}};
-    rt_status status = render_job_run(context, &arguments->job, &callbacks, &summary, &error);
+    rt_status status = render_job_run(context, &job, &callbacks, &summary, &error);
     if (status != RT_OK && summary.failure == RENDER_JOB_FAILURE_SCENE)
         fprintf(stderr, "%s\n", error.message);  /* the parser's message names the file already */
     else if (status != RT_OK && summary.failure != RENDER_JOB_FAILURE_STOPPED)
         fprintf(stderr, "rtspheres render: %s\n", error.message);
     int rendered = summary.images_started;
-    if (arguments->job.frame_count > 0 && !arguments->quiet && rendered > 0)
-        fprintf(stderr, "rtspheres: %d frame%s in %.2f s (%.3g frames/s)\n", rendered, rendered == 1 ? "" : "s",
-                summary.seconds, rendered / summary.seconds);
+    bool list = arguments->job.frame_count > 0 || arguments->job.sweep != NULL;
+    const char *unit = arguments->job.sweep != NULL ? "sweep row" : "frame";
+    if (list && !arguments->quiet && rendered > 0)
+        fprintf(stderr, "rtspheres: %d %s%s in %.2f s (%.3g %ss/s)\n", rendered, unit, rendered == 1 ? "" : "s",
+                summary.seconds, rendered / summary.seconds, unit);
+    if (list && arguments->verbose)
+        fprintf(stderr, "rtspheres: the tracer program was compiled %d time%s for %d image%s\n", shown.compiles,
+                shown.compiles == 1 ? "" : "s", rendered, rendered == 1 ? "" : "s");
     return exit_code_for_status(status);
 }
 
@@ -206,6 +247,14 @@ int command_render(int argc, char **argv)
             exit_code = EXIT_BAD_INPUT;
         }
     }
+    display_tev *display = NULL;
+    if (exit_code == EXIT_OK && !help_shown && arguments.display != NULL) {
+        rt_error error = {{0}};
+        if (display_tev_create(arguments.display, &display, &error) != RT_OK) {
+            fprintf(stderr, "rtspheres render: --display: %s\n", error.message);
+            exit_code = exit_code_for_status(RT_ERROR_INPUT);
+        }
+    }
     if (exit_code != EXIT_OK || help_shown) {
         render_arguments_free(&arguments);
         return exit_code;
@@ -222,9 +271,10 @@ int command_render(int argc, char **argv)
     gpu_context *context = NULL;
     exit_code = open_gpu(&arguments, &context);
     if (exit_code == EXIT_OK) {
-        exit_code = run_job(context, &arguments, command_start);
+        exit_code = run_job(context, &arguments, display, command_start);
         gpu_destroy(context);
     }
+    display_tev_destroy(display);
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
     render_arguments_free(&arguments);

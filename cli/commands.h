@@ -17,6 +17,7 @@ int command_info(int argc, char **argv);
 int command_stats(int argc, char **argv);
 int command_merge(int argc, char **argv);
 int command_montage(int argc, char **argv);
+int command_relight(int argc, char **argv);
 
 /* Exit codes shared by all commands. */
 #define EXIT_OK 0

@@ -21,6 +21,7 @@ static void print_usage(FILE *stream)
             "  stats IMAGE              per-channel mean/min/max of an image and its rtspheres metadata\n"
             "  merge PARTS... -o OUT    merge EXR parts of one render (sample ranges, tiles, shards)\n"
             "  montage IMAGES... -o OUT lay equal-size images out as a contact sheet\n"
+            "  relight IN.exr -o OUT    reweigh the light group layers of a --light-groups render\n"
             "\n"
             "Run 'rtspheres COMMAND --help' for a command's options.\n");
 }
@@ -32,6 +33,7 @@ static const struct {
 } commands[] = {
     {"render", command_render}, {"diff", command_diff},   {"check", command_check},  {"info", command_info},
     {"stats", command_stats},   {"merge", command_merge}, {"montage", command_montage},
+    {"relight", command_relight},
 };
 
 int main(int argc, char **argv)

@@ -35,6 +35,11 @@ static void print_help(FILE *stream)
             "      --frames LIST      render frames, e.g. 1-60 or 1-10,15,20-30:2; each frame\n"
             "                         sets $frame and $time (= frame / --fps)\n"
             "      --fps F            frames per second for $time (default 24)\n"
+            "      --display HOST:PORT  stream the image to the tev viewer as it converges (every\n"
+            "                         second, and when done); no viewer there is a warning\n"
+            "      --sweep TABLE      one image per row of TABLE (.tsv or .csv: a header of\n"
+            "                         variable names, then a row of values each), set as -D;\n"
+            "                         the output may use {NAME} and %%d (the row number)\n"
             "      --samples S:C      render only sample indices S .. S+C-1 of each pixel\n"
             "                         (parts merge exactly with `rtspheres merge`)\n"
             "      --crop x0,y0,x1,y1 render only that region (row 0 at the top, x1/y1 exclusive)\n"
@@ -61,6 +66,9 @@ static void print_help(FILE *stream)
             "                         soft shadows from area lights: fast, nearly noise-free\n"
             "      --aovs             add layers to the EXR: albedo, normal, depth (first hit) and\n"
             "                         per-pixel variance of luminance, next to R, G, B, samples\n"
+            "      --light-groups     add a layer per light group to the EXR (NAME.R/G/B; `group`\n"
+            "                         clauses of the scene, the rest in 'default'): the layers\n"
+            "                         sum to the image; rtspheres relight reweighs them\n"
             "      --variance         add layers to the EXR: variance.R/G/B, each pixel's sample\n"
             "                         variance of each colour channel (for `rtspheres diff --test z`\n"
             "                         and `rtspheres check`)\n"
@@ -89,10 +97,10 @@ static void print_help(FILE *stream)
 
 enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
-    OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
+    OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_SWEEP, OPTION_DISPLAY, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
-    OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER, OPTION_CAMERA,
-    OPTION_NOISE_THRESHOLD, OPTION_MIN_SPP, OPTION_TIME_LIMIT, OPTION_SAMPLES_MAP,
+    OPTION_LIGHT_GROUPS, OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
+    OPTION_CAMERA, OPTION_NOISE_THRESHOLD, OPTION_MIN_SPP, OPTION_TIME_LIMIT, OPTION_SAMPLES_MAP,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -311,6 +319,15 @@ static int take_part(int option, const char *value, render_arguments *arguments)
         job->frames = arguments->frames.frames;
         job->frame_count = arguments->frames.count;
         return EXIT_OK;
+    case OPTION_SWEEP:
+        sweep_table_free(&arguments->sweep);
+        job->sweep = NULL;
+        if (sweep_table_load(value, &arguments->sweep, &error) != RT_OK) {
+            fprintf(arguments->messages, "%s--sweep: %s\n", arguments->message_prefix, error.message);
+            return EXIT_BAD_INPUT;
+        }
+        job->sweep = &arguments->sweep;
+        return EXIT_OK;
     case OPTION_TILE: return take_split(arguments, "--tile", value, &job->tile_index, &job->tile_count);
     case OPTION_SHARD: return take_split(arguments, "--shard", value, &job->shard_index, &job->shard_count);
     }
@@ -351,8 +368,10 @@ static int take_option(int option, const char *value, render_arguments *argument
     case 'o': job->output = value; break;
     case OPTION_RESUME: job->resume_path = value; break;
     case OPTION_SAMPLES_MAP: job->samples_map = value; break;
+    case OPTION_DISPLAY: arguments->display = value; break;
     case OPTION_CAMERA: job->camera = value; break;
     case OPTION_AOVS: job->aovs = true; break;
+    case OPTION_LIGHT_GROUPS: job->light_groups = true; break;
     case OPTION_VARIANCE: job->variance = true; break;
     case OPTION_DENOISE: job->denoise = true; break;
     case OPTION_FULL_TRACER: job->tracer.full_tracer = true; break;
@@ -368,6 +387,7 @@ static int take_option(int option, const char *value, render_arguments *argument
         complaint = take_whole_number(option, value, arguments);
         break;
     case OPTION_FRAMES:
+    case OPTION_SWEEP:
     case OPTION_TILE:
     case OPTION_SHARD:
         return take_part(option, value, arguments);
@@ -408,6 +428,8 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
         {"device", required_argument, NULL, OPTION_DEVICE},
         {"roulette-depth", required_argument, NULL, OPTION_ROULETTE_DEPTH},
         {"frames", required_argument, NULL, OPTION_FRAMES},
+        {"sweep", required_argument, NULL, OPTION_SWEEP},
+        {"display", required_argument, NULL, OPTION_DISPLAY},
         {"fps", required_argument, NULL, OPTION_FPS},
         {"samples", required_argument, NULL, OPTION_SAMPLES},
         {"crop", required_argument, NULL, OPTION_CROP},
@@ -426,6 +448,7 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
         {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},
         {"aovs", no_argument, NULL, OPTION_AOVS},
+        {"light-groups", no_argument, NULL, OPTION_LIGHT_GROUPS},
         {"variance", no_argument, NULL, OPTION_VARIANCE},
         {"denoise", no_argument, NULL, OPTION_DENOISE},
         {"blur", required_argument, NULL, OPTION_BLUR},
@@ -485,5 +508,6 @@ void render_arguments_free(render_arguments *arguments)
     for (int i = 0; i < arguments->job.define_count; i++)
         free(arguments->define_copies[i]);
     frame_list_free(&arguments->frames);
+    sweep_table_free(&arguments->sweep);
     memset(arguments, 0, sizeof *arguments);
 }

@@ -20,6 +20,8 @@ typedef struct render_arguments {
     bool quiet, verbose;
     int device;                  /* --device N, or -1: let gpu.h choose */
     frame_list frames;
+    sweep_table sweep;           /* --sweep's table (job.sweep points here) */
+    const char *display;         /* --display HOST:PORT, or NULL */
     scene_define defines[RENDER_ARGUMENTS_MAX_DEFINES];
     char *define_copies[RENDER_ARGUMENTS_MAX_DEFINES];  /* NAME\0VALUE of each -D */
     FILE *messages;              /* where complaints go, after message_prefix */

@@ -113,6 +113,7 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_PBR             no pbr material
  *   GPU_OMIT_ALPHA_MASK      no alpha-masked material (the traversal's alpha test)
  *   GPU_OMIT_VERTEX_COLORS   no vertex colour section
+ *   GPU_OMIT_LIGHT_GROUPS    no light group layers asked for (render_options.light_groups)
  *   GPU_FIX_UNIFORMS         the integrator, the sky type and the sampler compiled in as constants
  *                            (the values in the parameters), not read from the
  *                            parameter block
@@ -132,7 +133,8 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_PBR (1u << 12)
 #define GPU_OMIT_ALPHA_MASK (1u << 13)
 #define GPU_OMIT_VERTEX_COLORS (1u << 14)
-#define GPU_VARIANT_BITS 15
+#define GPU_OMIT_LIGHT_GROUPS (1u << 15)
+#define GPU_VARIANT_BITS 16
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct
@@ -223,6 +225,13 @@ rt_status gpu_tracer_set_pass_rectangles(gpu_tracer *tracer, const int *rectangl
 rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
                           rt_error *error);
 
+/* Reads the light group layers (glsl/light_groups.glsl) of a tracer created with
+ * shader.light_group_count > 0 and without GPU_OMIT_LIGHT_GROUPS: layers receives
+ * light_group_count * width * height * 4 floats, layer after layer, rows top to bottom,
+ * (sum of the group's radiance over the samples gathered r, g, b, 0). Other tracers:
+ * RT_ERROR_RUNTIME. */
+rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error);
+
 /* Reads the per-channel sums of squares: squares receives width*height*4 floats, rows top
  * to bottom, (sum of finished samples' squared radiance r^2, g^2, b^2, 0), from which
  * render.c makes the variance layers. */
@@ -240,6 +249,11 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
  * context (frames of an animation whose scene did not change) and did not upload it. The
  * compiled tracer program is always kept by the context between tracers. */
 bool gpu_tracer_reused_scene(const gpu_tracer *tracer);
+
+/* True when gpu_tracer_create() compiled the tracer program for this tracer; false when
+ * the context's program cache already held its variant (frames and sweep rows after the
+ * first, whose variant does not change). */
+bool gpu_tracer_compiled_program(const gpu_tracer *tracer);
 
 /* Frees the tracer's GL objects (not the context's program and packed scene). NULL is
  * ignored. */

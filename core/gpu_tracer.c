@@ -23,9 +23,12 @@ struct gpu_tracer {
     GLuint sample_limits;        /* R32UI per-pixel sample limits (TRACER_SAMPLE_LIMITS_UNIT) */
     int *pass_rectangles;        /* 4 ints each (gpu_tracer_set_pass_rectangles); NULL: all */
     int pass_rectangle_count;
+    GLuint light_group_texture;  /* the light group layers (2D array, rgba32f), or 0 when the
+                                  * program has no light group code */
     int current;                 /* which state set holds the latest pass */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
     bool reused_scene;           /* the packed scene was already on the device */
+    bool compiled_program;       /* its program was compiled for it (not in the cache) */
 };
 
 /* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
@@ -203,6 +206,7 @@ static void variant_defines(uint32_t omitted, const tracer_parameter_block *sett
         {GPU_FIX_UNIFORMS, "RTSPHERES_FIX_UNIFORMS"},
         {GPU_OMIT_LIGHT_CHOICE, "RTSPHERES_OMIT_LIGHT_CHOICE"},
         {GPU_OMIT_RECTANGLE_LIGHTS, "RTSPHERES_OMIT_RECTANGLE_LIGHTS"},
+        {GPU_OMIT_LIGHT_GROUPS, "RTSPHERES_OMIT_LIGHT_GROUPS"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;
@@ -245,6 +249,7 @@ static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *
     GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
     if (program == 0)
         return RT_ERROR_RUNTIME;
+    tracer->compiled_program = true;
     int slot = context->tracer_program_count;
     if (slot == GPU_PROGRAM_CACHE_SIZE) {
         slot = context->next_eviction;
@@ -361,6 +366,28 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     return status;
 }
 
+/* Creates the light group layers when the program collects them: one rgba32f layer per
+ * group (light_group_count), zeroed; a single texel when the program has the code but no
+ * group is asked for (the full tracer), so that its image unit is never unbound. */
+static rt_status create_light_groups(gpu_tracer *tracer, rt_error *error)
+{
+    if (tracer->parameters.omitted_features & GPU_OMIT_LIGHT_GROUPS)
+        return RT_OK;
+    uint32_t layers = tracer->parameters.shader.light_group_count;
+    int width = layers > 0 ? tracer->width : 1, height = layers > 0 ? tracer->height : 1;
+    glGenTextures(1, &tracer->light_group_texture);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tracer->light_group_texture);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, width, height, layers > 0 ? (GLsizei)layers : 1);
+    const GLfloat zero[4] = {0, 0, 0, 0};
+    glClearTexImage(tracer->light_group_texture, 0, GL_RGBA, GL_FLOAT, zero);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    rt_status status = check_gl("creating the light group layers", error);
+    if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
+        return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for %u light group layers of %dx%d (%d MB)",
+                            layers, width, height, (int)((double)width * height * 16 * layers / 1e6));
+    return status;
+}
+
 /* Loads a partial result into the state the first pass reads: the accumulated sums
  * and, as "samples started", the finished counts (a path that was in flight is simply
  * traced again: its random numbers are the same). */
@@ -472,7 +499,9 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->parameters.resume = NULL;
     glGenBuffers(1, &tracer->parameter_buffer);
     upload_parameters(tracer);
-    status = check_gl("setting up the tracer", error);
+    status = create_light_groups(tracer, error);
+    if (status == RT_OK)
+        status = check_gl("setting up the tracer", error);
     if (status != RT_OK) {
         gpu_tracer_destroy(tracer);
         return status;
@@ -500,6 +529,9 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
     glActiveTexture(GL_TEXTURE0 + TRACER_SAMPLE_LIMITS_UNIT);
     glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
+    if (tracer->light_group_texture != 0)
+        glBindImageTexture(TRACER_LIGHT_GROUP_IMAGE_UNIT, tracer->light_group_texture, 0, GL_TRUE, 0, GL_READ_WRITE,
+                           GL_RGBA32F);
     glBindVertexArray(tracer->vertex_array);
     if (tracer->pass_rectangles == NULL) {
         glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -513,7 +545,10 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
         }
         glDisable(GL_SCISSOR_TEST);
     }
-    glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    /* Image stores of this pass are read by the next pass and by the read-back. */
+    glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT
+                    | (tracer->light_group_texture != 0 ? GL_SHADER_IMAGE_ACCESS_BARRIER_BIT
+                                                              | GL_TEXTURE_UPDATE_BARRIER_BIT : 0));
     GLuint counters[2] = {0, 0};
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof counters, counters);
     tracer->current = target;
@@ -600,6 +635,29 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
     return check_gl("reading the result", error);
 }
 
+rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error)
+{
+    uint32_t count = tracer->parameters.shader.light_group_count;
+    if (tracer->light_group_texture == 0 || count == 0)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: this tracer collects no light groups");
+    size_t row_floats = (size_t)tracer->width * 4, layer_floats = row_floats * tracer->height;
+    float *bottom_up = malloc(layer_floats * count * sizeof(float));
+    if (bottom_up == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the light groups");
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, tracer->light_group_texture);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA, GL_FLOAT, bottom_up);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    for (uint32_t layer = 0; layer < count; layer++)
+        for (int row = 0; row < tracer->height; row++)
+            memcpy(layers + layer * layer_floats + (size_t)row * row_floats,
+                   bottom_up + layer * layer_floats + (size_t)(tracer->height - 1 - row) * row_floats,
+                   row_floats * sizeof(float));
+    free(bottom_up);
+    return check_gl("reading the light groups", error);
+}
+
 rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error)
 {
     glActiveTexture(GL_TEXTURE0);
@@ -670,6 +728,11 @@ bool gpu_tracer_reused_scene(const gpu_tracer *tracer)
     return tracer->reused_scene;
 }
 
+bool gpu_tracer_compiled_program(const gpu_tracer *tracer)
+{
+    return tracer->compiled_program;
+}
+
 void gpu_tracer_destroy(gpu_tracer *tracer)
 {
     if (tracer == NULL)
@@ -683,6 +746,7 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
         glDeleteTextures(1, &tracer->packed_texture);
         glDeleteBuffers(1, &tracer->packed_buffer);
     }
+    glDeleteTextures(1, &tracer->light_group_texture);
     glDeleteBuffers(1, &tracer->counter_buffer);
     glDeleteBuffers(1, &tracer->parameter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);

@@ -31,7 +31,7 @@
 extern "C" {
 #endif
 
-#define IMAGE_MAX_CHANNELS 32
+#define IMAGE_MAX_CHANNELS 128
 #define IMAGE_CHANNEL_NAME_MAX 32
 
 typedef struct rt_image {

@@ -1,7 +1,7 @@
 /* metadata_keys.h: the names of the rtspheres:* metadata in the EXR files rtspheres writes,
  * spelled once. The writer is core/render_output.c (for renders, their partial files and
  * merges); the readers are core/merge.c (merge_read_part), core/render_output.c (resuming
- * a partial) and cli/command_stats.c.
+ * a partial), core/relight.c and cli/command_stats.c.
  *
  *   key               type      what it says
  *   version           string    the rtspheres version that wrote the file
@@ -24,6 +24,9 @@
  *   min_spp           int       --min-spp as used (0 without adaptive sampling); renders only
  *   render_seconds    float     the render's time (a merge: summed over its parts)
  *   merged_parts      int       only in a merge's output: how many parts it merged
+ *   light_groups      string    only with light group layers (--light-groups, relight): the
+ *                               groups' names, comma-separated; group NAME's layer is the
+ *                               channels NAME.R, NAME.G, NAME.B
  * "text" values are whole numbers stored as decimal text, since an OpenEXR int attribute
  * holds 32 bits only.
  */
@@ -46,17 +49,18 @@
 #define METADATA_KEY_STOP_REASON "rtspheres:stop_reason"
 #define METADATA_KEY_NOISE_THRESHOLD "rtspheres:noise_threshold"
 #define METADATA_KEY_MIN_SPP "rtspheres:min_spp"
+#define METADATA_KEY_LIGHT_GROUPS "rtspheres:light_groups"
 
 /* Every key, in the order `rtspheres stats` prints them: an initializer for an array of
  * METADATA_KEY_COUNT strings. */
-#define METADATA_KEY_COUNT 16
+#define METADATA_KEY_COUNT 17
 #define METADATA_KEYS_IN_STATS_ORDER                                                                         \
     {                                                                                                        \
         METADATA_KEY_VERSION, METADATA_KEY_SCENE, METADATA_KEY_SCENE_HASH, METADATA_KEY_FRAME, METADATA_KEY_SPP, \
             METADATA_KEY_SEED, METADATA_KEY_MAX_DEPTH, METADATA_KEY_SAMPLE_START, METADATA_KEY_SAMPLES_FINISHED, \
             METADATA_KEY_PATH_SEGMENTS, METADATA_KEY_COMPLETE, METADATA_KEY_STOP_REASON,                      \
             METADATA_KEY_NOISE_THRESHOLD, METADATA_KEY_MIN_SPP, METADATA_KEY_RENDER_SECONDS,                 \
-            METADATA_KEY_MERGED_PARTS,                                                                       \
+            METADATA_KEY_MERGED_PARTS, METADATA_KEY_LIGHT_GROUPS,                                            \
     }
 
 #endif

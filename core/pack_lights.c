@@ -68,6 +68,7 @@ static void write_area_lights(packer *p, double *power)
         put_texel(p->texels, base + 2, float_bits(normal[0]), float_bits(normal[1]), float_bits(normal[2]),
                   float_bits((float)(luminance * area)));
         put_texel(p->texels, base + 3, float_bits((float)area), 0, 0, 0);
+        put_texel(p->texels, base + 4, (uint32_t)s->materials[item->material].light_group, 0, 0, 0);
         p->out->summary.light_types |= 1u << type;
         light++;
     }
@@ -125,6 +126,7 @@ static void write_scene_lights(packer *p, uint32_t first, double radius, double 
                   float_bits((float)(type == LIGHT_SUN ? cos_sun : cos_outer)));
         put_texel(p->texels, base + 3, float_bits(source->direction[0]), float_bits(source->direction[1]),
                   float_bits(source->direction[2]), float_bits((float)cos_inner));
+        put_texel(p->texels, base + 4, (uint32_t)source->light_group, 0, 0, 0);
         p->out->summary.light_types |= 1u << type;
     }
 }
@@ -178,6 +180,7 @@ static rt_status write_environment(packer *p, uint32_t light, double radius, dou
     put_texel(texels, base, LIGHT_ENVIRONMENT, (uint32_t)width, (uint32_t)height, 0);
     /* The irradiance it gives a surface facing any way, about pi x its mean radiance. */
     put_texel(texels, base + 2, 0, 0, 0, float_bits((float)(M_PI * mean * p->scene->sky.intensity)));
+    put_texel(texels, base + 4, (uint32_t)p->scene->sky.light_group, 0, 0, 0);
     p->out->summary.light_types |= 1u << LIGHT_ENVIRONMENT;
     return RT_OK;
 }

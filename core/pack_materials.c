@@ -45,8 +45,10 @@ void pack_write_materials(packer *p)
         uint64_t base = p->layout.material_offset + i * PACKED_MATERIAL_STRIDE;
         put_texel(p->texels, base + 0, (uint32_t)m.type | flags, float_bits(m.albedo[0]), float_bits(m.albedo[1]),
                   float_bits(m.albedo[2]));
+        /* texel 1 .w: the metal's fuzz, any other's light group (what an emitter's light goes to). */
         put_texel(p->texels, base + 1, float_bits(m.emission[0]), float_bits(m.emission[1]),
-                  float_bits(m.emission[2]), float_bits(m.fuzz));
+                  float_bits(m.emission[2]),
+                  m.type == MATERIAL_METAL ? float_bits(m.fuzz) : (uint32_t)m.light_group);
         put_texel(p->texels, base + 2, float_bits(m.index_of_refraction),
                   m.albedo_texture >= 0 ? (uint32_t)m.albedo_texture : PACKED_NONE,
                   m.emission_texture >= 0 ? (uint32_t)m.emission_texture : PACKED_NONE,

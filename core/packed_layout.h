@@ -79,6 +79,8 @@
  *   texel 2 = (index of refraction, albedo texture, emission texture, normal map image)
  *             (texture and image indices, or PACKED_NONE)
  *   texel 3 = (Phong exponent, Phong specular colour.rgb)      Whitted integrator only
+ *   emitters (emissive, pbr): texel 1 .w = the light group (scene.h light_groups; fuzz is
+ *   metal's)
  *   texel 4 = (metallic, roughness, transmission, metallic-roughness image)        pbr only
  *   texel 5 = (alpha, alpha cutoff, alpha image, 0)                                pbr only
  * The type word is the MATERIAL_* tag in its low MATERIAL_TYPE_BITS bits and MATERIAL_FLAG_*
@@ -186,13 +188,14 @@
 #define IMAGE_WRAP_MIRROR 2
 #define IMAGE_WRAP_V_SHIFT 2
 
-/* ---- lights: 4 texels (what next-event estimation samples: see glsl/lights.glsl for how
+/* ---- lights: 5 texels (what next-event estimation samples: see glsl/lights.glsl for how
  * one is chosen: by power, or by its estimated irradiance at the point)
  *   texel 0 = (type tag, primitive slot (area lights), 0, 0) -- see below for the others
  *   texel 1 = (position.xyz (point, spot) or direction towards the light (sun), cdf)
  *             cdf: the probability of choosing this light or any before it
  *   texel 2 = (intensity colour.rgb (point, spot: per steradian; sun: irradiance), 0)
  *   texel 3 = (spot direction.xyz, cos of the spot's inner half-angle)
+ *   texel 4 = (light group (scene.h light_groups; the environment: the sky's), 0, 0, 0)
  *   point, spot, sun: texel 0 .yzw = polynomial attenuation c, l, q (all 0: inverse square),
  *   texel 1 .xyz = position (point, spot) or the direction towards the sun, texel 2 .w = cos
  *   of the spot's outer half-angle or of the sun's angular radius.
@@ -205,7 +208,7 @@
  * intensity); it is importance-sampled by the environment section: one float per texel
  * (in .x): the cumulative distribution over rows (height values), then for each row the
  * cumulative distribution over its pixels (width values), of luminance x sin(latitude). */
-#define PACKED_LIGHT_STRIDE 4
+#define PACKED_LIGHT_STRIDE 5
 #define LIGHT_SPHERE 0
 #define LIGHT_QUAD 1
 #define LIGHT_TRIANGLE 2

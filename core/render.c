@@ -80,6 +80,8 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     p->integrator = options->integrator;
     p->light_sampling = !options->no_light_sampling;
     memcpy(p->ambient, s->ambient, sizeof p->ambient);
+    p->light_group_count = options->light_groups ? (uint32_t)s->light_group_count : 0;
+    p->sky_light_group = (uint32_t)s->sky.light_group;
     p->pass_work_budget = (int32_t)(options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET);
 }
 
@@ -125,6 +127,8 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_ALPHA_MASK;
     if (!contents->vertex_colors)
         omitted |= GPU_OMIT_VERTEX_COLORS;
+    if (!options->light_groups)
+        omitted |= GPU_OMIT_LIGHT_GROUPS;
     return omitted;
 }
 
@@ -173,6 +177,42 @@ static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image 
             pixels[4 * i + c] = count > 0 ? pixels[4 * i + c] / count : 0.0f;
     }
     snprintf(image->channel_names[3], IMAGE_CHANNEL_NAME_MAX, "samples");
+    return RT_OK;
+}
+
+/* Reads the light group layers into a new image of the colour's size: NAME.R/G/B per group
+ * of s, each the group's sum over a pixel's finished samples divided by their count (the
+ * fourth channel of colour), as read_image makes the beauty's means. The caller frees
+ * groups. */
+static rt_status read_light_groups(gpu_tracer *tracer, const scene *s, const rt_image *colour, rt_image *groups,
+                                   rt_error *error)
+{
+    int width = colour->width, height = colour->height, count = s->light_group_count;
+    size_t pixel_count = (size_t)width * height;
+    float *layers = malloc(pixel_count * 4 * (size_t)count * sizeof(float));
+    if (layers == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for the light groups");
+    rt_status status = gpu_tracer_read_light_groups(tracer, layers, error);
+    if (status == RT_OK)
+        status = image_create(groups, width, height, 3 * count, error);
+    if (status != RT_OK) {
+        free(layers);
+        return status;
+    }
+    static const char channels[3] = {'R', 'G', 'B'};
+    for (int g = 0; g < count; g++) {
+        for (int c = 0; c < 3; c++)
+            snprintf(groups->channel_names[3 * g + c], IMAGE_CHANNEL_NAME_MAX, "%s.%c", s->light_groups[g],
+                     channels[c]);
+        const float *layer = layers + (size_t)g * pixel_count * 4;
+        for (size_t i = 0; i < pixel_count; i++) {
+            float samples = colour->pixels[4 * i + 3];
+            for (int c = 0; c < 3; c++)
+                groups->pixels[i * 3 * (size_t)count + 3 * (size_t)g + c] = samples > 0 ? layer[4 * i + c] / samples
+                                                                                        : 0.0f;
+        }
+    }
+    free(layers);
     return RT_OK;
 }
 
@@ -344,6 +384,9 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
         traced[2] = region[2] + reach < s->render.width ? region[2] + reach : s->render.width;
         traced[3] = region[3] + reach < s->render.height ? region[3] + reach : s->render.height;
     }
+    /* A partial file keeps no light groups (and its paths in flight are traced again). */
+    if (options->light_groups && options->resume != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT, "RENDER: light groups cannot be resumed from a partial render");
     int width = region[2] - region[0], height = region[3] - region[1];
 
     camera_frame frame;
@@ -519,20 +562,26 @@ static bool pass_fits_deadline(gpu_tracer *tracer, const render_options *options
     return true;
 }
 
-/* Writes a checkpoint of the image so far (cut to region) through options->checkpoint. */
-static rt_status write_checkpoint(gpu_tracer *tracer, const render_options *options, const int traced[4],
-                                  const int region[4], uint64_t scene_hash, rt_error *error)
+/* Reads the image so far once (cut to region) and hands it to options->checkpoint when
+ * checkpoint_due and to options->preview (--display) when preview_due. */
+static rt_status write_partial(gpu_tracer *tracer, const render_options *options, const int traced[4],
+                               const int region[4], uint64_t scene_hash, bool checkpoint_due, bool preview_due,
+                               rt_error *error)
 {
     rt_image partial;
     uint64_t partial_samples;
     rt_status status = read_image(tracer, traced[2] - traced[0], traced[3] - traced[1], &partial, NULL, NULL,
                                   &partial_samples, error);
-    if (status == RT_OK && memcmp(traced, region, 4 * sizeof *traced) != 0) {
+    if (status != RT_OK)
+        return status;
+    if (memcmp(traced, region, 4 * sizeof *traced) != 0) {
         status = crop_to_region(&partial, traced, region, error);
         partial_samples = status == RT_OK ? sample_total(&partial) : 0;
     }
-    if (status == RT_OK)
+    if (status == RT_OK && checkpoint_due)
         status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, scene_hash, error);
+    if (status == RT_OK && preview_due)
+        options->preview(options->preview_context, &partial);
     image_free(&partial);
     return status;
 }
@@ -548,7 +597,7 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
                             uint32_t initial_budget, double start, render_progress *progress,
                             render_stop_reason *stop, render_result *result, rt_error *error)
 {
-    double last_checkpoint = clock_seconds();
+    double last_checkpoint = clock_seconds(), last_preview = clock_seconds();
     double first_pass_end = 0, last_pass_seconds = 0;
     bool adaptive_budget = options->pass_work_budget == 0;
     gpu_info device;
@@ -606,10 +655,18 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
             *stop = RENDER_STOP_INTERRUPTED;
             break;
         }
-        if (status == RT_OK && options->checkpoint != NULL && options->checkpoint_seconds > 0
-            && clock_seconds() - last_checkpoint >= options->checkpoint_seconds) {
-            status = write_checkpoint(tracer, options, traced, region, result->scene_hash, error);
-            last_checkpoint = clock_seconds();
+        /* Checkpoints and previews (--display) share one read-back when both are due. */
+        bool checkpoint_due = options->checkpoint != NULL && options->checkpoint_seconds > 0
+                              && clock_seconds() - last_checkpoint >= options->checkpoint_seconds;
+        bool preview_due = options->preview != NULL && options->preview_seconds > 0
+                           && clock_seconds() - last_preview >= options->preview_seconds;
+        if (status == RT_OK && (checkpoint_due || preview_due)) {
+            status = write_partial(tracer, options, traced, region, result->scene_hash, checkpoint_due, preview_due,
+                                   error);
+            if (checkpoint_due)
+                last_checkpoint = clock_seconds();
+            if (preview_due)
+                last_preview = clock_seconds();
         }
     }
     end_adaptive(&adaptive);
@@ -619,8 +676,8 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
 /* The read-back of render_scene: the image (and the AOVs and variance layers asked for) into
  * *result, with the path segments; an error, with nothing allocated, when a path
  * reached the work cap. */
-static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const render_options *options, int width,
-                             int height, render_result *result, rt_error *error)
+static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const scene *s, const render_options *options,
+                             int width, int height, render_result *result, rt_error *error)
 {
     gpu_tracer_totals totals = {0};
     float *luminance_squares = NULL;
@@ -637,9 +694,12 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const ren
     if (status == RT_OK && options->variance)
         status = add_variance_layers(tracer, width, height, result, error);
     free(luminance_squares);
+    if (status == RT_OK && options->light_groups)
+        status = read_light_groups(tracer, s, &result->image, &result->light_groups, error);
     if (status != RT_OK) {
         image_free(&result->image);
         image_free(&result->aovs);
+        image_free(&result->light_groups);
         return status;
     }
     if (totals.traversal_overflows > 0) {
@@ -647,6 +707,7 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const ren
         gpu_get_info(context, &device);
         image_free(&result->image);
         image_free(&result->aovs);
+        image_free(&result->light_groups);
         return rt_error_set(error, RT_ERROR_RUNTIME,
                             "RENDER: %.0f paths reached the shader's work cap (%d loop iterations per pass, "
                             "`rtspheres info`) or the traversal stack and were cut short; the image would be "
@@ -676,6 +737,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (status != RT_OK)
         return status;
     result->reused_scene = gpu_tracer_reused_scene(tracer);
+    result->compiled_program = gpu_tracer_compiled_program(tracer);
     int traced_width = traced[2] - traced[0], traced_height = traced[3] - traced[1];
 
     render_progress progress = {
@@ -686,17 +748,20 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     status = run_passes(context, tracer, options, (uint32_t)s->render.samples_per_pixel, traced, region, budget,
                         start, &progress, &stop, result, error);
     if (status == RT_OK)
-        status = read_result(context, tracer, options, traced_width, traced_height, result, error);
+        status = read_result(context, tracer, s, options, traced_width, traced_height, result, error);
     gpu_tracer_destroy(tracer);
     if (status == RT_OK && memcmp(traced, region, sizeof traced) != 0) {
         status = crop_to_region(&result->image, traced, region, error);
         if (status == RT_OK)
             status = crop_to_region(&result->aovs, traced, region, error);
         if (status == RT_OK)
+            status = crop_to_region(&result->light_groups, traced, region, error);
+        if (status == RT_OK)
             result->samples = sample_total(&result->image);
         if (status != RT_OK) {
             image_free(&result->image);
             image_free(&result->aovs);
+            image_free(&result->light_groups);
         }
     }
     if (status != RT_OK)

@@ -87,6 +87,8 @@ typedef struct render_options {
     int sampler;                 /* SAMPLER_* of tracer_interface.h: 0, the default, is
                                   * SAMPLER_SOBOL; SAMPLER_INDEPENDENT for comparisons */
     bool aovs;                   /* also render the AOV image (see render_result.aovs) */
+    bool light_groups;           /* also collect each light group's image (see
+                                  * render_result.light_groups); not with resume */
     bool variance;               /* also make the variance layers (see render_result.aovs) */
     uint32_t russian_roulette_depth;
     uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */
@@ -111,6 +113,11 @@ typedef struct render_options {
     rt_status (*checkpoint)(void *checkpoint_context, const rt_image *partial, uint64_t samples, uint64_t scene_hash,
                             rt_error *error);
     void *checkpoint_context;
+    /* Every preview_seconds (0: never), between passes, preview() receives the image so far
+     * (the same layout as the result: means and samples); for a live view (--display). */
+    double preview_seconds;
+    void (*preview)(void *preview_context, const rt_image *partial);
+    void *preview_context;
 } render_options;
 
 typedef struct render_result {
@@ -124,6 +131,12 @@ typedef struct render_result {
                                   * pixel's finished samples: the variance of the pixel's
                                   * mean is it / (samples - 1)); empty when neither is
                                   * asked; free with image_free() */
+    rt_image light_groups;       /* with options.light_groups: NAME.R, NAME.G, NAME.B for each
+                                  * of the scene's light groups in order (scene.h), the mean
+                                  * radiance of that group alone: the groups sum to image's
+                                  * R, G, B up to float rounding (an interrupted render's
+                                  * groups also hold part of the paths then in flight);
+                                  * free with image_free() */
     uint64_t samples;            /* samples finished over all pixels */
     double seconds;              /* whole render, including set-up */
     double first_pass_seconds;   /* from the start until the first pass finished */
@@ -140,6 +153,8 @@ typedef struct render_result {
     uint32_t triangle_count;     /* triangles stored (a mesh once however often placed) */
     uint32_t primitive_count, instance_count, light_count;
     bool reused_scene;           /* the device already held this packed scene (frames) */
+    bool compiled_program;       /* the tracer program was compiled for this render (not
+                                  * found in the context's cache) */
     uint64_t scene_hash;         /* FNV-1a of what decides the image apart from the samples:
                                   * packed scene, camera, sky, full size, max depth. Parts of
                                   * one render share it; `merge` refuses mixed hashes. */

@@ -23,6 +23,7 @@ typedef struct job_run {
     render_job_callbacks callbacks;      /* the caller's, or all NULL */
     render_job_failure failure;          /* where the run stopped short */
     bool image_begun;                    /* an image has begun (its limit counted from then) */
+    int sweep_row;                       /* the sweep row being rendered, -1: none */
 } job_run;
 
 /* One image being rendered: its scene (render settings after the job's overrides and
@@ -39,7 +40,8 @@ typedef struct job_image {
 static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
 {
     const render_job *job = run->job;
-    scene_define *defines = malloc(((size_t)job->define_count + 2) * sizeof *defines);
+    int columns = job->sweep != NULL && run->sweep_row >= 0 ? job->sweep->column_count : 0;
+    scene_define *defines = malloc(((size_t)job->define_count + 2 + (size_t)columns) * sizeof *defines);
     if (defines == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory for the scene's variables");
     run->failure = RENDER_JOB_FAILURE_SCENE;
@@ -47,12 +49,29 @@ static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
     scene_parse_options parse_options = scene_parse_options_defaults();
     parse_options.defines = defines;
     parse_options.define_count = render_job_scene_defines(job, frame, defines, &values);
+    for (int c = 0; c < columns; c++)
+        defines[parse_options.define_count++] = (scene_define){
+            .name = job->sweep->names[c],
+            .value = job->sweep->values[(size_t)run->sweep_row * columns + c],
+        };
     /* A glTF file is a scene by itself (scene_gltf.h); render_job_check() refused defines
      * for it, and its frames' $frame and $time are optional. */
     rt_status status = scene_gltf_is_model_path(job->scene_path)
                            ? scene_gltf_load_file(job->scene_path, job->camera, s, error)
                            : scene_load_file(job->scene_path, &parse_options, s, error);
     free(defines);
+    /* A column the scene does not use is the table's mistake: say where. */
+    for (int c = 0; c < columns && status == RT_ERROR_INPUT; c++) {
+        char expected[2 * SWEEP_NAME_MAX + 64];
+        snprintf(expected, sizeof expected, "-D %s: the scene never sets or uses $%s", job->sweep->names[c],
+                 job->sweep->names[c]);
+        if (strstr(error->message, expected) != NULL) {
+            status = rt_error_set(error, RT_ERROR_INPUT, "%s:%d: column '%s': the scene never sets or uses $%s",
+                                  job->sweep->path, job->sweep->header_line, job->sweep->names[c],
+                                  job->sweep->names[c]);
+            run->failure = RENDER_JOB_FAILURE_IMAGE;
+        }
+    }
     if (status == RT_OK) {
         status = scene_load_assets(s, error);
         if (status != RT_OK)
@@ -77,6 +96,11 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
     placed.full_height = settings->height;
     char hash[24];
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)result->scene_hash);
+    /* The layers' names (the partial file keeps none). */
+    char groups[SCENE_LIGHT_GROUP_MAX * (SCENE_LIGHT_GROUP_NAME_MAX + 1) + 1] = "";
+    for (int g = 0; complete && job->light_groups && g < image->scene.light_group_count; g++)
+        snprintf(groups + strlen(groups), sizeof groups - strlen(groups), "%s%s", g > 0 ? "," : "",
+                 image->scene.light_groups[g]);
     render_output_metadata metadata = {
         .scene = job->scene_path,
         .scene_hash = hash,
@@ -89,6 +113,7 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
         .path_segments = result->path_segments,
         .complete = complete,
         .render_seconds = result->seconds,
+        .light_groups = groups[0] != '\0' ? groups : NULL,
     };
     if (!checkpoint) {
         bool adaptive = job->tracer.noise_threshold > 0;
@@ -208,6 +233,27 @@ static rt_status write_samples_map(const char *path, const rt_image *image, int 
     return status;
 }
 
+/* Moves the result's light group layers (if any) after its AOVs, where the writer takes
+ * the layers of an EXR from. */
+static rt_status add_light_groups(render_result *result, rt_error *error)
+{
+    if (result->light_groups.pixels == NULL)
+        return RT_OK;
+    if (result->aovs.pixels == NULL) {
+        result->aovs = result->light_groups;
+        result->light_groups = (rt_image){0};
+        return RT_OK;
+    }
+    rt_image joined = {0};
+    rt_status status = image_append_channels(&result->aovs, &result->light_groups, &joined, error);
+    if (status != RT_OK)
+        return status;
+    image_free(&result->aovs);
+    image_free(&result->light_groups);
+    result->aovs = joined;
+    return RT_OK;
+}
+
 /* After the passes: writes the result, post-processed, to the output when the render
  * finished, else (render_status RT_ERROR_INTERRUPTED) as it is to the partial file, which
  * the message then names. */
@@ -229,6 +275,8 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
                             (unsigned long long)result->samples, plan->partial, plan->partial);
     }
     rt_status status = postprocess_result(image->run->job, plan->output, result, error);
+    if (status == RT_OK)
+        status = add_light_groups(result, error);
     if (status != RT_OK)
         return status;
     status = write_image(image, &result->image, plan->output, result->samples,
@@ -257,6 +305,7 @@ static void image_render_options(job_image *image, render_options *options)
     options->sample_start = image->plan.sample_start;
     memcpy(options->region, image->plan.region, sizeof options->region);
     options->aovs = job->aovs || job->denoise;
+    options->light_groups = job->light_groups;
     options->variance = job->variance;
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;
@@ -303,6 +352,7 @@ static rt_status render_image(job_image *image, rt_error *error)
         status = finish_image(image, &result, status, error);
         image_free(&result.image);
         image_free(&result.aovs);
+        image_free(&result.light_groups);
     }
     image_free(&resume_image);
     return status;
@@ -327,7 +377,7 @@ static rt_status run_image(job_run *run, int frame, const char *output, rt_error
     run->failure = RENDER_JOB_FAILURE_IMAGE;
     scene *s = &image->scene;
     /* Asset warnings (a missing MTL file, ...): once, with the first frame of the list. */
-    bool first_frame = frame < 0 || frame == job->frames[0];
+    bool first_frame = frame < 0 ? run->sweep_row <= 0 : frame == job->frames[0];
     for (int i = 0; i < s->warning_count && first_frame && run->callbacks.warning != NULL; i++)
         run->callbacks.warning(run->callbacks.user, s->warnings[i].message);
     render_job_apply_overrides(job, &s->render);
@@ -381,6 +431,31 @@ static rt_status run_frames(job_run *run, render_job_summary *summary, rt_error 
     return status;
 }
 
+/* Renders the job's sweep rows (those of its shard) in order. */
+static rt_status run_sweep(job_run *run, render_job_summary *summary, rt_error *error)
+{
+    const render_job *job = run->job;
+    rt_status status = RT_OK;
+    for (int row = 0; row < job->sweep->row_count && status == RT_OK && !stop_requested(job); row++) {
+        if (!render_job_includes_frame(job, &run->plan, row))
+            continue;
+        char name[RENDER_JOB_PATH_MAX];
+        run->failure = RENDER_JOB_FAILURE_IMAGE;
+        status = sweep_output_name(job->output, job->sweep, row, name, sizeof name, error);
+        if (status != RT_OK)
+            break;
+        summary->images_started++;
+        run->sweep_row = row;
+        status = run_image(run, -1, name, error);
+    }
+    run->sweep_row = -1;
+    if (status == RT_OK && stop_requested(job)) {
+        run->failure = RENDER_JOB_FAILURE_STOPPED;
+        status = rt_error_set(error, RT_ERROR_INTERRUPTED, "interrupted between sweep rows; every row begun is written");
+    }
+    return status;
+}
+
 rt_status render_job_run(gpu_context *context, const render_job *job, const render_job_callbacks *callbacks,
                          render_job_summary *summary, rt_error *error)
 {
@@ -388,7 +463,7 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
     if (summary == NULL)
         summary = &ignored;
     memset(summary, 0, sizeof *summary);
-    job_run run = {.context = context, .job = job};
+    job_run run = {.context = context, .job = job, .sweep_row = -1};
     if (callbacks != NULL)
         run.callbacks = *callbacks;
     rt_status status = render_job_check(job, &run.plan, error);
@@ -397,7 +472,9 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
         return status;
     }
     double start = clock_seconds();
-    if (job->frame_count == 0) {
+    if (job->sweep != NULL) {
+        status = run_sweep(&run, summary, error);
+    } else if (job->frame_count == 0) {
         summary->images_started = 1;
         status = run_image(&run, -1, run.plan.first_output, error);
     } else {

@@ -34,6 +34,9 @@
  *   resume_path             NULL: start afresh; else continue that partial file
  *   checkpoint_seconds      0: never; else write the partial file that often
  *   aovs                    add the AOV layers (render.h) to an EXR
+ *   light_groups            add a layer per light group (render.h render_result.light_groups,
+ *                           NAME.R/G/B) to an EXR; not with denoise, blur, resume, sample
+ *                           ranges, tiles or shards other than by frames
  *   variance                add the variance layers variance.R/G/B (render.h) to an EXR
  *   denoise                 postprocess_denoise() guided by the AOVs; an EXR keeps the noisy
  *                           colour as noisy.R/G/B
@@ -57,6 +60,10 @@
  *                           stop_requested, deadline, resume and checkpoint fields itself.
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
+ *   sweep                   NULL: none; else a sweep table (sweep.h): one image per row,
+ *                           each row's values as defines after the job's, the output
+ *                           pattern formatted per row (sweep_output_name); rows shard
+ *                           as frames do; not with frames or resume
  *
  * ## Planning
  * render_job_check() checks the fields against each other and against the file system
@@ -95,6 +102,7 @@
 #include "scene.h"
 #include "scene_parse.h"
 #include "status.h"
+#include "sweep.h"
 
 #define RENDER_JOB_PATH_MAX 4096
 #define RENDER_JOB_DEFAULT_FRAMES_PER_SECOND 24.0
@@ -127,6 +135,7 @@ typedef struct render_job {
     const char *resume_path;
     double checkpoint_seconds;
     bool aovs;
+    bool light_groups;
     bool variance;
     bool denoise;
     float blur_sigma;
@@ -138,6 +147,7 @@ typedef struct render_job {
     double time_limit_start;
     render_options tracer;
     const volatile sig_atomic_t *stop_requested;
+    const sweep_table *sweep;
 } render_job;
 
 /* What render_job_check() found: the first output name and the shard resolved. */
@@ -216,11 +226,13 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * with the first rule broken, in this order: a define of frame or time with frames; the
  * first output name (batch.h's errors; several frames and no frame number in the
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
- * without EXR; variance without EXR; variance with resume; resume with several frames; shard_by without shard; a shard by frames
- * without frames, or with no frame; a shard by samples with a sample range; a shard by
- * tiles with crop or tile; a samples map with several frames or of an unknown format;
- * a minimum spp without a noise threshold; a noise threshold
- * with a shard by samples, a sample range or resume. */
+ * without EXR; variance without EXR; variance with resume; resume with several frames;
+ * shard_by without shard; a shard by frames without frames, or with no frame; light groups
+ * (see the job); a shard by samples with a sample range; a shard by tiles with crop or
+ * tile; light groups with a shard not by frames; a samples map with several frames or of an unknown
+ * format; a minimum spp without a noise threshold; a noise threshold with a shard by samples,
+ * a sample range or resume; a sweep with frames, resume or a define
+ * of one of its columns, two of its rows writing one file (the table's file:line). */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 
 /* True when the frame at position index of job->frames is this job's to render (always,

@@ -4,6 +4,7 @@
 #include "render_job.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "batch.h"
@@ -55,7 +56,9 @@ static rt_status plan_first_output(const render_job *job, render_job_plan *plan,
     }
     int first_frame = job->frame_count > 0 ? job->frames[0] : -1;
     rt_status status =
-        render_job_output_name(job, plan, first_frame, plan->first_output, sizeof plan->first_output, error);
+        job->sweep != NULL
+            ? sweep_output_name(job->output, job->sweep, 0, plan->first_output, sizeof plan->first_output, error)
+            : render_job_output_name(job, plan, first_frame, plan->first_output, sizeof plan->first_output, error);
     if (status != RT_OK)
         return status;
     if (job->frame_count > 1 && !output_pattern_has_frame(job->output))
@@ -81,6 +84,65 @@ static rt_status check_first_output(const render_job *job, const char *output, r
     return RT_OK;
 }
 
+/* Checks --light-groups against the output and the other options: its layers need an
+ * EXR; they must sum to the beauty, which denoise and blur change; a partial file and
+ * merge keep no layers (no resume, sample ranges or tiles). */
+static rt_status check_light_groups(const render_job *job, const char *output, rt_error *error)
+{
+    if (!job->light_groups)
+        return RT_OK;
+    if (image_format_of(output) != IMAGE_FORMAT_EXR)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups writes a layer per light group, which only .exr keeps; not '%s' "
+                            "(rtspheres relight makes other formats from the EXR)", output);
+    if (job->denoise || job->blur_sigma > 0)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups with --%s: the layers would no longer sum to the image; relight, "
+                            "then post-process", job->denoise ? "denoise" : "blur");
+    if (job->resume_path != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT, "--light-groups cannot --resume: a partial file keeps no layers");
+    if (job->sample_count > 0 || job->tile_count)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups with --%s: merge keeps no light group layers; render whole images",
+                            job->sample_count > 0 ? "samples" : "tile");
+    return RT_OK;
+}
+
+/* Checks a sweep against the job: no frames, no resume, no define of a column, and every
+ * row's output its own file that is not the scene (the table's file:line of the row). */
+static rt_status check_sweep(const render_job *job, rt_error *error)
+{
+    const sweep_table *table = job->sweep;
+    if (table == NULL)
+        return RT_OK;
+    if (job->frame_count > 0)
+        return rt_error_set(error, RT_ERROR_INPUT, "--sweep and --frames both make a list of images; give one");
+    if (job->resume_path != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT, "--resume continues one image, not a sweep's rows");
+    for (int c = 0; c < table->column_count; c++)
+        if (last_define(job, table->names[c]) != NULL)
+            return rt_error_set(error, RT_ERROR_INPUT, "%s:%d: column '%s' and -D %s both set $%s; give one",
+                                table->path, table->header_line, table->names[c], table->names[c], table->names[c]);
+    char(*names)[RENDER_JOB_PATH_MAX] = malloc((size_t)table->row_count * sizeof *names);
+    if (names == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory for the sweep's output names");
+    rt_status status = RT_OK;
+    for (int r = 0; r < table->row_count && status == RT_OK; r++) {
+        status = sweep_output_name(job->output, table, r, names[r], sizeof names[r], error);
+        if (status == RT_OK && path_same_file(names[r], job->scene_path))
+            status = rt_error_set(error, RT_ERROR_INPUT, "%s:%d: this row's output '%s' is the scene file",
+                                  table->path, table->lines[r], names[r]);
+        for (int k = 0; k < r && status == RT_OK; k++)
+            if (strcmp(names[k], names[r]) == 0)
+                status = rt_error_set(error, RT_ERROR_INPUT,
+                                      "%s:%d: this row writes '%s', as the row of line %d does; put {NAME} or "
+                                      "%%d in the output pattern", table->path, table->lines[r], names[r],
+                                      table->lines[k]);
+    }
+    free(names);
+    return status;
+}
+
 /* Resolves the shard (its kind, and for tiles the band) into plan and checks it against
  * the other ways of choosing frames, samples and region. */
 static rt_status plan_shard(const render_job *job, render_job_plan *plan, rt_error *error)
@@ -91,16 +153,19 @@ static rt_status plan_shard(const render_job *job, render_job_plan *plan, rt_err
     if (job->shard_count == 0)
         return RT_OK;
     render_job_shard_kind by = job->shard_by;
+    /* A sweep's rows shard as frames do. */
+    int images = job->sweep != NULL ? job->sweep->row_count : job->frame_count;
+    const char *unit = job->sweep != NULL ? "sweep row" : "frame";
     if (by == RENDER_SHARD_AUTO)
-        by = job->frame_count > 1 ? RENDER_SHARD_FRAMES : RENDER_SHARD_SAMPLES;
+        by = images > 1 ? RENDER_SHARD_FRAMES : RENDER_SHARD_SAMPLES;
     plan->shard_by = by;
-    if (by == RENDER_SHARD_FRAMES && job->frame_count == 0)
+    if (by == RENDER_SHARD_FRAMES && images == 0)
         return rt_error_set(error, RT_ERROR_INPUT, "--shard-by frames needs --frames");
     /* As with an empty sample shard or tile: a part with nothing to render is an error,
      * not a silent success that writes nothing. */
-    if (by == RENDER_SHARD_FRAMES && job->shard_index >= job->frame_count)
-        return rt_error_set(error, RT_ERROR_INPUT, "shard %d/%d of %d frame%s is empty; use fewer shards",
-                            job->shard_index, job->shard_count, job->frame_count, job->frame_count == 1 ? "" : "s");
+    if (by == RENDER_SHARD_FRAMES && job->shard_index >= images)
+        return rt_error_set(error, RT_ERROR_INPUT, "shard %d/%d of %d %s%s is empty; use fewer shards",
+                            job->shard_index, job->shard_count, images, unit, images == 1 ? "" : "s");
     if (by == RENDER_SHARD_SAMPLES && job->sample_count > 0)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--shard by samples and --samples both choose the samples; give one");
@@ -156,7 +221,16 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
         return rt_error_set(error, RT_ERROR_INPUT,
                             "cannot tell the format of --samples-map '%s'; use .png, .exr, .hdr, .jpg or .tif",
                             job->samples_map);
+    status = check_light_groups(job, plan->first_output, error);
+    if (status == RT_OK)
+        status = check_sweep(job, error);
+    if (status != RT_OK)
+        return status;
     status = plan_shard(job, plan, error);
+    if (status == RT_OK && job->light_groups && job->shard_count && plan->shard_by != RENDER_SHARD_FRAMES)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--light-groups with --shard by %s: merge keeps no light group layers; shard by frames",
+                            render_job_shard_kind_name(plan->shard_by));
     if (status == RT_OK && job->tracer.min_spp && !(job->tracer.noise_threshold > 0))
         return rt_error_set(error, RT_ERROR_INPUT, "--min-spp does nothing without --noise-threshold");
     if (status != RT_OK || !(job->tracer.noise_threshold > 0))

@@ -65,23 +65,27 @@ rt_status render_output_write(const char *path, const rt_image *image, const rt_
         {.name = METADATA_KEY_PATH_SEGMENTS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
         {.name = METADATA_KEY_COMPLETE, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->complete},
         {.name = METADATA_KEY_RENDER_SECONDS, .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = metadata->render_seconds},
-        /* The optional keys last: a render's three, or a merge's one. */
-        {.name = METADATA_KEY_STOP_REASON, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->stop_reason},
-        {.name = METADATA_KEY_NOISE_THRESHOLD, .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = metadata->noise_threshold},
-        {.name = METADATA_KEY_MIN_SPP, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->min_spp},
-        {.name = METADATA_KEY_MERGED_PARTS, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->merged_parts},
+        {0}, {0}, {0}, {0}, {0},   /* the optional keys, added below when they apply */
     };
+    int count = (int)(sizeof attributes / sizeof attributes[0]) - 5;
+    if (metadata->stop_reason != NULL) {   /* a render's keys (not a merge's) */
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_STOP_REASON, .type = IMAGE_ATTRIBUTE_STRING,
+                                                .string_value = metadata->stop_reason};
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_NOISE_THRESHOLD, .type = IMAGE_ATTRIBUTE_FLOAT,
+                                                .float_value = metadata->noise_threshold};
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_MIN_SPP, .type = IMAGE_ATTRIBUTE_INT,
+                                                .int_value = metadata->min_spp};
+    }
+    if (metadata->merged_parts > 0)
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_MERGED_PARTS, .type = IMAGE_ATTRIBUTE_INT,
+                                                .int_value = metadata->merged_parts};
+    if (metadata->light_groups != NULL)
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_LIGHT_GROUPS, .type = IMAGE_ATTRIBUTE_STRING,
+                                                .string_value = metadata->light_groups};
     image_write_options options = image_write_options_defaults();
     options.exposure = exposure;
-    int count = (int)(sizeof attributes / sizeof attributes[0]);
-    int render_keys = 3;
-    if (metadata->stop_reason == NULL) {
-        /* No render keys: the merge key moves into their place. */
-        attributes[count - 1 - render_keys] = attributes[count - 1];
-        count -= render_keys;
-    }
     options.attributes = attributes;
-    options.attribute_count = metadata->merged_parts > 0 ? count : count - 1;
+    options.attribute_count = count;
     status = image_write(path, written, &options, error);
     image_free(&made);
     return status;

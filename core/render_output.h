@@ -39,6 +39,8 @@ typedef struct render_output_metadata {
                                           * keys (a merge) */
     float noise_threshold;
     int min_spp;
+    const char *light_groups;            /* NULL: no rtspheres:light_groups key; else the
+                                          * layers' group names, comma-separated */
 } render_output_metadata;
 
 /* What a partial file must match to continue a render: its seed, first sample, samples

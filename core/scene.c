@@ -20,6 +20,8 @@ void scene_defaults(scene *s)
         .width = 640, .height = 360, .samples_per_pixel = 64, .max_depth = 16, .seed = 1,
     };
     s->ambient[0] = s->ambient[1] = s->ambient[2] = 0.03f;
+    snprintf(s->light_groups[0], SCENE_NAME_MAX, "%s", SCENE_DEFAULT_LIGHT_GROUP);
+    s->light_group_count = 1;
     s->sky = (scene_sky){
         .type = SKY_GRADIENT, .bottom = {1, 1, 1}, .top = {0.5f, 0.7f, 1.0f},
         .faces = {-1, -1, -1, -1, -1, -1}, .environment = -1, .intensity = 1, .rotation_degrees = 0,
@@ -119,6 +121,17 @@ int scene_add_warning(scene *s, const char *format, ...)
               arguments);
     va_end(arguments);
     return s->warning_count++;
+}
+
+int scene_light_group(scene *s, const char *name)
+{
+    for (int i = 0; i < s->light_group_count; i++)
+        if (strcmp(s->light_groups[i], name) == 0)
+            return i;
+    if (s->light_group_count == SCENE_LIGHT_GROUP_MAX)
+        return -1;
+    snprintf(s->light_groups[s->light_group_count], SCENE_NAME_MAX, "%s", name);
+    return s->light_group_count++;
 }
 
 scene_light scene_light_defaults(scene_light_type type)

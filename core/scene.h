@@ -27,6 +27,14 @@
 
 #define SCENE_NAME_MAX 64
 
+/* Light groups (`group NAME` on lights, emissive materials and the sky): each group's
+ * contribution is written as its own layer with --light-groups (render.h). Group 0 is
+ * "default", where everything without a group clause falls. The layers cost the tracer
+ * 16 bytes per pixel each (docs/scene-format.md, "Light groups"). */
+#define SCENE_LIGHT_GROUP_MAX 32
+#define SCENE_LIGHT_GROUP_NAME_MAX 24   /* bytes of a group's name, so NAME.R fits a channel name */
+#define SCENE_DEFAULT_LIGHT_GROUP "default"
+
 typedef struct scene_camera {
     float look_from[3];
     float look_at[3];
@@ -57,6 +65,8 @@ typedef struct scene_sky {
     int environment;             /* environment: index into scene.images */
     float intensity;             /* multiplies every kind of sky; default 1 */
     float rotation_degrees;      /* box and environment: turn about +Y; default 0 */
+    int light_group;             /* index into scene.light_groups (the Whitted ambient term
+                                  * counts as the sky's too); default 0 */
 } scene_sky;
 
 /* An image file used by a texture, a normal map or the sky: recorded by the parser
@@ -108,6 +118,7 @@ typedef struct scene_light {
     float sun_angle_degrees;     /* sun: angular diameter, soft shadows (default 0.53) */
     scene_falloff falloff;
     float attenuation[3];        /* polynomial falloff: constant, linear, quadratic */
+    int light_group;             /* index into scene.light_groups; default 0 */
 } scene_light;
 
 /* One named material. type is a MATERIAL_* tag of packed_layout.h; fields that the
@@ -143,6 +154,7 @@ typedef struct scene_material {
                                   * colours (PLY, glTF COLOR_0) */
     bool one_sided;              /* emissive and pbr emission: only the front face emits (the
                                   * side the geometric normal points to); default both sides */
+    int light_group;             /* what it emits: index into scene.light_groups; default 0 */
 } scene_material;
 
 /* pbr alpha modes (glTF's OPAQUE and MASK; BLEND is imported as MASK). */
@@ -269,6 +281,9 @@ typedef struct scene {
     int light_count;
     size_t light_capacity;
     float ambient[3];            /* Whitted integrator's ambient term; default 0.03 0.03 0.03 */
+    char light_groups[SCENE_LIGHT_GROUP_MAX][SCENE_NAME_MAX];   /* [0] is "default", then in
+                                  * the order the scene first names them */
+    int light_group_count;       /* >= 1 */
     scene_warning *warnings;     /* things worth telling the user that do not stop the render */
     int warning_count;
     size_t warning_capacity;     /* (e.g. a mesh's missing MTL file), in the order found */
@@ -297,6 +312,10 @@ int scene_add_mesh(scene *s, const scene_mesh *mesh);
 int scene_add_texture(scene *s, const scene_texture *texture);
 int scene_add_image(scene *s, const scene_image *image);
 int scene_add_light(scene *s, const scene_light *light);
+
+/* Returns the index of the light group called name, adding it when it is new; -1 when
+ * SCENE_LIGHT_GROUP_MAX groups are already there. */
+int scene_light_group(scene *s, const char *name);
 
 /* Appends a warning whose message is the printf-style format (cut to SCENE_WARNING_MAX - 1
  * bytes); returns its index, or -1 when memory runs out. */

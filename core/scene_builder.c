@@ -78,6 +78,11 @@ const scene *builder_scene(const scene_builder *builder)
     return builder->scene;
 }
 
+int builder_light_group(scene_builder *builder, const char *name)
+{
+    return scene_light_group(builder->scene, name);
+}
+
 int builder_depth(const scene_builder *builder)
 {
     return builder->block_count - 1;

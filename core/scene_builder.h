@@ -135,6 +135,10 @@ void builder_set_render(scene_builder *builder, const scene_render_settings *ren
 void builder_set_sky(scene_builder *builder, const scene_sky *sky);
 void builder_set_ambient(scene_builder *builder, const float ambient[3]);
 
+/* The index of the light group called name (scene.h scene_light_group: added when new);
+ * -1 when the scene has SCENE_LIGHT_GROUP_MAX already. */
+int builder_light_group(scene_builder *builder, const char *name);
+
 /* Fails unless a light may stand here (at the top level); where is its keyword. */
 bool builder_check_light_allowed(scene_builder *builder, const source_position *where);
 

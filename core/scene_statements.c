@@ -144,6 +144,30 @@ bool read_image(scene_parser *p, source_line *line, const char *what, int *image
     return added;
 }
 
+bool read_light_group(scene_parser *p, source_line *line, const char *owner, int *group)
+{
+    token t = {.kind = TOKEN_END};
+    if (!next_token(line, &t))
+        return false;
+    char kind[DESCRIPTION_BUFFER], name[SCENE_NAME_MAX];
+    snprintf(kind, sizeof kind, "light group (of %s)", owner);
+    if (t.kind == TOKEN_END)
+        return fail_at(line, t.offset, "expected a %s name, found end of line", kind);
+    if (!name_from_token(line, &t, kind, name))
+        return false;
+    if (strlen(name) > SCENE_LIGHT_GROUP_NAME_MAX)
+        return fail_at(line, t.offset, "light group name '%s' is %zu bytes long; the limit is %d", name,
+                       strlen(name), SCENE_LIGHT_GROUP_NAME_MAX);
+    if (strchr(name, '.') != NULL)
+        return fail_at(line, t.offset, "light group name '%s' has a '.', which EXR layer names keep for "
+                       "their channels (use letters, digits, '_' and '-')", name);
+    *group = builder_light_group(&p->builder, name);
+    if (*group < 0)
+        return fail_at(line, t.offset, "light group '%s' is one more than the %d a scene may have", name,
+                       SCENE_LIGHT_GROUP_MAX);
+    return true;
+}
+
 /* ------------------------------------------------------------------ files and variables */
 
 /* include "PATH": parses the file at PATH (relative to the including file's directory)
@@ -358,12 +382,14 @@ static bool read_sky_type(scene_parser *p, source_line *line, scene_sky *sky, bo
                    describe_token(line, &type, found, sizeof found));
 }
 
-/* Reads the value of sky clause (intensity or rotate) into the scene_sky target. */
+/* Reads the value of sky clause (intensity, group or rotate) into the scene_sky target. */
 static bool read_sky_clause(scene_parser *p, source_line *line, int clause, void *target)
 {
     scene_sky *sky = target;
     if (clause == 0)
         return read_non_negative_float(&p->variables, line, "the sky's intensity", &sky->intensity);
+    if (clause == 1)
+        return read_light_group(p, line, "the sky", &sky->light_group);
     double value = 0;
     size_t offset = 0;
     return read_number(&p->variables, line, "the sky's rotation in degrees", &value, &offset) &&
@@ -371,7 +397,8 @@ static bool read_sky_clause(scene_parser *p, source_line *line, int clause, void
 }
 
 /* sky gradient R G B  R G B | constant R G B | box "+X" "-X" "+Y" "-Y" "+Z" "-Z" |
- * environment "FILE", then [intensity I] (and [rotate DEGREES] for box and environment).
+ * environment "FILE", then [intensity I] [group NAME] (and [rotate DEGREES] for box and
+ * environment).
  * The last sky statement wins, wholly: what it leaves out is back at the default. */
 bool statement_sky(scene_parser *p, source_line *line, const token *keyword)
 {
@@ -382,8 +409,8 @@ bool statement_sky(scene_parser *p, source_line *line, const token *keyword)
     bool has_image = false;
     if (!read_sky_type(p, line, &sky, &has_image))
         return false;
-    static const char *const clauses[] = {"intensity", "rotate"};
-    if (!read_clauses(p, line, "sky", clauses, has_image ? 2 : 1, read_sky_clause, &sky))
+    static const char *const clauses[] = {"intensity", "group", "rotate"};
+    if (!read_clauses(p, line, "sky", clauses, has_image ? 3 : 2, read_sky_clause, &sky))
         return false;
     builder_set_sky(&p->builder, &sky);
     return true;

@@ -58,6 +58,12 @@ bool parse_source(scene_parser *p, const source_file *file);
  * to its index (images are shared by resolved path). */
 bool read_image(scene_parser *p, source_line *line, const char *what, int *image);
 
+/* Reads the NAME of a `group NAME` clause of owner ("the point light") and sets *group to
+ * its light group's index (scene.h). A name takes letters, digits, '_' and '-' (no '.':
+ * it becomes the prefix of EXR channels, NAME.R), at most SCENE_LIGHT_GROUP_NAME_MAX bytes;
+ * more than SCENE_LIGHT_GROUP_MAX groups is an error. */
+bool read_light_group(scene_parser *p, source_line *line, const char *owner, int *group);
+
 /* Reads a quoted, non-empty path for what (e.g. "the mesh") and resolves it as include
  * paths are: relative to the directory of the file that names it. The caller frees
  * *resolved; *offset gets the string's offset. Whether the file exists is the asset

@@ -163,7 +163,7 @@ static bool read_light_clause(scene_parser *p, source_line *line, int index, voi
     scene_light *light = clauses->light;
     const char *owner = clauses->owner;
     /* Every type's clause words, in the order of the switch below. */
-    static const char *const all_clauses[] = {"color", "intensity", "falloff", "cone", "angle"};
+    static const char *const all_clauses[] = {"color", "intensity", "falloff", "cone", "angle", "group"};
     int clause = 0;
     while (strcmp(all_clauses[clause], clauses->names[index]) != 0)
         clause++;
@@ -196,7 +196,7 @@ static bool read_light_clause(scene_parser *p, source_line *line, int index, voi
         light->spot_outer_degrees = (float)outer;
         return true;
     }
-    default: {
+    case 4: {
         double angle = 0;
         size_t offset = 0;
         if (!read_light_angle(p, line, "the sun's angle", &angle, &offset))
@@ -204,12 +204,15 @@ static bool read_light_clause(scene_parser *p, source_line *line, int index, voi
         light->sun_angle_degrees = (float)angle;
         return true;
     }
+    default:
+        return read_light_group(p, line, owner, &light->light_group);
     }
 }
 
 /* light point X Y Z [color R G B] [intensity I] [falloff inverse_square | falloff polynomial C L Q]
  * light spot X Y Z at X Y Z [color R G B] [intensity I] [cone INNER OUTER] [falloff ...]
  * light sun DX DY DZ [color R G B] [intensity I] [angle DEGREES]
+ * each with [group NAME] (its light group; default "default").
  * Only at the top level. scene_light.color is colour x intensity; the sun's direction is
  * the one its light travels. */
 bool statement_light(scene_parser *p, source_line *line, const token *keyword)
@@ -237,14 +240,14 @@ bool statement_light(scene_parser *p, source_line *line, const token *keyword)
         return false;
 
     /* The clauses each type takes. */
-    static const char *const point_clauses[] = {"color", "intensity", "falloff"};
-    static const char *const spot_clauses[] = {"color", "intensity", "cone", "falloff"};
-    static const char *const sun_clauses[] = {"color", "intensity", "angle"};
+    static const char *const point_clauses[] = {"color", "intensity", "falloff", "group"};
+    static const char *const spot_clauses[] = {"color", "intensity", "cone", "falloff", "group"};
+    static const char *const sun_clauses[] = {"color", "intensity", "angle", "group"};
     light_clauses clauses = {
         .owner = owner, .light = &light, .colour = {1, 1, 1}, .intensity = 1, .intensity_offset = SIZE_MAX,
         .names = kind == SCENE_LIGHT_POINT ? point_clauses : kind == SCENE_LIGHT_SPOT ? spot_clauses : sun_clauses,
     };
-    if (!read_clauses(p, line, statement, clauses.names, kind == SCENE_LIGHT_SPOT ? 4 : 3, read_light_clause,
+    if (!read_clauses(p, line, statement, clauses.names, kind == SCENE_LIGHT_SPOT ? 5 : 4, read_light_clause,
                       &clauses))
         return false;
     char what[DESCRIPTION_BUFFER];
@@ -302,6 +305,8 @@ static bool read_material_clause(scene_parser *p, source_line *line, int index, 
         snprintf(what, sizeof what, "the phong exponent of %s", clauses->owner);
         return read_positive_float(&p->variables, line, what, &material->phong_exponent);
     }
+    if (strcmp(name, "group") == 0)
+        return read_light_group(p, line, clauses->owner, &material->light_group);
     if (strcmp(name, "specular") == 0) {
         if (!read_specular(p, line, clauses->owner, material->specular))
             return false;
@@ -316,10 +321,11 @@ static bool read_material_clause(scene_parser *p, source_line *line, int index, 
 }
 
 /* Reads the optional clauses of a material, in any order: a number (fuzz, strength) into
- * *value (offset into *value_offset), normal_map "FILE" into material->normal_map, phong
+ * *value (offset into *value_offset), group NAME (emissive: its light group), normal_map
+ * "FILE" into material->normal_map, phong
  * EXPONENT (> 0; 0 in scene_material means "the default") and specular R G B (lambertian
- * and metal) into the Whitted fields, one_sided (emissive). statement names the material type for messages
- * ("metal material"), owner the material ("material 'm'"). */
+ * and metal) into the Whitted fields, one_sided (emissive). statement names the material
+ * type for messages ("metal material"), owner the material ("material 'm'"). */
 static bool read_material_clauses(scene_parser *p, source_line *line, const char *statement, const char *owner,
                                   const char *const *names, int count, scene_material *material, double *value,
                                   size_t *value_offset)
@@ -345,6 +351,7 @@ typedef struct pbr_clauses {
 static const char *const pbr_clause_names[] = {
     "metallic", "roughness", "ior",       "transmission", "emission",   "strength",
     "one_sided", "alpha",    "alpha_cutoff", "vertex_colors", "normal_map", "metallic_roughness_map",
+    "group",
 };
 #define PBR_CLAUSE_COUNT ((int)(sizeof pbr_clause_names / sizeof pbr_clause_names[0]))
 
@@ -389,6 +396,8 @@ static bool read_pbr_clause(scene_parser *p, source_line *line, int index, void 
     case 9:
         material->vertex_colors = true;
         return true;
+    case 12:
+        return read_light_group(p, line, clauses->owner, &material->light_group);
     default: {
         int *image = index == 10 ? &material->normal_map : &material->metallic_roughness_texture;
         snprintf(what, sizeof what, "the %s of the pbr material", pbr_clause_names[index]);
@@ -463,12 +472,12 @@ static bool read_material_type(scene_parser *p, source_line *line, const char *o
                read_material_clauses(p, line, "dielectric material", owner, normal_map_only, 1, material, NULL, NULL);
     }
     if (token_is(line, &type, "emissive")) {
-        static const char *const clauses[] = {"strength", "one_sided"};
+        static const char *const clauses[] = {"strength", "one_sided", "group"};
         material->type = MATERIAL_EMISSIVE;
         float colour[3];
         value = 1;
         if (!read_colour_or_texture(p, line, owner, colour, &material->emission_texture) ||
-            !read_material_clauses(p, line, "emissive material", owner, clauses, 2, material, &value, &offset))
+            !read_material_clauses(p, line, "emissive material", owner, clauses, 3, material, &value, &offset))
             return false;
         if (!(value >= 0))
             return fail_at(line, offset, "the strength of %s must be >= 0, found %s", owner,
@@ -486,9 +495,9 @@ static bool read_material_type(scene_parser *p, source_line *line, const char *o
 
 /* material NAME lambertian COLOR [normal_map "F"] [phong E] [specular R G B] |
  * metal COLOR [fuzz F] [normal_map "F"] [phong E] [specular R G B] |
- * dielectric IOR [normal_map "F"] | emissive COLOR [strength S] [one_sided] |
+ * dielectric IOR [normal_map "F"] | emissive COLOR [strength S] [one_sided] [group NAME] |
  * pbr COLOR metallic M roughness R [ior I] [transmission T] [emission COLOR] [strength S]
- * [one_sided] [alpha A] [alpha_cutoff C] [vertex_colors] [normal_map "F"]
+ * [one_sided] [group NAME] [alpha A] [alpha_cutoff C] [vertex_colors] [normal_map "F"]
  * [metallic_roughness_map "F"], COLOR being R G B or @TEXTURE. The builder remembers where
  * NAME was defined, for duplicate errors. */
 bool statement_material(scene_parser *p, source_line *line, const token *keyword)

@@ -52,6 +52,7 @@ shader_modules:
     module "glsl/material_phong.glsl", SHADER_PROGRAM_SHADING       /* Whitted's shading model */
     module "glsl/material_table.glsl", SHADER_PROGRAM_SHADING       /* the table of materials */
     module "glsl/material_test.frag", SHADER_PROGRAM_MATERIAL_TEST
+    module "glsl/light_groups.glsl", SHADER_PROGRAM_TRACER         /* --light-groups layers */
     module "glsl/lights.glsl", SHADER_PROGRAM_TRACER
     module "glsl/direct_light.glsl", SHADER_PROGRAM_TRACER
     module "glsl/path_state.glsl", SHADER_PROGRAM_TRACER

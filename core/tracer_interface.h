@@ -76,6 +76,8 @@
 #define TRACER_SAMPLE_LIMITS_UNIT 9
 #define TRACER_PARAMETER_BINDING 0
 #define TRACER_COUNTER_BINDING 0
+/* image unit of the light group layers (glsl/light_groups.glsl): an rgba32f 2D array */
+#define TRACER_LIGHT_GROUP_IMAGE_UNIT 0
 
 /* ---- the parameter block. Vectors are world space; pixels count from the top left. */
 #define TRACER_PARAMETERS(P) \
@@ -111,6 +113,8 @@
     P(int, integrator)               /* INTEGRATOR_* */ \
     P(int, light_sampling)           /* 0: BSDF sampling only (to compare the estimators) */ \
     P(vec3, ambient)                 /* Whitted: ambient light */ \
+    P(uint, light_group_count)       /* layers of light groups collected (0: none) */ \
+    P(uint, sky_light_group)         /* the sky's (and Whitted's ambient's) light group */ \
     P(int, pass_work_budget)         /* work units a pixel may start in one pass (core/gpu_tracer.c */ \
                                      /* clamps it to what the device allows) */ \
     P(int, work_cap)                 /* no invocation does more (core/gpu_tracer.c, from the device) */ \

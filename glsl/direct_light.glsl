@@ -42,6 +42,7 @@ struct PendingShadow {
     bool pending;
     ShadowRay ray;
     vec3 contribution;      // added to the path's radiance times the transmittance
+    uint light_group;       // the light's group (glsl/light_groups.glsl), which it goes to too
     ShadowTransit transit;  // through volumes
 };
 
@@ -91,6 +92,7 @@ PendingShadow no_pending_shadow()
     shadow.ray.light_slot = NONE;
     shadow.ray.time = 0.0;
     shadow.contribution = vec3(0.0);
+    shadow.light_group = 0u;
     shadow.transit = shadow_transit(0.0, 0u);
     return shadow;
 }
@@ -104,8 +106,10 @@ bool direct_light_pending(LightQuery query) { return query.next_light < query.li
 void begin_direct_light(inout LightQuery query, vec3 view, uint media, float time, uint bounce, inout vec3 radiance)
 {
     bool phong_model = query.model == DIRECT_PHONG;
-    if (phong_model)
+    if (phong_model) {
         radiance += query.weight * (ambient * query.material.albedo);
+        add_to_light_group(sky_light_group, query.weight * (ambient * query.material.albedo));
+    }
     bool choose = !phong_model || light_count > WHITTED_ALL_LIGHTS;
     query.next_light = 0u;
     query.light_samples = light_count == 0u ? 0u : choose ? 1u : light_count;
@@ -176,6 +180,7 @@ PendingShadow next_shadow_ray(inout LightQuery query, inout float light_total)
     shadow.ray.light_slot = light_sample.slot;
     shadow.ray.time = query.time;
     shadow.contribution = query.weight * (value * light_sample.emitted * weight);
+    shadow.light_group = light_group_of(light);
     shadow.transit = shadow_transit(light_sample.distance, query.media);
     return shadow;
 }
@@ -210,7 +215,9 @@ void direct_light_in_place(inout LightQuery query, inout float light_total, inou
                 Surface surface = surface_at(hit, shadow.ray.origin, shadow.ray.direction, shadow.ray.time);
                 shadow.pending = shadow_cross(shadow.ray, shadow.transit, hit, surface);
             } else {
-                radiance += shadow_arrived(shadow.transit, shadow.ray, blocked, hit) * shadow.contribution;
+                vec3 light = shadow_arrived(shadow.transit, shadow.ray, blocked, hit) * shadow.contribution;
+                radiance += light;
+                add_to_light_group(shadow.light_group, light);
                 shadow.pending = false;
             }
         }

@@ -104,6 +104,7 @@ void integrate(inout PixelState s)
             crossing = shadow_at_boundary(shadow.ray, blocked, shadow_hit);
             if (!crossing) {
                 vec3 light = shadow_arrived(shadow.transit, shadow.ray, blocked, shadow_hit) * shadow.contribution;
+                add_to_light_group(shadow.light_group, light);
                 shadow.pending = false;
                 if (finishing) {
                     finish_sample(s, finishing_radiance + light);
@@ -129,7 +130,9 @@ void integrate(inout PixelState s)
             if (scatter_in_medium(s, path_hit.t, u, query, path_done)) {
                 // scattered before the surface: done there
             } else if (path_hit.t == INFINITY) {
-                s.radiance += s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
+                vec3 sky = s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
+                s.radiance += sky;
+                add_to_light_group(sky_light_group, sky);
                 path_done = true;
             } else {
                 at_surface = true;

@@ -126,5 +126,7 @@ void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material
     // this is the last boundary instead. Kept as it was: fixing it changes images.
     vec3 vertex = s.origin - s.since_vertex * s.direction;
     float weight = emitter_mis_weight(hit, s.previous_pdf, s.light_total, vertex, surface.position, surface.geometric);
-    s.radiance += s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
+    vec3 emitted = s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
+    s.radiance += emitted;
+    add_to_light_group(emitter_light_group(material), emitted);
 }

@@ -20,6 +20,7 @@ const bool HAS_RECTANGLE_LIGHTS = RTSPHERES_OMIT_RECTANGLE_LIGHTS == 0;   // qua
 const bool HAS_PBR = RTSPHERES_OMIT_PBR == 0;                     // the pbr material
 const bool HAS_ALPHA_MASK = RTSPHERES_OMIT_ALPHA_MASK == 0;       // alpha-masked materials
 const bool HAS_VERTEX_COLORS = RTSPHERES_OMIT_VERTEX_COLORS == 0; // the vertex colour section
+const bool HAS_LIGHT_GROUPS = RTSPHERES_OMIT_LIGHT_GROUPS == 0;   // light group layers
 
 // Derived: flat primitives (triangles, quads), and scenes of a single primitive kind, whose
 // records need no type test.

@@ -187,6 +187,36 @@ bench() {
         "$build" "$per_triangle" "$first" "$rss" - "$cpu" "$note" rtspheres "$rmse"
 }
 
+# Times a sweep of ROWS rows of the three balls' light at SIZE and SPP (issue 15): one
+# `render --sweep` against ROWS separate renders of the same rows, wall seconds each, as
+# the rows sweep-ROWS (the sweep) and sweep-ROWS-separate (the renders together).
+bench_sweep() {
+    rows=$1 size=$2 spp=$3
+    table=$work/sweep.tsv
+    printf 'light_x\tlight_z\n' >"$table"
+    i=0
+    while [ "$i" -lt "$rows" ]; do
+        printf '4*cos(2*pi*%d/%d)\t4*sin(2*pi*%d/%d)\n' "$i" "$rows" "$i" "$rows" >>"$table"
+        i=$((i + 1))
+    done
+    start=$(date +%s.%N)
+    "$program" render scenes/three-balls.txt -o "$work/sweep-%02d.exr" --sweep "$table" --size "$size" --spp "$spp" \
+        --quiet || failures=$((failures + 1))
+    middle=$(date +%s.%N)
+    i=0
+    while [ "$i" -lt "$rows" ]; do
+        "$program" render scenes/three-balls.txt -o "$work/separate-$i.exr" --size "$size" --spp "$spp" --quiet \
+            -D "light_x=4*cos(2*pi*$i/$rows)" -D "light_z=4*sin(2*pi*$i/$rows)" || failures=$((failures + 1))
+        i=$((i + 1))
+    done
+    end=$(date +%s.%N)
+    sweep_wall=$(awk -v a="$start" -v b="$middle" 'BEGIN { printf "%.3f", b - a }')
+    separate_wall=$(awk -v a="$middle" -v b="$end" 'BEGIN { printf "%.3f", b - a }')
+    record "sweep-$rows" "$size" "$spp" "$rows" 0 "$sweep_wall" - - - - - - - - - - "--sweep, one process"
+    record "sweep-$rows-separate" "$size" "$spp" "$rows" 0 "$separate_wall" - - - - - - - - - - \
+        "$rows separate renders"
+}
+
 # Renders the three-ball animation (frames 0 .. FRAMES-1 on one GPU context) as NAME and
 # records its row: rates over all frames, first pass and BVH of the first frame.
 bench_animation() {
@@ -298,6 +328,11 @@ if peer_ready povray; then
     bench_povray povray-three-balls scenes/three-balls.txt 640x360 16
 fi
 bench_animation three-balls-anim scenes/three-balls.txt 320x180 "$(scaled 4)" 24
+# Light groups (issue 15): lights.txt's four lights in four groups (and the sky in
+# default), with and without their layers, back to back.
+bench lights scenes/lights.txt 640x360 "$(scaled 16)" ""
+bench lights-groups scenes/lights.txt 640x360 "$(scaled 16)" "--light-groups, 5 layers" --light-groups
+bench_sweep 12 320x180 "$(scaled 4)"
 # The books' scenes at the books' sizes, except the Next Week scene at half its 800x800
 # (its fog makes every path scatter: 1 spp of the full frame takes ~40 s here).
 bench cornell scenes/cornell.txt 600x600 "$(scaled 4)" ""
@@ -423,6 +458,13 @@ targets=$work/targets.tsv
         printf '%s_1M_packed_bytes_per_triangle\t%s\t<=\t100\tB\tpacked bytes per triangle, %s-1M\n' "$label" \
             "$(value "$label-1M" 12)" "$label"
     done
+    # issue 15: light groups and sweeps
+    printf 'light_groups_time_per_sample_ratio\t%s\t<=\t1.1\tx\tlights.txt time per sample, --light-groups / none\n' \
+        "$(ratio "$(value lights-groups 10)" "$(value lights 10)")"
+    printf 'sweep_saving_per_row_over_startup\t%s\t>=\t1\tx\t%s\n' \
+        "$(awk -v s="$(value sweep-12 6)" -v p="$(value sweep-12-separate 6)" -v u="$(value startup-cached 13)" 'BEGIN {
+            if (s == "-" || p == "-" || u == "-" || u <= 0) print "-"; else printf "%.3g", (p - s) / 11 / u }')" \
+        "12-row sweep: (12 separate renders - the sweep) / 11 / a cached start-up's first pass"
     # issue 13, against Blender Cycles (tests/bench/peers.sh)
     printf 'weekend_time_ratio_cycles\t%s\t<=\t0.5\tx\tweekend at equal spp, render s rtspheres / Cycles\n' \
         "$(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")"

@@ -34,20 +34,37 @@ if [ "$sizes" = " 32x18 32x18 32x18 32x18" ] && [ ! -e "$sweep/light-04.png" ]; 
     pass "sweep writes 4 frames of 32x18"
 else fail "sweep writes 4 frames of 32x18" "sizes:$sizes"; fi
 
-# 4 frames: ceil(sqrt(4)) = 2 columns, 2 rows, the default gap of 2 pixels between them.
+# 4 frames: ceil(sqrt(4)) = 2 columns, 2 rows, the default gap of 2 pixels between them;
+# under each frame its label band: 5 characters a line at 32 pixels (scale 1, 6 pixels a
+# character), the values' text needs the most lines (4), so 4 x 8 + 2 = 34 pixels.
 sheet=$sweep/contact-sheet.png
 size=$(image_size "$sheet" 2>/dev/null)
-if [ "$size" = 66x38 ]; then pass "contact sheet is 2x2 frames with 2-pixel gaps (66x38)"
-else fail "contact sheet is 2x2 frames with 2-pixel gaps (66x38)" "size '$size'"; fi
+if [ "$size" = 66x106 ]; then pass "contact sheet is 2x2 labelled frames with 2-pixel gaps (66x106)"
+else fail "contact sheet is 2x2 labelled frames with 2-pixel gaps (66x106)" "size '$size'"; fi
 
 # The tiles are the frames, not re-brightened by decoding sRGB twice, in row order.
 if same_means "$sheet" 0,0,32,18 "$sweep/light-00.png" "" && same_means "$sheet" 34,0,66,18 "$sweep/light-01.png" "" &&
-   same_means "$sheet" 0,20,32,38 "$sweep/light-02.png" "" && same_means "$sheet" 34,20,66,38 "$sweep/light-03.png" ""; then
+   same_means "$sheet" 0,54,32,72 "$sweep/light-02.png" "" && same_means "$sheet" 34,54,66,72 "$sweep/light-03.png" ""; then
     pass "sheet tiles equal the frames, row by row"
 else fail "sheet tiles equal the frames, row by row" "a tile's channel means differ from its frame's"; fi
-if [ "$(channel_range "$sheet" G 32,0,34,38)" = "0 0" ] && [ "$(channel_range "$sheet" G 0,18,66,20)" = "0 0" ]; then
+if [ "$(channel_range "$sheet" G 32,0,34,106)" = "0 0" ] && [ "$(channel_range "$sheet" G 0,52,66,54)" = "0 0" ]; then
     pass "sheet gaps are black"
-else fail "sheet gaps are black" "gap range $(channel_range "$sheet" G 32,0,34,38)"; fi
+else fail "sheet gaps are black" "gap range $(channel_range "$sheet" G 32,0,34,106)"; fi
+# The label bands hold white text on black: pixels of 1 and of 0, mostly 0.
+band=$(channel_range "$sheet" G 0,18,32,52)
+band_mean=$(channel_mean "$sheet" G 0,18,32,52)
+if [ "$band" = "0 1" ] && awk -v m="$band_mean" 'BEGIN { exit !(m > 0.05 && m < 0.5) }'; then
+    pass "label bands hold white text on black"
+else fail "label bands hold white text on black" "range '$band', mean $band_mean"; fi
+# --labels writes the file names: "light-00.png" is 12 characters, 3 lines of 5 at 32
+# pixels, a band of 3 x 8 + 2 = 26 pixels.
+"$program" montage "$sweep/light-00.png" "$sweep/light-01.png" -o "$scratch/named.png" --labels --quiet
+expect_exit "montage --labels adds a band of 3 lines (26 pixels)" 0 "" \
+    test "$(image_size "$scratch/named.png")" = 66x44
+expect_exit "montage --labels and --label-table together" 2 "give one" \
+    "$program" montage "$sweep/light-00.png" -o "$scratch/bad.png" --labels --label-table "$sweep/light-positions.tsv"
+expect_exit "montage --label-table with another number of rows" 2 "has 4 rows for 1 image" \
+    "$program" montage "$sweep/light-00.png" -o "$scratch/bad.png" --label-table "$sweep/light-positions.tsv"
 
 # The images actually change with the light: frames 0 and 2 put it on opposite sides.
 expect_exit "frames 0 and 2 differ (light on opposite sides)" 1 "" \

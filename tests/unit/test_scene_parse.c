@@ -541,10 +541,10 @@ static void test_unknown_clause(void **state)
     assert_parse_error("material m metal 1 1 1 shine 2", "s.txt:1:24: ",
                        "unknown metal material clause 'shine' (expected fuzz, normal_map, phong or specular)");
     assert_parse_error("material m emissive 1 1 1 fuzz 2", "s.txt:1:27: ",
-                       "unknown emissive material clause 'fuzz' (expected strength or one_sided)");
+                       "unknown emissive material clause 'fuzz' (expected strength, one_sided or group)");
     assert_parse_error("sky rainbow 1 1 1", "s.txt:1:5: ",
                        "expected a sky type (gradient, constant, box or environment), found 'rainbow'");
-    assert_parse_error("sky constant 1 1 1 rotate 3", "s.txt:1:20: ", "unknown sky clause 'rotate' (expected intensity)");
+    assert_parse_error("sky constant 1 1 1 rotate 3", "s.txt:1:20: ", "unknown sky clause 'rotate' (expected intensity or group)");
     assert_parse_error("material m plastic 1 1 1", "s.txt:1:12: ",
                        "expected a material type (lambertian, metal, dielectric, emissive or pbr), found 'plastic'");
 }
@@ -596,7 +596,7 @@ static void test_extra_tokens(void **state)
     assert_parse_error("material m lambertian 1 1 1\nsphere 0 0 0 1 m extra", "s.txt:2:18: ",
                        "unexpected 'extra' after the sphere (expected end of line)");
     /* Statements with optional clauses name the clauses they take. */
-    assert_parse_error("sky constant 1 1 1 2", "s.txt:1:20: ", "unknown sky clause '2' (expected intensity)");
+    assert_parse_error("sky constant 1 1 1 2", "s.txt:1:20: ", "unknown sky clause '2' (expected intensity or group)");
     assert_parse_error("sky gradient 1 1 1 0 0 0 \"x\"", "s.txt:1:26: ", "unknown sky clause the string \"x\"");
     assert_parse_error("material g dielectric 1.5 2", "s.txt:1:27: ",
                        "unknown dielectric material clause '2' (expected normal_map)");
@@ -1241,7 +1241,7 @@ static void test_material_textures_and_normal_maps(void **state)
     assert_parse_error("material m dielectric 1.5 normal_map \"a.png\" normal_map \"b.png\"", "s.txt:1:46: ",
                        "clause 'normal_map' given twice");
     assert_parse_error("material m emissive 1 1 1 normal_map \"a.png\"", "s.txt:1:27: ",
-                       "unknown emissive material clause 'normal_map' (expected strength or one_sided)");
+                       "unknown emissive material clause 'normal_map' (expected strength, one_sided or group)");
 }
 
 /* The pbr material: every clause, the defaults (ior 1.5, opaque, no emission), emission
@@ -1313,8 +1313,8 @@ static void test_pbr_material(void **state)
                        "the strength of material 'm' must be >= 0, found -1");
     assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 fuzz 1", "s.txt:1:45: ",
                        "unknown pbr material clause 'fuzz' (expected metallic, roughness, ior, transmission, "
-                       "emission, strength, one_sided, alpha, alpha_cutoff, vertex_colors, normal_map or "
-                       "metallic_roughness_map)");
+                       "emission, strength, one_sided, alpha, alpha_cutoff, vertex_colors, normal_map, "
+                       "metallic_roughness_map or group)");
     assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 metallic 1", "s.txt:1:45: ",
                        "pbr material clause 'metallic' given twice");
     assert_parse_error("material m pbr 1 1 1 metallic 0 roughness 0 emission @nothing", "s.txt:1:54: ",
@@ -2479,13 +2479,13 @@ static void test_light_errors(void **state)
 
     /* Clauses that the type does not take, unknown and repeated clauses, extra tokens. */
     assert_parse_error("light point 0 0 0 cone 10 20", "s.txt:1:19: ",
-                       "unknown point light clause 'cone' (expected color, intensity or falloff)");
+                       "unknown point light clause 'cone' (expected color, intensity, falloff or group)");
     assert_parse_error("light point 0 0 0 angle 1", "s.txt:1:19: ", "unknown point light clause 'angle'");
     assert_parse_error("light sun 0 -1 0 falloff inverse_square", "s.txt:1:18: ",
-                       "unknown sun light clause 'falloff' (expected color, intensity or angle)");
+                       "unknown sun light clause 'falloff' (expected color, intensity, angle or group)");
     assert_parse_error("light sun 0 -1 0 cone 1 2", "s.txt:1:18: ", "unknown sun light clause 'cone'");
     assert_parse_error("light spot 0 5 0 at 0 0 0 angle 1", "s.txt:1:27: ",
-                       "unknown spot light clause 'angle' (expected color, intensity, cone or falloff)");
+                       "unknown spot light clause 'angle' (expected color, intensity, cone, falloff or group)");
     assert_parse_error("light spot 0 5 0 at 0 0 0 at 1 1 1", "s.txt:1:27: ", "unknown spot light clause 'at'");
     assert_parse_error("light point 0 0 0 2", "s.txt:1:19: ", "unknown point light clause '2'");
     assert_parse_error("light point 0 0 0 colour 1 1 1", "s.txt:1:19: ", "unknown point light clause 'colour'");
@@ -2642,7 +2642,7 @@ static void test_material_phong_and_specular(void **state)
     assert_parse_error("material g dielectric 1.5 phong 8", "s.txt:1:27: ",
                        "unknown dielectric material clause 'phong' (expected normal_map)");
     assert_parse_error("material l emissive 1 1 1 specular 1 1 1", "s.txt:1:27: ",
-                       "unknown emissive material clause 'specular' (expected strength or one_sided)");
+                       "unknown emissive material clause 'specular' (expected strength, one_sided or group)");
 }
 
 /* The example in docs/scene-format.md's light section, exactly. */

@@ -1,0 +1,103 @@
+#!/bin/sh
+# test-light-groups.sh: --light-groups and rtspheres relight end to end. The layers sum to
+# the beauty image (relight with every weight 1, compared pixel by pixel within float
+# rounding: 1e-4 on values up to about 10, a few ulps of a sum of samples) for every golden
+# scene at 32x18 and 4 spp with its options (both integrators, volumes, environment), and
+# for a scene with every kind of light in its own group with light sampling on and off;
+# relight writes 8-bit outputs tone-mapped as render does; bad input is exit 2. The
+# statistics (a layer is its light alone, relight by k is the light times k) are
+# tests/unit/test_light_groups.c. About 85 s in `make test` on the loaded machine (43 s of CPU).
+#   usage: sh tests/render/test-light-groups.sh PROGRAM SCRATCH_DIR
+here=$(dirname "$0")
+. "$here/lib.sh"
+
+# sums NAME EXR: one check: relighting EXR with every weight 1 gives its R, G, B back.
+sums() {
+    if ! "$program" relight "$2" -o "$scratch/sum.exr" --quiet 2>"$scratch/stderr"; then
+        fail "$1" "relight failed: $(head -c 300 "$scratch/stderr")"
+    elif "$program" diff "$2" "$scratch/sum.exr" --fail 1e-4 --failpercent 0 >"$scratch/diff" 2>&1; then
+        pass "$1 ($(grep '^max error' "$scratch/diff"))"
+    else
+        fail "$1" "the layers do not sum to the image: $(tr '\n' ' ' <"$scratch/diff" | head -c 300)"
+    fi
+}
+
+# The golden suite's cases: `case NAME SCENE GOLDEN [OPTIONS...]` (a suite file of check).
+grep '^case ' "$here/golden-scenes.txt" | {
+    while read -r _ name scene _ extra; do
+        # shellcheck disable=SC2086 # $extra is a list of options; the later --size wins
+        if "$program" render "$scene" -o "$scratch/$name.exr" --quiet $extra --size 32x18 --spp 4 --light-groups \
+            2>"$scratch/stderr"; then
+            sums "layers sum to the image: $name" "$scratch/$name.exr"
+        else
+            fail "layers sum to the image: $name" "render failed: $(head -c 300 "$scratch/stderr")"
+        fi
+    done
+    finish
+} || failures=$((failures + 1))
+
+scene=$here/scenes/light-groups.txt
+for options in "" "--light-sampling off" "--integrator whitted" "--sampler independent"; do
+    # shellcheck disable=SC2086
+    "$program" render "$scene" -o "$scratch/groups.exr" --quiet $options --light-groups
+    sums "every kind of light in a group ${options:-(defaults)}" "$scratch/groups.exr"
+done
+
+# The layers are named by the scene's groups, default first, and listed in the metadata.
+"$program" render "$scene" -o "$scratch/groups.exr" --quiet --light-groups
+groups=$(metadata "$scratch/groups.exr" light_groups)
+if [ "$groups" = "default,sky,panel,key,fill,sun" ]; then pass "rtspheres:light_groups lists the groups"
+else fail "rtspheres:light_groups lists the groups" "'$groups'"; fi
+stats_of "$scratch/groups.exr"
+missing=""
+for group in default sky panel key fill sun; do
+    for c in R G B; do [ -n "$(stat_mean "$group.$c")" ] || missing="$missing $group.$c"; done
+done
+if [ -z "$missing" ]; then pass "a layer NAME.R/G/B per group"; else fail "a layer NAME.R/G/B per group" "missing$missing"; fi
+# The key light's layer is lit: its mean is a real share of the image.
+key=$(stat_mean key.R) all=$(stat_mean R)
+if awk -v k="$key" -v a="$all" 'BEGIN { exit !(k > 0.05 * a && k < a) }'; then pass "the key layer holds light"
+else fail "the key layer holds light" "key.R mean $key of R $all"; fi
+
+# Relighting to 8 bits: with every weight 1 it is the render's own 8-bit image (exposure
+# and tone mapping as render applies them), within one 8-bit step.
+"$program" render "$scene" -o "$scratch/render.png" --quiet --exposure 1 --tonemap aces
+"$program" relight "$scratch/groups.exr" -o "$scratch/relit.png" --quiet --exposure 1 --tonemap aces
+if "$program" diff "$scratch/render.png" "$scratch/relit.png" --fail 0.0040 --failpercent 0 >"$scratch/diff" 2>&1
+then pass "relight to PNG is render's PNG"
+else fail "relight to PNG is render's PNG" "$(tr '\n' ' ' <"$scratch/diff" | head -c 300)"; fi
+# Turning every group off but one leaves that group's layer as the image.
+"$program" relight "$scratch/groups.exr" -o "$scratch/key.exr" --quiet --group default=0 --group sky=0 \
+    --group panel=0 --group fill=0 --group sun=0,0,0
+key_only=$(channel_mean "$scratch/key.exr" R)
+if within "$key_only" "$key" 1e-5; then pass "relight with the others at 0 is the key layer"
+else fail "relight with the others at 0 is the key layer" "R mean $key_only, key.R mean $key"; fi
+# A relit EXR keeps its weighted layers: relighting it again composes the weights.
+"$program" relight "$scratch/key.exr" -o "$scratch/key2.exr" --quiet --group key=2
+twice=$(channel_mean "$scratch/key2.exr" R)
+if within "$twice" "$(awk -v k="$key" 'BEGIN { print 2 * k }')" 1e-5; then pass "a relit EXR relights again"
+else fail "a relit EXR relights again" "R mean $twice, expected 2 x $key"; fi
+
+# Bad input: exit 2 with a message, nothing written.
+"$program" render "$scene" -o "$scratch/plain.exr" --quiet
+mkdir -p "$scratch/out"
+expect_refusal "relight of a file without layers" "has no light group layers" "$scratch/out" \
+    "$program" relight "$scratch/plain.exr" -o "$scratch/out/x.exr"
+expect_refusal "relight of a group the file lacks" "no light group 'rim' in the image; it has default,sky,panel,key,fill,sun" \
+    "$scratch/out" "$program" relight "$scratch/groups.exr" -o "$scratch/out/x.png" --group rim=2
+expect_refusal "a weight that is no number" "not a number SCALE or three numbers R,G,B" "$scratch/out" \
+    "$program" relight "$scratch/groups.exr" -o "$scratch/out/x.png" --group key=1,2
+expect_refusal "relight onto its input" "is the input" "$scratch/out" \
+    "$program" relight "$scratch/groups.exr" -o "$scratch/groups.exr"
+expect_refusal "--light-groups to a PNG" "only .exr keeps" "$scratch/out" \
+    "$program" render "$scene" -o "$scratch/out/x.png" --light-groups
+expect_refusal "--light-groups with --denoise" "no longer sum to the image" "$scratch/out" \
+    "$program" render "$scene" -o "$scratch/out/x.exr" --light-groups --denoise
+expect_refusal "--light-groups with --samples" "merge keeps no light group layers" "$scratch/out" \
+    "$program" render "$scene" -o "$scratch/out/x.exr" --light-groups --samples 0:8
+expect_refusal "--light-groups with a shard by samples" "shard by frames" "$scratch/out" \
+    "$program" render "$scene" -o "$scratch/out/x.exr" --light-groups --shard 0/2
+printf 'light point 0 1 0 group a.b\n' >"$scratch/bad.txt"
+expect_refusal "a group name with a dot" "bad.txt:1:25: light group name 'a.b' has a '.'" "$scratch/out" \
+    "$program" render "$scratch/bad.txt" -o "$scratch/out/x.exr" --light-groups
+finish
