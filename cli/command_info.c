@@ -100,6 +100,7 @@ int command_info(int argc, char **argv)
     printf("GL version:       %s\n", info.gl_version);
     printf("GLSL version:     %s\n", info.glsl_version);
     printf("max texture size: %d\n", info.max_texture_size);
+    printf("max tile side:    %d (larger images render in tiles)\n", info.max_tile_side);
     printf("max texture buffer size: %d texels (the packed scene's limit)\n", info.max_texture_buffer_size);
     if (info.simd_lanes > 0)
         printf("work bound:       %d lanes per shader invocation under a 65,535-iteration loop cap: "

@@ -95,6 +95,16 @@ static void draw_progress(void *user, const render_progress *progress)
     fflush(stderr);
 }
 
+/* render_job_callbacks.tiles_planned: says that (and why) the image is rendered in tiles. */
+static void show_tiles(void *user, const render_job_image *image, int columns, int rows, int tile_width,
+                       int tile_height, const char *reason)
+{
+    const presentation *shown = user;
+    if (!shown->arguments->quiet)
+        fprintf(stderr, "rtspheres: %s: rendering in %d x %d tiles of up to %dx%d pixels (%s)\n", image->output,
+                columns, rows, tile_width, tile_height, reason);
+}
+
 /* render_job_callbacks.render_finished: ends the bar's line. */
 static void end_bar(void *user, const render_job_image *image, rt_status status)
 {
@@ -207,6 +217,7 @@ static int run_job(gpu_context *context, const render_arguments *arguments, disp
     render_job_callbacks callbacks = {
         .user = &shown,
         .warning = show_warning,
+        .tiles_planned = show_tiles,
         .render_started = start_bar,
         .progress = draw_progress,
         .render_finished = end_bar,

@@ -2,6 +2,7 @@
  * "rtspheres render: ..." (exit 2), and names the option and the value it refused. */
 #include "render_arguments.h"
 
+#include <ctype.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdint.h>
@@ -26,7 +27,10 @@ static void print_help(FILE *stream)
             "                         frame-%%04d.png gets each frame's number with --frames,\n"
             "                         else the value of -D frame=N, else 0 (%%%% for a '%%')\n"
             "  -s, --spp N            samples per pixel\n"
-            "      --size WxH         image size in pixels, e.g. 640x360\n"
+            "      --size WxH         image size in pixels, e.g. 640x360 (each 1 to 65536)\n"
+            "      --memory-budget SIZE  memory an image's render may take, e.g. 512M, 2G (default:\n"
+            "                         a quarter of the machine's memory, at most 1G); larger\n"
+            "                         images, and any wider than the device, render in tiles\n"
             "      --max-depth N      path segments per sample at most\n"
             "      --seed N           random seed (same seed, same image)\n"
             "      --camera NAME      a glTF scene: render its camera (or camera node) NAME\n"
@@ -101,6 +105,7 @@ enum {
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
     OPTION_LIGHT_GROUPS, OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
     OPTION_CAMERA, OPTION_NOISE_THRESHOLD, OPTION_MIN_SPP, OPTION_TIME_LIMIT, OPTION_SAMPLES_MAP,
+    OPTION_MEMORY_BUDGET,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -203,8 +208,8 @@ static const char *take_value(int option, const char *value, render_job *job)
     int word = 0;
     switch (option) {
     case OPTION_SIZE:
-        if (!parse_pair(value, 'x', 1, 16384, 1, 16384, &a, &b))
-            return "--size wants WIDTHxHEIGHT, each 1 to 16384, e.g. 640x360";
+        if (!parse_pair(value, 'x', 1, SCENE_MAX_IMAGE_SIDE, 1, SCENE_MAX_IMAGE_SIDE, &a, &b))
+            return "--size wants WIDTHxHEIGHT, each 1 to 65536, e.g. 640x360";
         job->width = (int)a;
         job->height = (int)b;
         return NULL;
@@ -233,6 +238,23 @@ static const char *take_value(int option, const char *value, render_job *job)
         if (!parse_real(value, &threshold) || !(threshold > 0) || threshold > 1e6)
             return "--noise-threshold wants a positive number, e.g. 0.05 (a relative standard error)";
         job->tracer.noise_threshold = (float)threshold;
+        return NULL;
+    }
+    case OPTION_MEMORY_BUDGET: {
+        /* A size as Slurm's --mem spells one: K, M, G or T (powers of 1024), else bytes. */
+        char *end = NULL;
+        double amount = strtod(value, &end);
+        const char *units = "KMGT";
+        const char *unit = end != NULL && *end != '\0' ? strchr(units, toupper((unsigned char)*end)) : NULL;
+        if (unit != NULL && end[1] == 'i' && end[2] == 'B' && end[3] == '\0')
+            end += 2;
+        else if (unit != NULL && (end[1] == 'B' || end[1] == 'b') && end[2] == '\0')
+            end += 1;
+        double scale = unit != NULL ? pow(1024.0, (double)(unit - units + 1)) : 1.0;
+        if (end == value || !(amount > 0) || (unit == NULL && *end != '\0') || (unit != NULL && end[1] != '\0')
+            || amount * scale < 65536.0 || amount * scale > 1e18)
+            return "--memory-budget wants a size of at least 64K, e.g. 512M or 2G (K, M, G, T: powers of 1024)";
+        job->memory_budget = (uint64_t)(amount * scale);
         return NULL;
     }
     case OPTION_TIME_LIMIT:
@@ -440,6 +462,7 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
         {"noise-threshold", required_argument, NULL, OPTION_NOISE_THRESHOLD},
         {"min-spp", required_argument, NULL, OPTION_MIN_SPP},
         {"time-limit", required_argument, NULL, OPTION_TIME_LIMIT},
+        {"memory-budget", required_argument, NULL, OPTION_MEMORY_BUDGET},
         {"samples-map", required_argument, NULL, OPTION_SAMPLES_MAP},
         {"resume", required_argument, NULL, OPTION_RESUME},
         {"camera", required_argument, NULL, OPTION_CAMERA},

@@ -205,6 +205,21 @@ static void read_gl_info(gpu_context *context)
                 (const char *)glGetString(GL_SHADING_LANGUAGE_VERSION));
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &info->max_texture_size);
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &info->max_texture_buffer_size);
+    /* A tile is a texture and a framebuffer's attachment: it must fit every one of these. */
+    GLint framebuffer_width = 0, framebuffer_height = 0, renderbuffer_size = 0;
+    glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &framebuffer_width);
+    glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &framebuffer_height);
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &renderbuffer_size);
+    info->max_tile_side = info->max_texture_size;
+    const GLint side_limits[3] = {framebuffer_width, framebuffer_height, renderbuffer_size};
+    for (int i = 0; i < 3; i++)
+        if (side_limits[i] > 0 && side_limits[i] < info->max_tile_side)
+            info->max_tile_side = side_limits[i];
+    /* For tests of images wider than the device, which a real device's 16384 or 32768
+     * would make far too slow for a test: lowers, never raises, the tile side. */
+    const char *test_side = getenv("RTSPHERES_TEST_MAX_TEXTURE_SIZE");
+    if (test_side != NULL && atoi(test_side) > 0 && atoi(test_side) < info->max_tile_side)
+        info->max_tile_side = atoi(test_side);
     /* For tests of the "scene too large" path, which no real test scene could reach
      * (134M texels is 2 GiB): RTSPHERES_TEST_MAX_TEXTURE_BUFFER_SIZE lowers, never
      * raises, the limit. */

@@ -56,7 +56,12 @@ typedef struct gpu_info {
     char device_extensions[512]; /* of the chosen device, "" for surfaceless */
     char egl_vendor[128], egl_version[128];
     char gl_vendor[128], gl_renderer[256], gl_version[128], glsl_version[128];
-    int max_texture_size;
+    int max_texture_size;        /* GL_MAX_TEXTURE_SIZE as the driver says */
+    /* The widest and tallest tile the tracer can render: the least of GL_MAX_TEXTURE_SIZE,
+     * GL_MAX_FRAMEBUFFER_WIDTH/HEIGHT and GL_MAX_RENDERBUFFER_SIZE. Larger images are
+     * rendered in tiles (render_job.h). The test hook RTSPHERES_TEST_MAX_TEXTURE_SIZE
+     * lowers, never raises, it. */
+    int max_tile_side;
     int max_texture_buffer_size; /* texels of a buffer texture: bounds the packed scene */
     int max_draw_buffers;
     int max_color_attachments;
@@ -189,8 +194,14 @@ typedef struct gpu_tracer gpu_tracer;
  * already holds exactly these texels) (texel_count texels of 4 uint32 each,
  * see packed_layout.h; texel_hash: their hash, pack.h's packed_scene.texel_hash, which
  * tells whether the context holds them) and creates the state textures for
- * parameters->width x height. Too large for the device (texture size, memory) is
- * RT_ERROR_INPUT saying which limit. Free with gpu_tracer_destroy(). */
+ * parameters->width x height. Wider or taller than gpu_info.max_tile_side is RT_ERROR_INPUT
+ * naming the limit; a device that cannot hold the state (GL_OUT_OF_MEMORY, or a state
+ * framebuffer it calls incomplete) is RT_ERROR_RUNTIME "GPU: out of memory for the state
+ * of a WxH image (N MiB); ..." naming the size and what to try (a smaller
+ * --memory-budget), never a raw framebuffer status. Test hook: RTSPHERES_TEST_GPU_FAILURE
+ * = "memory" or "framebuffer" makes the state's creation fail as that failure would.
+ * Free with gpu_tracer_destroy(). */
+#define GPU_TRACER_STATE_BYTES_PER_PIXEL (2 * TRACER_STATE_COUNT * 16 + 4)
 rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
                             uint64_t texel_hash, const gpu_tracer_parameters *parameters, gpu_tracer **out,
                             rt_error *error);

@@ -309,18 +309,33 @@ static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels,
     return check_gl("uploading the packed scene", error);
 }
 
+/* The message of a device that could not hold a width x height image's state (bytes of
+ * it; what: the failure as the driver put it): the size, and what the user can do. */
+static rt_status state_out_of_memory(const gpu_tracer *tracer, const char *what, rt_error *error)
+{
+    double mib = (double)tracer->width * tracer->height * GPU_TRACER_STATE_BYTES_PER_PIXEL / (1024.0 * 1024.0);
+    return rt_error_set(error, RT_ERROR_RUNTIME,
+                        "GPU: out of memory for the state of a %dx%d image (%.0f MiB on the device; %s): give a "
+                        "smaller --memory-budget, which renders the image in smaller tiles",
+                        tracer->width, tracer->height, mib, what);
+}
+
 /* Creates both sets of state textures (zeroed) and their framebuffers. */
 static rt_status create_state(gpu_tracer *tracer, rt_error *error)
 {
-    int max_size = tracer->context->info.max_texture_size;
+    int max_size = tracer->context->info.max_tile_side;
     if (tracer->width > max_size || tracer->height > max_size)
         return rt_error_set(error, RT_ERROR_INPUT,
-                            "GPU: the image %dx%d is larger than the device's textures (GL_MAX_TEXTURE_SIZE %d): "
-                            "render it in tiles (--tile, --crop) of at most %d pixels a side",
+                            "GPU: the image %dx%d is larger than the device's textures and framebuffers (%d pixels "
+                            "a side): render it in tiles of at most %d pixels a side",
                             tracer->width, tracer->height, max_size, max_size);
     if (tracer->context->info.max_draw_buffers < TRACER_STATE_COUNT)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
                             TRACER_STATE_COUNT, tracer->context->info.max_draw_buffers);
+    /* The test hook forces the two failures a real device shows only for huge images. */
+    const char *forced = getenv("RTSPHERES_TEST_GPU_FAILURE");
+    if (forced != NULL && strcmp(forced, "memory") == 0)
+        return state_out_of_memory(tracer, "GL_OUT_OF_MEMORY", error);
     GLenum draw_buffers[TRACER_STATE_COUNT];
     for (int set = 0; set < 2; set++) {
         glGenTextures(TRACER_STATE_COUNT, tracer->state_textures[set]);
@@ -338,9 +353,17 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
         }
         glDrawBuffers(TRACER_STATE_COUNT, draw_buffers);
         GLenum complete = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-        if (complete != GL_FRAMEBUFFER_COMPLETE)
-            return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the state framebuffer is incomplete (0x%04x)",
-                                complete);
+        if (forced != NULL && strcmp(forced, "framebuffer") == 0)
+            complete = GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT;
+        /* A texture the driver could not allocate leaves its attachment incomplete
+         * (llvmpipe above about 4 GiB a texture): memory, in the user's words. */
+        if (complete != GL_FRAMEBUFFER_COMPLETE) {
+            while (glGetError() != GL_NO_ERROR) {
+            }
+            char what[96];
+            snprintf(what, sizeof what, "the driver left the state framebuffer incomplete, status 0x%04x", complete);
+            return state_out_of_memory(tracer, what, error);
+        }
         const GLfloat zero[4] = {0, 0, 0, 0};
         const GLuint zero_uint[4] = {0, 0, 0, 0};
         for (int target = 0; target < TRACER_STATE_COUNT; target++) {
@@ -360,9 +383,7 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     glClearTexImage(tracer->sample_limits, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, no_limit);
     rt_status status = check_gl("creating the state textures", error);
     if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
-        return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for a %dx%d image's state (%d MB)",
-                            tracer->width, tracer->height,
-                            (int)((double)tracer->width * tracer->height * 16 * 2 * TRACER_STATE_COUNT / 1e6));
+        return state_out_of_memory(tracer, "GL_OUT_OF_MEMORY", error);
     return status;
 }
 

@@ -229,33 +229,33 @@ bool encodes_in_memory(const std::string &extension)
     return strcasecmp(e, ".tif") != 0 && strcasecmp(e, ".tiff") != 0;
 }
 
-/* Has OIIO write image as the format of format_path: into bytes when memory is not null,
- * else into the file file_path (which is also the name OIIO's messages use). Returns ""
- * on success, else OIIO's message. */
-std::string encode(const std::string &format_path, const char *file_path, file_kind kind,
-                   const rt_image *image, const image_write_options *options,
-                   OIIO::Filesystem::IOVecOutput *memory)
+/* The pixels written for image in a file of this kind, as floats: 8-bit files'
+ * (eight_bit_pixels()), Radiance HDR's RGB (the first three channels, or a grey one
+ * thrice), an EXR's as they are. Every step is per pixel, so a band of rows converts
+ * to the rows of the whole image's conversion. */
+OIIO::ImageBuf pixels_for_kind(file_kind kind, const rt_image *image, float exposure)
 {
-    auto output = OIIO::ImageOutput::create(format_path, memory);
-    if (!output)
-        return one_line(OIIO::geterror());
-    if (memory != nullptr && !output->supports("ioproxy"))
-        return "the OpenImageIO plugin for this format cannot write to memory";
-
-    /* Radiance HDR holds exactly RGB: the first three channels, or a grey one thrice. */
-    OIIO::ImageBuf pixels;
-    if (kind == file_kind::eight_bit) {
-        pixels = eight_bit_pixels(image, options->exposure);
-    } else if (kind == file_kind::hdr) {
-        pixels = image->channels >= 3 ? OIIO::ImageBufAlgo::channels(wrap(image), 3, {0, 1, 2}, {}, {"R", "G", "B"})
-                                      : OIIO::ImageBufAlgo::channels(wrap(image), 3, {0, 0, 0}, {}, {"R", "G", "B"});
+    if (kind == file_kind::eight_bit)
+        return eight_bit_pixels(image, exposure);
+    if (kind == file_kind::hdr) {
+        OIIO::ImageBuf pixels =
+            image->channels >= 3 ? OIIO::ImageBufAlgo::channels(wrap(image), 3, {0, 1, 2}, {}, {"R", "G", "B"})
+                                 : OIIO::ImageBufAlgo::channels(wrap(image), 3, {0, 0, 0}, {}, {"R", "G", "B"});
         check(pixels.initialized(), pixels);
-    } else {
-        pixels = wrap(image);
+        return pixels;
     }
+    return wrap(image);
+}
 
-    /* 8-bit files are quantised by OIIO, from floats to the spec's format as it writes. */
-    OIIO::ImageSpec spec = pixels.spec();
+/* The spec of a file of this kind holding pixels (pixels_for_kind()'s, of height rows:
+ * the whole image's, a band may be shorter) of image: 8-bit files quantised by OIIO as it
+ * writes, an EXR's place in the full image, the colour space and the caller's metadata. */
+OIIO::ImageSpec spec_for_kind(file_kind kind, const OIIO::ImageSpec &pixels, int height, const rt_image *image,
+                              const image_write_options *options)
+{
+    OIIO::ImageSpec spec = pixels;
+    spec.height = height;
+    spec.full_height = height;
     if (kind == file_kind::eight_bit)
         spec.set_format(OIIO::TypeDesc::UINT8);
     /* A crop or tile of a larger image keeps its place: EXR stores it as the data window
@@ -274,7 +274,23 @@ std::string encode(const std::string &format_path, const char *file_path, file_k
     if (kind == file_kind::eight_bit)
         spec.attribute("oiio:UnassociatedAlpha", 1);
     add_attributes(spec, options);
+    return spec;
+}
 
+/* Has OIIO write image as the format of format_path: into bytes when memory is not null,
+ * else into the file file_path (which is also the name OIIO's messages use). Returns ""
+ * on success, else OIIO's message. */
+std::string encode(const std::string &format_path, const char *file_path, file_kind kind,
+                   const rt_image *image, const image_write_options *options,
+                   OIIO::Filesystem::IOVecOutput *memory)
+{
+    auto output = OIIO::ImageOutput::create(format_path, memory);
+    if (!output)
+        return one_line(OIIO::geterror());
+    if (memory != nullptr && !output->supports("ioproxy"))
+        return "the OpenImageIO plugin for this format cannot write to memory";
+    OIIO::ImageBuf pixels = pixels_for_kind(kind, image, options->exposure);
+    OIIO::ImageSpec spec = spec_for_kind(kind, pixels.spec(), image->height, image, options);
     if (!output->open(file_path, spec))
         return one_line(output->geterror());
     if (!output->write_image(OIIO::TypeDesc::FLOAT, pixels.localpixels())) {
@@ -332,6 +348,22 @@ rt_status write_failed(rt_error *error, const char *path, const std::string &why
                         why.c_str());
 }
 
+/* Returns the mkstemps() template of destination's temporary file (".NAME.tmp-XXXXXX"
+ * and the extension, in its directory, NUL-terminated) and sets directory to the
+ * directory. */
+std::vector<char> temporary_template(const std::string &destination, const std::string &extension,
+                                     std::string &directory)
+{
+    size_t slash = destination.find_last_of('/');
+    std::string prefix = slash == std::string::npos ? "" : destination.substr(0, slash + 1);
+    std::string base = destination.substr(prefix.size());
+    directory = prefix.empty() ? "." : prefix.size() == 1 ? "/" : prefix.substr(0, prefix.size() - 1);
+    std::string temporary = prefix + "." + base + ".tmp-XXXXXX" + extension;
+    std::vector<char> name(temporary.begin(), temporary.end());
+    name.push_back('\0');
+    return name;
+}
+
 /* Writes image to a temporary file next to path and renames it over path. On failure the
  * temporary file is removed and path is untouched. */
 rt_status image_write_impl(const char *path, const rt_image *image,
@@ -360,15 +392,8 @@ rt_status image_write_impl(const char *path, const rt_image *image,
     if (options == nullptr)
         options = &defaults;
 
-    size_t slash = destination.find_last_of('/');
-    std::string prefix = slash == std::string::npos ? "" : destination.substr(0, slash + 1);
-    std::string base = destination.substr(prefix.size());
-    std::string directory = prefix.empty()       ? "."
-                            : prefix.size() == 1 ? "/"
-                                                 : prefix.substr(0, prefix.size() - 1);
-    std::string temporary = prefix + "." + base + ".tmp-XXXXXX" + extension;
-    std::vector<char> temporary_name(temporary.begin(), temporary.end());
-    temporary_name.push_back('\0');
+    std::string directory;
+    std::vector<char> temporary_name = temporary_template(destination, extension, directory);
 
     int fd = mkstemps(temporary_name.data(), (int)extension.size());
     if (fd < 0)
@@ -657,7 +682,178 @@ rt_status image_read_guarded(const char *path, int max_side, bool linear, rt_ima
 
 }  // namespace
 
+/* A file being written band by band (image_stream_open()). */
+struct image_stream {
+    std::string destination, directory, temporary;
+    file_kind kind = file_kind::unknown;
+    std::unique_ptr<OIIO::ImageOutput> output;
+    rt_image layout{};           /* size, channels, names and place; no pixels */
+    float exposure = 0;
+    int next_row = 0;
+};
+
+namespace {
+
+/* Ends stream: closes its output, removes the temporary file and frees it. */
+void abandon_stream(image_stream *stream)
+{
+    if (stream->output)
+        stream->output->close();
+    if (!stream->temporary.empty())
+        unlink(stream->temporary.c_str());
+    delete stream;
+}
+
+/* The body of image_stream_open(). */
+rt_status open_stream(const char *path, const rt_image *layout, const image_write_options *options,
+                      image_stream **out, rt_error *error)
+{
+    const std::string destination = path;
+    const std::string extension = extension_of(destination);
+    file_kind kind = kind_of_extension(extension);
+    if (kind == file_kind::unknown)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: cannot write '%s': unknown extension '%s' (supported: %s)",
+                            path, extension.c_str(), supported_extensions);
+    if (layout->width <= 0 || layout->height <= 0 || layout->channels <= 0 || layout->channels > IMAGE_MAX_CHANNELS)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: cannot write '%s': not a valid image (%dx%d, %d channels)",
+                            path, layout->width, layout->height, layout->channels);
+    image_write_options defaults = image_write_options_defaults();
+    if (options == nullptr)
+        options = &defaults;
+    std::unique_ptr<image_stream> stream(new image_stream);
+    stream->destination = destination;
+    stream->kind = kind;
+    stream->layout = *layout;
+    stream->layout.pixels = nullptr;
+    stream->exposure = options->exposure;
+    std::vector<char> name = temporary_template(destination, extension, stream->directory);
+    int fd = mkstemps(name.data(), (int)extension.size());
+    if (fd < 0)
+        return write_failed(error, path, std::string("cannot create a temporary file in '") + stream->directory
+                                             + "': " + strerror(errno));
+    stream->temporary = name.data();
+    /* OIIO writes the file itself (a band at a time cannot go through memory): the
+     * descriptor only reserved the name and gives the file its mode. */
+    int mode_error = fchmod(fd, new_file_mode()) != 0 ? errno : 0;
+    ::close(fd);
+    if (mode_error != 0) {
+        unlink(stream->temporary.c_str());
+        return write_failed(error, path, strerror(mode_error));
+    }
+    /* The spec of the converted pixels, from a one-row stand-in of the layout. */
+    rt_image row = stream->layout;
+    row.height = 1;
+    std::vector<float> zeros((size_t)row.width * row.channels);
+    row.pixels = zeros.data();
+    OIIO::ImageBuf converted = pixels_for_kind(kind, &row, options->exposure);
+    OIIO::ImageSpec spec = spec_for_kind(kind, converted.spec(), layout->height, layout, options);
+    stream->output = OIIO::ImageOutput::create(destination);
+    std::string failure = !stream->output ? one_line(OIIO::geterror()) : "";
+    if (failure.empty() && !stream->output->open(stream->temporary, spec))
+        failure = one_line(stream->output->geterror());
+    if (!failure.empty()) {
+        stream->output.reset();
+        abandon_stream(stream.release());
+        return write_failed(error, path, failure);
+    }
+    *out = stream.release();
+    return RT_OK;
+}
+
+}  // namespace
+
 extern "C" {
+
+rt_status image_stream_open(const char *path, const rt_image *layout, const image_write_options *options,
+                            image_stream **out, rt_error *error)
+{
+    *out = nullptr;
+    if (path == nullptr || layout == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path or image to write");
+    try {
+        return open_stream(path, layout, options, out, error);
+    } catch (const std::bad_alloc &) {
+        return write_failed(error, path, "out of memory");
+    } catch (const std::exception &e) {
+        return write_failed(error, path, one_line(e.what()));
+    } catch (...) {
+        return write_failed(error, path, "unexpected C++ exception");
+    }
+}
+
+rt_status image_stream_write_rows(image_stream *stream, const rt_image *rows, rt_error *error)
+{
+    const char *path = stream->destination.c_str();
+    if (rows->width != stream->layout.width || rows->channels != stream->layout.channels || rows->height <= 0
+        || stream->next_row + rows->height > stream->layout.height)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "IMAGE: cannot write '%s': a band of %dx%d with %d channels does not continue a %dx%d "
+                            "image of %d channels at row %d",
+                            path, rows->width, rows->height, rows->channels, stream->layout.width,
+                            stream->layout.height, stream->layout.channels, stream->next_row);
+    std::string failure;
+    try {
+        rt_image band = stream->layout;
+        band.height = rows->height;
+        band.pixels = rows->pixels;
+        OIIO::ImageBuf converted = pixels_for_kind(stream->kind, &band, stream->exposure);
+        /* An EXR's rows are numbered within its data window, which starts at its place. */
+        int first = stream->next_row + (stream->kind == file_kind::exr && stream->layout.full_width > 0
+                                            ? stream->layout.y : 0);
+        if (!stream->output->write_scanlines(first, first + rows->height, 0, OIIO::TypeDesc::FLOAT,
+                                             converted.localpixels()))
+            failure = one_line(stream->output->geterror());
+    } catch (const std::bad_alloc &) {
+        failure = "out of memory";
+    } catch (const std::exception &e) {
+        failure = one_line(e.what());
+    } catch (...) {
+        failure = "unexpected C++ exception";
+    }
+    if (!failure.empty())
+        return write_failed(error, path, failure);
+    stream->next_row += rows->height;
+    return RT_OK;
+}
+
+rt_status image_stream_close(image_stream *stream, rt_error *error)
+{
+    std::string path = stream->destination;
+    std::string failure;
+    if (stream->next_row != stream->layout.height)
+        failure = "only " + std::to_string(stream->next_row) + " of its " + std::to_string(stream->layout.height)
+                  + " rows were written";
+    if (failure.empty() && !stream->output->close())
+        failure = one_line(stream->output->geterror());
+    if (failure.empty()) {
+        int fd = ::open(stream->temporary.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd >= 0) {
+            if (fsync(fd) != 0 && errno != EINVAL)
+                failure = strerror(errno);
+            ::close(fd);
+        }
+    }
+    if (failure.empty() && rename(stream->temporary.c_str(), path.c_str()) != 0)
+        failure = std::string("cannot rename the temporary file over it: ") + strerror(errno);
+    if (!failure.empty()) {
+        stream->output.reset();
+        abandon_stream(stream);
+        return write_failed(error, path.c_str(), failure);
+    }
+    std::string directory = stream->directory;
+    stream->temporary.clear();
+    stream->output.reset();
+    delete stream;
+    sync_directory(directory);
+    return RT_OK;
+}
+
+void image_stream_abandon(image_stream *stream)
+{
+    if (stream != nullptr)
+        abandon_stream(stream);
+}
+
 
 image_write_options image_write_options_defaults(void)
 {

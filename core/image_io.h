@@ -100,6 +100,31 @@ void image_free(rt_image *image);
 rt_status image_write(const char *path, const rt_image *image, const image_write_options *options,
                       rt_error *error);
 
+/* Writing an image band by band, for images too large to hold (render_job.h's tiles): the
+ * same file image_write() makes of the whole image, pixel for pixel (every conversion is
+ * per pixel), written to the same kind of temporary file and renamed over path by
+ * image_stream_close() only. OpenImageIO writes the file itself: EXR by scanlines (its
+ * data window at layout's place), PNG, JPEG, TIFF and HDR by scanlines. */
+typedef struct image_stream image_stream;
+
+/* Creates path's temporary file for an image of layout's size, channels, names and place
+ * (its pixels are not read) with options' metadata and exposure, and returns the stream
+ * in *out. Errors as image_write()'s; nothing is left behind. */
+rt_status image_stream_open(const char *path, const rt_image *layout, const image_write_options *options,
+                            image_stream **out, rt_error *error);
+
+/* Writes the next rows->height rows (rows->width and channels as the layout's, rows top
+ * to bottom). A band that does not continue the image is RT_ERROR_INPUT; a failed write
+ * RT_ERROR_RUNTIME (the stream should then be abandoned). */
+rt_status image_stream_write_rows(image_stream *stream, const rt_image *rows, rt_error *error);
+
+/* Finishes the file and renames it over path; every row must have been written. Frees
+ * stream whatever happens; on failure the temporary file is removed and path untouched. */
+rt_status image_stream_close(image_stream *stream, rt_error *error);
+
+/* Removes the temporary file and frees stream: path stays as it was. NULL is ignored. */
+void image_stream_abandon(image_stream *stream);
+
 /* Reads the image at path into *out (allocated; caller frees with image_free()).
  * Missing, unreadable or malformed file: RT_ERROR_INPUT naming the file. */
 rt_status image_read(const char *path, rt_image *out, rt_error *error);

@@ -28,6 +28,22 @@ render_options render_options_defaults(void)
     return (render_options){0};
 }
 
+uint64_t render_bytes_per_pixel(const render_options *options, int light_group_count)
+{
+    /* Read-back: the rgba sums, GL's bottom-up copy, the statistics and theirs; the
+     * result's four channels and the copy a region's crop makes. */
+    uint64_t bytes = GPU_TRACER_STATE_BYTES_PER_PIXEL + 4 * 16 + 2 * 16;
+    if (options->aovs)           /* two AOV textures, their read-back, the 8-channel image twice */
+        bytes += 2 * 16 + 2 * 16 + 16 + 2 * 32 + 4;
+    if (options->variance)       /* the squares and GL's copy, the 3 layers, joined to the AOVs */
+        bytes += 2 * 16 + 12 + 44;
+    if (options->light_groups)   /* per group: the layer on the device, its read-back and copy, 3 channels twice */
+        bytes += (uint64_t)light_group_count * (16 + 2 * 16 + 2 * 12);
+    if (options->noise_threshold > 0)   /* the checks' read-back, limits, the sampler's arrays */
+        bytes += 16 + 4 + 4 + 16;
+    return bytes;
+}
+
 const char *render_stop_reason_name(render_stop_reason reason)
 {
     switch (reason) {

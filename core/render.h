@@ -163,6 +163,13 @@ typedef struct render_result {
 /* Returns options with every field at its default (all zero). */
 render_options render_options_defaults(void);
 
+/* Returns an estimate of the memory a render with these options takes per traced pixel at
+ * its peak, on the device and the host together (the state textures, gpu.h
+ * GPU_TRACER_STATE_BYTES_PER_PIXEL; the read-back copies; the result and its layers;
+ * adaptive sampling's buffers), light_group_count the scene's groups (counted only with
+ * options->light_groups). What render jobs tile an image by (render_job.h). */
+uint64_t render_bytes_per_pixel(const render_options *options, int light_group_count);
+
 /* Renders s with the scene's render settings on context. options may be NULL. On RT_OK
  * and on RT_ERROR_INTERRUPTED, result->image holds the image (the caller frees it with
  * image_free()); on other errors it is empty. */

@@ -1,6 +1,7 @@
 /* render_job.c: the running half of render_job.h: each image's scene, render, post-processing
  * and files. The planning half is render_job_plan.c, the files' format render_output.c. */
 #include "render_job.h"
+#include "render_job_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,26 +15,6 @@
 #include "render_output.h"
 #include "scene_assets.h"
 #include "scene_gltf.h"
-
-/* One run of a job: what every image needs. */
-typedef struct job_run {
-    gpu_context *context;
-    const render_job *job;
-    render_job_plan plan;
-    render_job_callbacks callbacks;      /* the caller's, or all NULL */
-    render_job_failure failure;          /* where the run stopped short */
-    bool image_begun;                    /* an image has begun (its limit counted from then) */
-    int sweep_row;                       /* the sweep row being rendered, -1: none */
-} job_run;
-
-/* One image being rendered: its scene (render settings after the job's overrides and
- * plan) and its plan. */
-typedef struct job_image {
-    job_run *run;
-    scene scene;
-    render_job_image plan;
-    double start;                        /* clock_seconds() its time limit counts from */
-} job_image;
 
 /* Loads the scene with the variables of frame (-1: none) and its assets into *s. On
  * failure *s is freed, and run->failure says whether the scene's own message is the error. */
@@ -80,30 +61,20 @@ static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
     return status;
 }
 
-/* Writes pixels (R, G, B means, samples, of the image's region) to path with the
- * metadata of image; complete says whether the render ended by its own rule. result gives
- * the AOV layers, region, path segments, scene hash, time and (but for a checkpoint, whose
- * passes have not ended) the stop reason. */
-static rt_status write_image(const job_image *image, const rt_image *pixels, const char *path, uint64_t samples,
-                             bool complete, bool checkpoint, const render_result *result, rt_error *error)
+void job_image_metadata(const job_image *image, uint64_t samples, bool complete, bool checkpoint,
+                        const render_result *result, render_output_metadata *metadata, job_metadata_texts *texts)
 {
     const render_job *job = image->run->job;
     const scene_render_settings *settings = &image->scene.render;
-    rt_image placed = *pixels;
-    placed.x = result->region[0];
-    placed.y = result->region[1];
-    placed.full_width = settings->width;
-    placed.full_height = settings->height;
-    char hash[24];
-    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)result->scene_hash);
+    snprintf(texts->hash, sizeof texts->hash, "%016llx", (unsigned long long)result->scene_hash);
     /* The layers' names (the partial file keeps none). */
-    char groups[SCENE_LIGHT_GROUP_MAX * (SCENE_LIGHT_GROUP_NAME_MAX + 1) + 1] = "";
+    texts->groups[0] = '\0';
     for (int g = 0; complete && job->light_groups && g < image->scene.light_group_count; g++)
-        snprintf(groups + strlen(groups), sizeof groups - strlen(groups), "%s%s", g > 0 ? "," : "",
-                 image->scene.light_groups[g]);
-    render_output_metadata metadata = {
+        snprintf(texts->groups + strlen(texts->groups), sizeof texts->groups - strlen(texts->groups), "%s%s",
+                 g > 0 ? "," : "", image->scene.light_groups[g]);
+    *metadata = (render_output_metadata){
         .scene = job->scene_path,
-        .scene_hash = hash,
+        .scene_hash = texts->hash,
         .spp = settings->samples_per_pixel,
         .sample_start = image->plan.sample_start,
         .seed = settings->seed,
@@ -113,19 +84,41 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
         .path_segments = result->path_segments,
         .complete = complete,
         .render_seconds = result->seconds,
-        .light_groups = groups[0] != '\0' ? groups : NULL,
+        .light_groups = texts->groups[0] != '\0' ? texts->groups : NULL,
     };
     if (!checkpoint) {
         bool adaptive = job->tracer.noise_threshold > 0;
         uint32_t min_spp = job->tracer.min_spp ? job->tracer.min_spp : ADAPTIVE_DEFAULT_MIN_SPP;
-        metadata.stop_reason = render_stop_reason_name(result->stop_reason);
-        metadata.noise_threshold = adaptive ? job->tracer.noise_threshold : 0.0f;
-        metadata.min_spp = !adaptive ? 0 : min_spp < (uint32_t)settings->samples_per_pixel ? (int)min_spp
-                                                                                         : settings->samples_per_pixel;
+        metadata->stop_reason = render_stop_reason_name(result->stop_reason);
+        metadata->noise_threshold = adaptive ? job->tracer.noise_threshold : 0.0f;
+        metadata->min_spp = !adaptive ? 0 : min_spp < (uint32_t)settings->samples_per_pixel ? (int)min_spp
+                                                                                          : settings->samples_per_pixel;
     }
+}
+
+float job_output_exposure(const render_job *job)
+{
     /* With a tone-mapping operator the exposure was applied before it (postprocess). */
-    float exposure = job->tonemap != TONEMAP_CLAMP ? 0.0f : (float)job->exposure;
-    return render_output_write(path, &placed, &result->aovs, &metadata, exposure, error);
+    return job->tonemap != TONEMAP_CLAMP ? 0.0f : (float)job->exposure;
+}
+
+/* Writes pixels (R, G, B means, samples, of the image's region) to path with the
+ * metadata of image; complete says whether the render ended by its own rule. result gives
+ * the AOV layers, region, path segments, scene hash, time and (but for a checkpoint, whose
+ * passes have not ended) the stop reason. */
+static rt_status write_image(const job_image *image, const rt_image *pixels, const char *path, uint64_t samples,
+                             bool complete, bool checkpoint, const render_result *result, rt_error *error)
+{
+    const scene_render_settings *settings = &image->scene.render;
+    rt_image placed = *pixels;
+    placed.x = result->region[0];
+    placed.y = result->region[1];
+    placed.full_width = settings->width;
+    placed.full_height = settings->height;
+    render_output_metadata metadata;
+    job_metadata_texts texts;
+    job_image_metadata(image, samples, complete, checkpoint, result, &metadata, &texts);
+    return render_output_write(path, &placed, &result->aovs, &metadata, job_output_exposure(image->run->job), error);
 }
 
 /* render_options.checkpoint: writes the image so far to the partial file. */
@@ -330,6 +323,11 @@ static rt_status render_image(job_image *image, rt_error *error)
     const render_job *job = run->job;
     render_options options;
     image_render_options(image, &options);
+    /* Too large for the device or the budget: tiles (render_job_tiles.c). */
+    job_tile_grid grid;
+    rt_status tiled = job_plan_tiles(image, &options, &grid, error);
+    if (tiled != RT_OK || grid.count > 1)
+        return tiled != RT_OK ? tiled : job_render_tiles(image, &options, &grid, error);
     rt_image resume_image = {0};
     if (job->resume_path != NULL) {
         render_output_resume_check check = {.seed = image->scene.render.seed,

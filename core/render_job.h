@@ -54,6 +54,8 @@
  *                           (`rtspheres render`: its command's start); 0: the job's start.
  *                           Every later frame's counts from when it begins: the limit is
  *                           per image, so a job of F frames ends within about F times it
+ *   memory_budget           bytes an image's render may take on the device and the host
+ *                           together (see "Tiles"); 0: render_job_default_memory_budget()
  *   tracer                  how each image is traced (render.h; zero = its defaults; its
  *                           noise_threshold and min_spp: adaptive sampling). The job sets
  *                           its sample_start, region, aovs, variance, progress,
@@ -72,6 +74,23 @@
  * samples, AOVs, resume and frames. Each image is then planned by
  * render_job_plan_image() from the scene's render settings, which are known only once
  * the scene is loaded (an empty sample shard or tile is refused there).
+ *
+ * ## Tiles
+ * An image (its window: the whole image, the crop or the --tile band) whose traced pixels
+ * would take more than memory_budget (render_bytes_per_pixel() each, render.h), or that is
+ * wider or taller than the device's gpu_info.max_tile_side, is rendered in tiles
+ * (render_job_tiles.c): a grid of at most max_tile_side a side (less adaptive sampling's
+ * margins) whose tiles fit the budget, each rendered by render_scene() as a region, so
+ * its pixels are exactly the untiled render's. Finished tiles go to a spool file beside
+ * the output (".NAME.tiles-XXXXXX": 4 bytes per channel per pixel on disk, removed at the
+ * end); then the output is streamed from it band by band (render_output_stream) with the
+ * final metadata, atomically as always; neither the device nor the process holds more
+ * than one tile and one band. Under tiling: AOVs, variance, light groups, adaptive
+ * sampling, tone mapping and the samples map work as untiled; a time limit is shared out
+ * over the tiles (tile k of n ends by start + limit * (k + 1) / n: unused time passes on,
+ * and every tile gets its first pass); --denoise, --blur, --checkpoint, --resume and
+ * --display are refused (RT_ERROR_INPUT naming the tiling and what to do), and an
+ * interrupted tiled render writes no partial file (the output stays as it was).
  *
  * ## Running
  * render_job_run() renders the images in order on one GPU context. Each image: the scene
@@ -145,6 +164,7 @@ typedef struct render_job {
     const char *samples_map;
     double time_limit_seconds;
     double time_limit_start;
+    uint64_t memory_budget;
     render_options tracer;
     const volatile sig_atomic_t *stop_requested;
     const sweep_table *sweep;
@@ -183,6 +203,11 @@ typedef struct render_job_callbacks {
     void *user;
     /* A warning of the scene's assets (a missing MTL file, ...), with the first frame only. */
     void (*warning)(void *user, const char *message);
+    /* The image is rendered in columns x rows tiles of at most tile_width x tile_height
+     * (render_job.h "Tiles"); reason says why ("it is larger than the device's ..."). Told
+     * before render_started; never for an untiled image. */
+    void (*tiles_planned)(void *user, const render_job_image *image, int columns, int rows, int tile_width,
+                          int tile_height, const char *reason);
     /* The image's passes are about to start (the scene is loaded and the image planned). */
     void (*render_started)(void *user, const render_job_image *image);
     /* render_options.progress of each pass. */
@@ -217,6 +242,11 @@ typedef struct render_job_summary {
 
 /* Returns a job with every field at its default (all zero). */
 render_job render_job_defaults(void);
+
+/* Returns the memory budget of a job that sets none: a quarter of the machine's physical
+ * memory, at most RENDER_JOB_DEFAULT_MEMORY_BUDGET_MAX (1 GiB). */
+#define RENDER_JOB_DEFAULT_MEMORY_BUDGET_MAX (1ull << 30)
+uint64_t render_job_default_memory_budget(void);
 
 /* Returns "frames", "samples" or "tiles" ("auto" for RENDER_SHARD_AUTO): the words of
  * --shard-by. */

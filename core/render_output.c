@@ -36,6 +36,55 @@ static const rt_image *image_for_format(const char *path, const rt_image *image,
     return made;
 }
 
+/* The image attributes of metadata (metadata_keys.h), with the texts they point into. */
+typedef struct output_attributes {
+    image_attribute list[17];
+    int count;
+    char seed[24], sample_start[24], samples[24], segments[32];
+} output_attributes;
+
+/* Fills *attributes from metadata (which must outlive them). */
+static void make_attributes(const render_output_metadata *metadata, output_attributes *attributes)
+{
+    /* Counters that may pass 2^31 would not fit an EXR int attribute: they go as text. */
+    snprintf(attributes->seed, sizeof attributes->seed, "%llu", metadata->seed);
+    snprintf(attributes->sample_start, sizeof attributes->sample_start, "%llu", metadata->sample_start);
+    snprintf(attributes->samples, sizeof attributes->samples, "%llu", metadata->samples_finished);
+    snprintf(attributes->segments, sizeof attributes->segments, "%.0f", metadata->path_segments);
+    const image_attribute always[] = {
+        {.name = METADATA_KEY_VERSION, .type = IMAGE_ATTRIBUTE_STRING, .string_value = RTSPHERES_VERSION},
+        {.name = METADATA_KEY_SCENE, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->scene},
+        {.name = METADATA_KEY_SCENE_HASH, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->scene_hash},
+        {.name = METADATA_KEY_SPP, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->spp},
+        {.name = METADATA_KEY_SAMPLE_START, .type = IMAGE_ATTRIBUTE_STRING, .string_value = attributes->sample_start},
+        {.name = METADATA_KEY_SEED, .type = IMAGE_ATTRIBUTE_STRING, .string_value = attributes->seed},
+        {.name = METADATA_KEY_MAX_DEPTH, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->max_depth},
+        {.name = METADATA_KEY_FRAME, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->frame},
+        {.name = METADATA_KEY_SAMPLES_FINISHED, .type = IMAGE_ATTRIBUTE_STRING, .string_value = attributes->samples},
+        {.name = METADATA_KEY_PATH_SEGMENTS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = attributes->segments},
+        {.name = METADATA_KEY_COMPLETE, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->complete},
+        {.name = METADATA_KEY_RENDER_SECONDS, .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = metadata->render_seconds},
+    };
+    int count = (int)(sizeof always / sizeof always[0]);
+    memcpy(attributes->list, always, sizeof always);
+    if (metadata->stop_reason != NULL) {   /* a render's keys (not a merge's) */
+        attributes->list[count++] = (image_attribute){
+            .name = METADATA_KEY_STOP_REASON, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->stop_reason};
+        attributes->list[count++] = (image_attribute){.name = METADATA_KEY_NOISE_THRESHOLD,
+                                                      .type = IMAGE_ATTRIBUTE_FLOAT,
+                                                      .float_value = metadata->noise_threshold};
+        attributes->list[count++] = (image_attribute){
+            .name = METADATA_KEY_MIN_SPP, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->min_spp};
+    }
+    if (metadata->merged_parts > 0)
+        attributes->list[count++] = (image_attribute){
+            .name = METADATA_KEY_MERGED_PARTS, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->merged_parts};
+    if (metadata->light_groups != NULL)
+        attributes->list[count++] = (image_attribute){
+            .name = METADATA_KEY_LIGHT_GROUPS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->light_groups};
+    attributes->count = count;
+}
+
 rt_status render_output_write(const char *path, const rt_image *image, const rt_image *layers,
                               const render_output_metadata *metadata, float exposure, rt_error *error)
 {
@@ -46,49 +95,75 @@ rt_status render_output_write(const char *path, const rt_image *image, const rt_
         image_free(&made);
         return status;
     }
-    /* Counters that may pass 2^31 would not fit an EXR int attribute: they go as text. */
-    char seed_text[24], sample_start_text[24], samples_text[24], segments_text[32];
-    snprintf(seed_text, sizeof seed_text, "%llu", metadata->seed);
-    snprintf(sample_start_text, sizeof sample_start_text, "%llu", metadata->sample_start);
-    snprintf(samples_text, sizeof samples_text, "%llu", metadata->samples_finished);
-    snprintf(segments_text, sizeof segments_text, "%.0f", metadata->path_segments);
-    image_attribute attributes[] = {
-        {.name = METADATA_KEY_VERSION, .type = IMAGE_ATTRIBUTE_STRING, .string_value = RTSPHERES_VERSION},
-        {.name = METADATA_KEY_SCENE, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->scene},
-        {.name = METADATA_KEY_SCENE_HASH, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->scene_hash},
-        {.name = METADATA_KEY_SPP, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->spp},
-        {.name = METADATA_KEY_SAMPLE_START, .type = IMAGE_ATTRIBUTE_STRING, .string_value = sample_start_text},
-        {.name = METADATA_KEY_SEED, .type = IMAGE_ATTRIBUTE_STRING, .string_value = seed_text},
-        {.name = METADATA_KEY_MAX_DEPTH, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->max_depth},
-        {.name = METADATA_KEY_FRAME, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->frame},
-        {.name = METADATA_KEY_SAMPLES_FINISHED, .type = IMAGE_ATTRIBUTE_STRING, .string_value = samples_text},
-        {.name = METADATA_KEY_PATH_SEGMENTS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
-        {.name = METADATA_KEY_COMPLETE, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->complete},
-        {.name = METADATA_KEY_RENDER_SECONDS, .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = metadata->render_seconds},
-        {0}, {0}, {0}, {0}, {0},   /* the optional keys, added below when they apply */
-    };
-    int count = (int)(sizeof attributes / sizeof attributes[0]) - 5;
-    if (metadata->stop_reason != NULL) {   /* a render's keys (not a merge's) */
-        attributes[count++] = (image_attribute){.name = METADATA_KEY_STOP_REASON, .type = IMAGE_ATTRIBUTE_STRING,
-                                                .string_value = metadata->stop_reason};
-        attributes[count++] = (image_attribute){.name = METADATA_KEY_NOISE_THRESHOLD, .type = IMAGE_ATTRIBUTE_FLOAT,
-                                                .float_value = metadata->noise_threshold};
-        attributes[count++] = (image_attribute){.name = METADATA_KEY_MIN_SPP, .type = IMAGE_ATTRIBUTE_INT,
-                                                .int_value = metadata->min_spp};
-    }
-    if (metadata->merged_parts > 0)
-        attributes[count++] = (image_attribute){.name = METADATA_KEY_MERGED_PARTS, .type = IMAGE_ATTRIBUTE_INT,
-                                                .int_value = metadata->merged_parts};
-    if (metadata->light_groups != NULL)
-        attributes[count++] = (image_attribute){.name = METADATA_KEY_LIGHT_GROUPS, .type = IMAGE_ATTRIBUTE_STRING,
-                                                .string_value = metadata->light_groups};
+    output_attributes attributes;
+    make_attributes(metadata, &attributes);
     image_write_options options = image_write_options_defaults();
     options.exposure = exposure;
-    options.attributes = attributes;
-    options.attribute_count = count;
+    options.attributes = attributes.list;
+    options.attribute_count = attributes.count;
     status = image_write(path, written, &options, error);
     image_free(&made);
     return status;
+}
+
+struct render_output_stream {
+    image_stream *stream;
+    bool exr;
+};
+
+rt_status render_output_stream_open(const char *path, const rt_image *layout, const render_output_metadata *metadata,
+                                    float exposure, render_output_stream **out, rt_error *error)
+{
+    *out = calloc(1, sizeof **out);
+    if (*out == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory opening '%s'", path);
+    (*out)->exr = image_format_of(path) == IMAGE_FORMAT_EXR;
+    rt_image written = *layout;
+    written.pixels = NULL;
+    if (!(*out)->exr) {
+        written.channels = 3;
+        memset(written.channel_names, 0, sizeof written.channel_names);
+    }
+    output_attributes attributes;
+    make_attributes(metadata, &attributes);
+    image_write_options options = image_write_options_defaults();
+    options.exposure = exposure;
+    options.attributes = attributes.list;
+    options.attribute_count = attributes.count;
+    rt_status status = image_stream_open(path, &written, &options, &(*out)->stream, error);
+    if (status != RT_OK) {
+        free(*out);
+        *out = NULL;
+    }
+    return status;
+}
+
+rt_status render_output_stream_rows(render_output_stream *stream, const rt_image *rows, rt_error *error)
+{
+    rt_image made;
+    rt_status status;
+    const rt_image *written = stream->exr ? rows : image_for_format("colour.png", rows, NULL, &made, &status, error);
+    if (!stream->exr && status != RT_OK)
+        return status;
+    status = image_stream_write_rows(stream->stream, written, error);
+    if (!stream->exr)
+        image_free(&made);
+    return status;
+}
+
+rt_status render_output_stream_close(render_output_stream *stream, rt_error *error)
+{
+    rt_status status = image_stream_close(stream->stream, error);
+    free(stream);
+    return status;
+}
+
+void render_output_stream_abandon(render_output_stream *stream)
+{
+    if (stream == NULL)
+        return;
+    image_stream_abandon(stream->stream);
+    free(stream);
 }
 
 void render_output_partial_path(const char *output, char *path, size_t size)

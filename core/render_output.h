@@ -60,6 +60,26 @@ typedef struct render_output_resume_check {
 rt_status render_output_write(const char *path, const rt_image *image, const rt_image *layers,
                               const render_output_metadata *metadata, float exposure, rt_error *error);
 
+/* An output written band by band (image_io.h image_stream), for tiled renders
+ * (render_job.h): the same file render_output_write() makes of the whole image. */
+typedef struct render_output_stream render_output_stream;
+
+/* Opens path for an image of layout's size, place and channels (R, G, B, samples and the
+ * layers, named; its pixels are not read), with the metadata and exposure of
+ * render_output_write(), which must be final: the header is written first. Frees
+ * nothing of the caller's; close or abandon *out. Errors: image_stream_open()'s. */
+rt_status render_output_stream_open(const char *path, const rt_image *layout, const render_output_metadata *metadata,
+                                    float exposure, render_output_stream **out, rt_error *error);
+
+/* Writes the next rows (all the layout's channels; the format keeps what it keeps). */
+rt_status render_output_stream_rows(render_output_stream *stream, const rt_image *rows, rt_error *error);
+
+/* Finishes the file and renames it over its path; frees stream whatever happens. */
+rt_status render_output_stream_close(render_output_stream *stream, rt_error *error);
+
+/* Drops the file (its path stays as it was) and frees stream. NULL is ignored. */
+void render_output_stream_abandon(render_output_stream *stream);
+
 /* Writes the partial file name of output into path (size bytes): output without its
  * extension, then ".partial.exr" ("out/frame-7.png" -> "out/frame-7.partial.exr"). */
 void render_output_partial_path(const char *output, char *path, size_t size);

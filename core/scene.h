@@ -26,6 +26,9 @@
 #include "tracer_interface.h"
 
 #define SCENE_NAME_MAX 64
+#define SCENE_MAX_IMAGE_SIDE 65536      /* widest and tallest image (the `render` line, --size):
+                                         * larger than any device's textures, rendered in
+                                         * tiles (render_job.h) */
 
 /* Light groups (`group NAME` on lights, emissive materials and the sky): each group's
  * contribution is written as its own layer with --light-groups (render.h). Group 0 is

@@ -304,8 +304,8 @@ static bool read_render_clause(scene_parser *p, source_line *line, int clause, v
     long long width, height, value;
     switch (clause) {
     case 0:
-        if (!read_integer(variables, line, "the render width", 1, 16384, &width) ||
-            !read_integer(variables, line, "the render height", 1, 16384, &height))
+        if (!read_integer(variables, line, "the render width", 1, SCENE_MAX_IMAGE_SIDE, &width) ||
+            !read_integer(variables, line, "the render height", 1, SCENE_MAX_IMAGE_SIDE, &height))
             return false;
         render->width = (int)width;
         render->height = (int)height;

@@ -226,11 +226,11 @@ static void test_render_clauses(void **state)
     assert_int_equal(s.render.seed, 42);
     scene_free(&s);
 
-    parse_ok("render seed 4294967295 depth 100000\nrender spp (2^30) size 16384 1\nrender seed 0", NULL, &s);
+    parse_ok("render seed 4294967295 depth 100000\nrender spp (2^30) size 65536 1\nrender seed 0", NULL, &s);
     assert_int_equal(s.render.seed, 0);
     assert_int_equal(s.render.max_depth, 100000);
     assert_int_equal(s.render.samples_per_pixel, 1073741824);
-    assert_int_equal(s.render.width, 16384);
+    assert_int_equal(s.render.width, 65536);
     assert_int_equal(s.render.height, 1);
     scene_free(&s);
 
@@ -505,8 +505,8 @@ static void test_integer_ranges(void **state)
 {
     (void)state;
     assert_parse_error("render size 0 10", "s.txt:1:13: ",
-                       "the render width must be a whole number from 1 to 16384, found 0");
-    assert_parse_error("render size 10 16385", "s.txt:1:16: ", "the render height must be a whole number from 1 to 16384");
+                       "the render width must be a whole number from 1 to 65536, found 0");
+    assert_parse_error("render size 10 65537", "s.txt:1:16: ", "the render height must be a whole number from 1 to 65536");
     assert_parse_error("render size 10.5 10", "s.txt:1:13: ", "found 10.5");
     assert_parse_error("render spp 0", "s.txt:1:12: ", "from 1 to 1073741824, found 0");
     assert_parse_error("render spp 1073741825", "s.txt:1:12: ", "from 1 to 1073741824");
