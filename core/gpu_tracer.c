@@ -315,7 +315,7 @@ static rt_status state_out_of_memory(const gpu_tracer *tracer, const char *what,
 {
     double mib = (double)tracer->width * tracer->height * GPU_TRACER_STATE_BYTES_PER_PIXEL / (1024.0 * 1024.0);
     return rt_error_set(error, RT_ERROR_RUNTIME,
-                        "GPU: out of memory for the state of a %dx%d image (%.0f MiB on the device; %s): give a "
+                        "GPU: out of memory for the state of a %dx%d image (%.1f MiB on the device; %s): give a "
                         "smaller --memory-budget, which renders the image in smaller tiles",
                         tracer->width, tracer->height, mib, what);
 }

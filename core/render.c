@@ -175,9 +175,17 @@ static uint64_t scene_hash(const scene *s, const packed_scene *packed, const cam
 static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, float *luminance_squares,
                             gpu_tracer_totals *totals, uint64_t *samples, rt_error *error)
 {
-    rt_status status = image_create(image, width, height, 4, error);
-    if (status == RT_OK)
-        status = gpu_tracer_read(tracer, image->pixels, luminance_squares, totals, error);
+    /* RTSPHERES_TEST_HOST_FAILURE=memory: the failure a huge image's read-back meets. */
+    const char *forced = getenv("RTSPHERES_TEST_HOST_FAILURE");
+    rt_status status = forced != NULL && strcmp(forced, "memory") == 0
+                           ? RT_ERROR_RUNTIME
+                           : image_create(image, width, height, 4, error);
+    if (status != RT_OK)
+        return rt_error_set(error, RT_ERROR_RUNTIME,
+                            "RENDER: out of memory reading back a %dx%d image (%.1f MiB and as much again for GL's "
+                            "copy): give a smaller --memory-budget, which renders the image in smaller tiles",
+                            width, height, (double)width * height * 16 / (1024.0 * 1024.0));
+    status = gpu_tracer_read(tracer, image->pixels, luminance_squares, totals, error);
     if (status != RT_OK) {
         image_free(image);
         return status;

@@ -344,6 +344,8 @@ static rt_status render_image(job_image *image, rt_error *error)
         run->callbacks.render_started(run->callbacks.user, &image->plan);
     render_result result;
     rt_status status = render_scene(run->context, &image->scene, &options, &result, error);
+    if (status == RT_ERROR_RUNTIME)
+        job_name_memory_budget(image, error);
     if (run->callbacks.render_finished != NULL)
         run->callbacks.render_finished(run->callbacks.user, &image->plan, status);
     if (status == RT_OK || status == RT_ERROR_INTERRUPTED) {

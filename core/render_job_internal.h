@@ -64,4 +64,8 @@ rt_status job_plan_tiles(const job_image *image, const render_options *options, 
 rt_status job_render_tiles(job_image *image, const render_options *options, const job_tile_grid *grid,
                            rt_error *error);
 
+/* After a failed render of image: a message that suggests a smaller --memory-budget
+ * (render.h, gpu.h) gets the budget in force appended, so the user knows where from. */
+void job_name_memory_budget(const job_image *image, rt_error *error);
+
 #endif

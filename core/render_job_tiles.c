@@ -39,6 +39,19 @@ static const char *size_text(double bytes, char text[32])
     return text;
 }
 
+void job_name_memory_budget(const job_image *image, rt_error *error)
+{
+    const render_job *job = image->run->job;
+    size_t length = strlen(error->message);
+    const char *tail = "renders the image in smaller tiles";
+    if (length < strlen(tail) || strcmp(error->message + length - strlen(tail), tail) != 0)
+        return;
+    char budget[32];
+    size_text((double)(job->memory_budget ? job->memory_budget : render_job_default_memory_budget()), budget);
+    snprintf(error->message + length, sizeof error->message - length, " (this render's budget: %s%s)", budget,
+             job->memory_budget ? "" : ", the default");
+}
+
 /* The refusals of render_job.h's "Tiles": the option the tiled job asks for that tiles
  * cannot do, and what to do instead; NULL when there is none. */
 static const char *unsupported_under_tiles(const render_job *job, const render_options *options,
@@ -397,6 +410,8 @@ rt_status job_render_tiles(job_image *image, const render_options *options, cons
             }
             render_result result;
             status = render_scene(owner->context, &image->scene, &tile_options, &result, error);
+            if (status == RT_ERROR_RUNTIME)
+                job_name_memory_budget(image, error);
             if (status == RT_OK) {
                 status = spool_tile(&run, &result, error);
                 add_tile(&run, &result, tile);
