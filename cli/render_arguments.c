@@ -29,7 +29,7 @@ static void print_help(FILE *stream)
             "  -s, --spp N            samples per pixel\n"
             "      --size WxH         image size in pixels, e.g. 640x360 (each 1 to 65536)\n"
             "      --memory-budget SIZE  memory an image's render may take, e.g. 512M, 2G (default:\n"
-            "                         a quarter of the machine's memory, at most 1G); larger\n"
+            "                         a quarter of the machine's memory, at most 512M); larger\n"
             "                         images, and any wider than the device, render in tiles\n"
             "      --max-depth N      path segments per sample at most\n"
             "      --seed N           random seed (same seed, same image)\n"

@@ -244,8 +244,9 @@ typedef struct render_job_summary {
 render_job render_job_defaults(void);
 
 /* Returns the memory budget of a job that sets none: a quarter of the machine's physical
- * memory, at most RENDER_JOB_DEFAULT_MEMORY_BUDGET_MAX (1 GiB). */
-#define RENDER_JOB_DEFAULT_MEMORY_BUDGET_MAX (1ull << 30)
+ * memory, at most RENDER_JOB_DEFAULT_MEMORY_BUDGET_MAX (512 MiB; why: docs/performance.md,
+ * "Memory"). */
+#define RENDER_JOB_DEFAULT_MEMORY_BUDGET_MAX (512ull << 20)
 uint64_t render_job_default_memory_budget(void);
 
 /* Returns "frames", "samples" or "tiles" ("auto" for RENDER_SHARD_AUTO): the words of

@@ -22,6 +22,10 @@
 #   crystal-ball   640x480, 4 spp
 #   pbr-chart      scenes/pbr-chart.txt 640x360, 16 spp: the pbr material, every
 #                  roughness and metallic (issue 14)
+#   panorama-20000, square-16384  three-balls at 20000x2000 (wider than the device) and
+#                  16384x16384 (depth 2), 1 spp, in tiles (issue 17: peak RSS targets)
+#   full-hd, full-hd-untiled  three-balls 1920x1080, 1 spp, with the default budget and
+#                  with one that never tiles: resident memory must not grow
 #   mesh-L         icospheres of level L (3 5 6 8: 1,280 / 20,480 / 81,920 / 1,310,720
 #                  triangles, the nearest levels to the issue's 1k/10k/100k/1M), 320x240,
 #                  16 spp, depth 8
@@ -59,12 +63,16 @@
 #   BENCH_SCALE          multiplies the spp of every other scene (default 1; 0.25 for a
 #                        quick look, integer results, at least 1 spp)
 #   BENCH_MESH_LEVELS    icosphere levels (default "3 5 6 8"; 20 * 4^level triangles)
+#   BENCH_LARGE          0: leave out the large images of issue 17 (panorama-20000,
+#                        square-16384, full-hd, full-hd-untiled), which take most of the
+#                        run's memory and, at 1 spp, a few minutes on idle cores
 set -eu
 program=$1
 weekend_spp=${BENCH_SPP:-32}
 reference_spp=${BENCH_REFERENCE_SPP:-8}
 scale=${BENCH_SCALE:-1}
 mesh_levels=${BENCH_MESH_LEVELS:-3 5 6 8}
+large=${BENCH_LARGE:-1}
 CC=${CC:-cc}
 CXX=${CXX:-c++}
 work=build/bench
@@ -340,6 +348,18 @@ bench next-week scenes/next-week.txt 400x400 "$(scaled 2)" ""
 bench crystal-ball scenes/crystal-ball.txt 640x480 "$(scaled 4)" ""
 # The pbr material (issue 14): a chart of roughness by metallic under a sphere light.
 bench pbr-chart scenes/pbr-chart.txt 640x360 "$(scaled 16)" ""
+# Any image size in bounded memory (issue 17): a panorama wider than the device's 16384
+# pixels, a 16384-pixel square at depth 2 (both in tiles, the default --memory-budget),
+# and a plain 1920x1080 as it renders by default and with a budget that never tiles it:
+# its resident memory must not grow with tiling. BENCH_LARGE=0 leaves them out.
+if [ "$large" != 0 ]; then
+    bench panorama-20000 scenes/three-balls.txt 20000x2000 1 "tiles; target peak RSS < 1536 MiB"
+    bench square-16384 scenes/three-balls.txt 16384x16384 1 "tiles, depth 2; target peak RSS < 2048 MiB" \
+        --max-depth 2
+    bench full-hd scenes/three-balls.txt 1920x1080 1 "default budget"
+    bench full-hd-untiled scenes/three-balls.txt 1920x1080 1 "--memory-budget 64G: never tiled" \
+        --memory-budget 64G
+fi
 
 # Time to quality against Cycles (tests/bench/peers.sh): ladders of spp, RMSE against
 # each renderer's own cached high-spp reference. The issue's sizes: the Cornell box at
@@ -465,6 +485,13 @@ targets=$work/targets.tsv
         "$(awk -v s="$(value sweep-12 6)" -v p="$(value sweep-12-separate 6)" -v u="$(value startup-cached 13)" 'BEGIN {
             if (s == "-" || p == "-" || u == "-" || u <= 0) print "-"; else printf "%.3g", (p - s) / 11 / u }')" \
         "12-row sweep: (12 separate renders - the sweep) / 11 / a cached start-up's first pass"
+    # issue 17: any image size in bounded memory
+    printf 'panorama_20000x2000_peak_rss\t%s\t<\t1536\tMiB\tpanorama-20000 (1 spp, tiles): peak resident set\n' \
+        "$(value panorama-20000 14)"
+    printf 'square_16384_peak_rss\t%s\t<\t2048\tMiB\tsquare-16384 (1 spp, depth 2, tiles): peak resident set\n' \
+        "$(value square-16384 14)"
+    printf 'full_hd_rss_ratio\t%s\t<=\t1\tx\t1920x1080 peak resident set, default budget / never tiled\n' \
+        "$(ratio "$(value full-hd 14)" "$(value full-hd-untiled 14)")"
     # issue 13, against Blender Cycles (tests/bench/peers.sh)
     printf 'weekend_time_ratio_cycles\t%s\t<=\t0.5\tx\tweekend at equal spp, render s rtspheres / Cycles\n' \
         "$(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")"
