@@ -4,6 +4,7 @@
  * when its metadata (samples, time, why it stopped) is known; an image file's header
  * comes first, so the output cannot be written while the tiles are still rendering. */
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -82,7 +83,9 @@ rt_status job_plan_tiles(const job_image *image, const render_options *options, 
     const render_job *job = image->run->job;
     const scene_render_settings *settings = &image->scene.render;
     static gpu_info device;      /* large (its device list); one job plans at a time */
-    gpu_get_info(image->run->context, &device);
+    device.max_tile_side = INT_MAX;   /* no context (a test of what fails before the GPU) */
+    if (image->run->context != NULL)
+        gpu_get_info(image->run->context, &device);
     uint64_t budget = job->memory_budget ? job->memory_budget : render_job_default_memory_budget();
     memset(grid, 0, sizeof *grid);
     grid->count = grid->columns = grid->rows = 1;
