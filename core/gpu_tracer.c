@@ -314,10 +314,11 @@ static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels,
 static rt_status state_out_of_memory(const gpu_tracer *tracer, const char *what, rt_error *error)
 {
     double mib = (double)tracer->width * tracer->height * GPU_TRACER_STATE_BYTES_PER_PIXEL / (1024.0 * 1024.0);
+    bool gib = mib >= 1024;
     return rt_error_set(error, RT_ERROR_RUNTIME,
-                        "GPU: out of memory for the state of a %dx%d image (%.1f MiB on the device; %s): give a "
+                        "GPU: out of memory for the state of a %dx%d image (%.1f %s on the device; %s): give a "
                         "smaller --memory-budget, which renders the image in smaller tiles",
-                        tracer->width, tracer->height, mib, what);
+                        tracer->width, tracer->height, gib ? mib / 1024 : mib, gib ? "GiB" : "MiB", what);
 }
 
 /* Creates both sets of state textures (zeroed) and their framebuffers. */
@@ -356,7 +357,7 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
         if (forced != NULL && strcmp(forced, "framebuffer") == 0)
             complete = GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT;
         /* A texture the driver could not allocate leaves its attachment incomplete
-         * (llvmpipe above about 4 GiB a texture): memory, in the user's words. */
+         * (llvmpipe for a 12000x12000 image, 2.1 GiB a texture): memory, in the user's words. */
         if (complete != GL_FRAMEBUFFER_COMPLETE) {
             while (glGetError() != GL_NO_ERROR) {
             }
