@@ -3,8 +3,8 @@
 # (render_job.h "Tiles", README "Large images") through the command: an image wider than
 # the device (17000x4, 1 spp) renders; 8-bit outputs, tone mapping and the samples map
 # under a forced small --memory-budget are the untiled files byte for byte; --tile parts
-# that are tiled inside merge into exactly the untiled image; frames tile each image; a
-# time limit is shared out over the tiles; what tiles cannot do is refused (exit 2,
+# that are tiled inside merge into exactly the untiled image; frames and sweep rows tile
+# each image, and a montage of them is the untiled montage; a time limit is shared out over the tiles; what tiles cannot do is refused (exit 2,
 # nothing written); an interrupted tiled render leaves the output as it was; device and
 # host failures (forced by RTSPHERES_TEST_* hooks) name the size and --memory-budget; the
 # --size and --memory-budget limits. Every channel bit for bit (AOVs, variance, light
@@ -57,10 +57,24 @@ problem=$(merge_problem "$scratch/full.exr" 0 4 "$scratch/merged.exr" "$scratch/
 if [ -n "$problem" ]; then fail "tiled --tile parts merge" "$problem"
 else pass "--tile parts rendered in tiles merge into exactly the untiled render"; fi
 
-# (d) Frames: each frame's image is tiled, and is the untiled frame.
+# (d) Frames and sweeps: each image is tiled, and is the untiled one.
 render "$scratch/frame-%d.exr" --frames 1-2
 render "$scratch/tiled-frame-%d.exr" --frames 1-2 $budget
 same "tiled frame 2 is the untiled frame" "$scratch/frame-2.exr" "$scratch/tiled-frame-2.exr"
+
+# Sweeps tile each row's image too, and a contact sheet of tiled images is the sheet of
+# the untiled ones (montage reads the files, which are the same).
+printf 'light_x\tlight_z\n3\t0\n-1.5\t2.6\n' >"$scratch/lights.tsv"
+"$program" render scenes/three-balls.txt -o "$scratch/row-%d.exr" --size 48x27 --spp 2 --quiet \
+    --sweep "$scratch/lights.tsv"
+"$program" render scenes/three-balls.txt -o "$scratch/tiled-row-%d.exr" --size 48x27 --spp 2 --sweep \
+    "$scratch/lights.tsv" $budget 2>"$scratch/stderr"
+tiled "sweep rows are rendered in tiles"
+same "tiled sweep row 1 is the untiled row" "$scratch/row-1.exr" "$scratch/tiled-row-1.exr"
+"$program" montage "$scratch/frame-1.exr" "$scratch/frame-2.exr" -o "$scratch/sheet.png" --quiet
+"$program" montage "$scratch/tiled-frame-1.exr" "$scratch/tiled-frame-2.exr" -o "$scratch/tiled-sheet.png" --quiet
+if cmp -s "$scratch/sheet.png" "$scratch/tiled-sheet.png"; then pass "a montage of tiled frames is the untiled one"
+else fail "montage of tiled frames" "differs from the montage of the untiled frames"; fi
 
 # (e) A time limit far too short for 4096 spp: every tile still gets its first pass (a
 # fixed pass budget of 4000 work units finishes a few samples in every pixel of it, so
@@ -77,7 +91,9 @@ fi
 
 # (f) What tiles cannot do: refused, naming the tiling and what to do.
 printf 'partial' >"$scratch/some.partial.exr"
-for options in "--denoise" "--blur 1" "--checkpoint 10" "--resume $scratch/some.partial.exr"; do
+# --display: refused before it connects (nothing listens on port 1 anyway).
+for options in "--denoise" "--blur 1" "--checkpoint 10" "--resume $scratch/some.partial.exr" \
+    "--display 127.0.0.1:1"; do
     word=${options%% *}
     # shellcheck disable=SC2086
     expect_refusal "$word under tiles is refused" "^rtspheres render: $word .*rendered in [0-9]+ tiles .*: " \
