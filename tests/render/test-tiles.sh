@@ -14,7 +14,7 @@
 scene=scenes/materials/metal.txt
 render_options="--size 48x27 --spp 4"
 # About 500 KiB untiled: 3 to 8 tiles.
-budget="--memory-budget 150K"
+budget=--memory-budget=150K
 
 # tiled NAME: one check that the last command's stderr says it rendered in tiles.
 tiled() {
@@ -37,11 +37,11 @@ fi
 # (b) 8-bit files, tone mapping, the samples map: the untiled files byte for byte.
 mkdir -p "$scratch/out"
 render "$scratch/untiled.png" --tonemap aces --samples-map "$scratch/untiled-map.png"
-render "$scratch/out/tiled.png" --tonemap aces --samples-map "$scratch/out/tiled-map.png" $budget 2>"$scratch/stderr"
+render "$scratch/out/tiled.png" --tonemap aces --samples-map "$scratch/out/tiled-map.png" "$budget" 2>"$scratch/stderr"
 render "$scratch/untiled.jpg" --noise-threshold 0.2 --min-spp 4 --spp 16
 # shellcheck disable=SC2086
 "$program" render "$scene" -o "$scratch/out/tiled.jpg" $render_options --noise-threshold 0.2 --min-spp 4 --spp 16 \
-    $budget 2>"$scratch/stderr"
+    "$budget" 2>"$scratch/stderr"
 tiled "a forced budget renders in tiles"
 for file in tiled.png tiled-map.png tiled.jpg; do
     if cmp -s "$scratch/out/$file" "$scratch/un$file"; then pass "tiled $file is the untiled file byte for byte"
@@ -51,15 +51,15 @@ files_are "a tiled render leaves no spool or temporary file" "$scratch/out" "til
 
 # (c) --tile parts, each tiled inside, merge into exactly the untiled render.
 render "$scratch/full.exr"
-render "$scratch/part0.exr" --tile 0/2 $budget 2>"$scratch/stderr"
-render "$scratch/part1.exr" --tile 1/2 $budget
+render "$scratch/part0.exr" --tile 0/2 "$budget" 2>"$scratch/stderr"
+render "$scratch/part1.exr" --tile 1/2 "$budget"
 problem=$(merge_problem "$scratch/full.exr" 0 4 "$scratch/merged.exr" "$scratch/part0.exr" "$scratch/part1.exr")
 if [ -n "$problem" ]; then fail "tiled --tile parts merge" "$problem"
 else pass "--tile parts rendered in tiles merge into exactly the untiled render"; fi
 
 # (d) Frames and sweeps: each image is tiled, and is the untiled one.
 render "$scratch/frame-%d.exr" --frames 1-2
-render "$scratch/tiled-frame-%d.exr" --frames 1-2 $budget
+render "$scratch/tiled-frame-%d.exr" --frames 1-2 "$budget"
 same "tiled frame 2 is the untiled frame" "$scratch/frame-2.exr" "$scratch/tiled-frame-2.exr"
 
 # Sweeps tile each row's image too, and a contact sheet of tiled images is the sheet of
@@ -68,7 +68,7 @@ printf 'light_x\tlight_z\n3\t0\n-1.5\t2.6\n' >"$scratch/lights.tsv"
 "$program" render scenes/three-balls.txt -o "$scratch/row-%d.exr" --size 48x27 --spp 2 --quiet \
     --sweep "$scratch/lights.tsv"
 "$program" render scenes/three-balls.txt -o "$scratch/tiled-row-%d.exr" --size 48x27 --spp 2 --sweep \
-    "$scratch/lights.tsv" $budget 2>"$scratch/stderr"
+    "$scratch/lights.tsv" "$budget" 2>"$scratch/stderr"
 tiled "sweep rows are rendered in tiles"
 same "tiled sweep row 1 is the untiled row" "$scratch/row-1.exr" "$scratch/tiled-row-1.exr"
 "$program" montage "$scratch/frame-1.exr" "$scratch/frame-2.exr" -o "$scratch/sheet.png" --quiet
@@ -80,7 +80,7 @@ else fail "montage of tiled frames" "differs from the montage of the untiled fra
 # fixed pass budget of 4000 work units finishes a few samples in every pixel of it, so
 # no pixel, in whatever tile, is left without samples), and the image says the time
 # ended it.
-if render "$scratch/timed.exr" --spp 4096 --time-limit 0.05 --pass-budget 4000 $budget \
+if render "$scratch/timed.exr" --spp 4096 --time-limit 0.05 --pass-budget 4000 "$budget" \
     && stats_of "$scratch/timed.exr" && [ "$(stat_metadata stop_reason)" = time ] \
     && [ "$(stat_metadata complete)" = 0 ] \
     && awk -v r="$(stat_range samples)" 'BEGIN { split(r, v, " "); exit !(v[1] >= 1 && v[2] < 4096) }'; then
@@ -97,7 +97,7 @@ for options in "--denoise" "--blur 1" "--checkpoint 10" "--resume $scratch/some.
     word=${options%% *}
     # shellcheck disable=SC2086
     expect_refusal "$word under tiles is refused" "^rtspheres render: $word .*rendered in [0-9]+ tiles .*: " \
-        "$scratch/refused" "$program" render "$scene" -o "$scratch/refused/out.exr" $render_options $budget \
+        "$scratch/refused" "$program" render "$scene" -o "$scratch/refused/out.exr" $render_options "$budget" \
         $options
 done
 expect_refusal "--size above 65536 names the limit" "--size wants WIDTHxHEIGHT, each 1 to 65536" "$scratch/refused" \
@@ -118,7 +118,7 @@ done
 # shellcheck disable=SC2086
 RTSPHERES_TEST_GPU_FAILURE=framebuffer expect_exit "a tile's failure names the tile and the budget" 1 \
     "state of a [0-9]+x[0-9]+ image .*this render's budget: 150 KiB\)$" \
-    "$program" render "$scene" -o "$scratch/failed.exr" $render_options $budget
+    "$program" render "$scene" -o "$scratch/failed.exr" $render_options "$budget"
 if grep -q 'framebuffer is incomplete' "$scratch/stderr"; then fail "no raw framebuffer status" "$(cat "$scratch/stderr")"
 else pass "no raw framebuffer status"; fi
 # shellcheck disable=SC2086
@@ -132,7 +132,7 @@ RTSPHERES_TEST_HOST_FAILURE=memory expect_exit "host memory failure is a message
 mkdir -p "$scratch/stop"
 printf 'previous image' >"$scratch/stop/out.exr"
 # shellcheck disable=SC2086
-"$program" render "$scene" -o "$scratch/stop/out.exr" --size 48x27 --spp 100000 $budget 2>"$scratch/stop.err" &
+"$program" render "$scene" -o "$scratch/stop/out.exr" --size 48x27 --spp 100000 "$budget" 2>"$scratch/stop.err" &
 pid=$!
 tries=0
 while ! grep -q 'rendering in' "$scratch/stop.err" 2>/dev/null && [ "$tries" -lt 600 ]; do
