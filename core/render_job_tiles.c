@@ -111,8 +111,7 @@ rt_status job_plan_tiles(const job_image *image, const render_options *options, 
     static char reason[256];
     if (traced_width > side || traced_height > side)
         snprintf(reason, sizeof reason, "it is larger than the device's %d pixels a side", side);
-    else
-    {
+    else {
         char need[32], have[32];
         snprintf(reason, sizeof reason, "its render would take about %s, over the memory budget of %s",
                  size_text(untiled_bytes, need), size_text((double)budget, have));

@@ -4,8 +4,9 @@
 # the device (17000x4, 1 spp) renders; 8-bit outputs, tone mapping and the samples map
 # under a forced small --memory-budget are the untiled files byte for byte; --tile parts
 # that are tiled inside merge into exactly the untiled image; frames and sweep rows tile
-# each image, and a montage of them is the untiled montage; a time limit is shared out over the tiles; what tiles cannot do is refused (exit 2,
-# nothing written); an interrupted tiled render leaves the output as it was; device and
+# each image, and a montage of them is the untiled montage; a time limit is shared out
+# over the tiles; what tiles cannot do, and a budget too small for one tile, are refused
+# (exit 2, nothing written); an interrupted tiled render leaves the output as it was; device and
 # host failures (forced by RTSPHERES_TEST_* hooks) name the size and --memory-budget; the
 # --size and --memory-budget limits. Every channel bit for bit (AOVs, variance, light
 # groups, adaptive sampling) is tests/unit/test_render_tiles.c.
@@ -100,6 +101,13 @@ for options in "--denoise" "--blur 1" "--checkpoint 10" "--resume $scratch/some.
         "$scratch/refused" "$program" render "$scene" -o "$scratch/refused/out.exr" $render_options "$budget" \
         $options
 done
+# Adaptive sampling's margins (25 pixels at --min-spp 2 and 1024 spp) round even a
+# one-pixel tile: a budget too small for that says how much one needs.
+# shellcheck disable=SC2086
+expect_refusal "a budget too small for one tile" \
+    "--memory-budget 64 KiB is too small for even a one-pixel tile of this render \([0-9.]+ [KM]iB\)" \
+    "$scratch/refused" "$program" render "$scene" -o "$scratch/refused/out.exr" $render_options --spp 1024 \
+    --noise-threshold 0.1 --min-spp 2 --memory-budget 64K
 expect_refusal "--size above 65536 names the limit" "--size wants WIDTHxHEIGHT, each 1 to 65536" "$scratch/refused" \
     "$program" render "$scene" -o "$scratch/refused/out.exr" --size 65537x4
 expect_refusal "--memory-budget below 64K" "--memory-budget wants a size of at least 64K" "$scratch/refused" \
