@@ -274,6 +274,18 @@ bool gpu_tracer_reused_scene(const gpu_tracer *tracer);
  * first, whose variant does not change). */
 bool gpu_tracer_compiled_program(const gpu_tracer *tracer);
 
+/* How long gpu_tracer_create() took for its parts, in seconds (0 for a part it did not
+ * need: a program from the cache, a scene already on the device). On llvmpipe the
+ * shader's machine code is made at its first draw, so compile_seconds is the GLSL
+ * compile and link only and the first pass carries the rest. */
+typedef struct gpu_tracer_timings {
+    double compile_seconds;               /* compiling and linking the tracer program */
+    double upload_seconds;                /* the packed scene into its buffer texture */
+    double state_seconds;                 /* state textures, framebuffers, resumed sums */
+} gpu_tracer_timings;
+
+void gpu_tracer_get_timings(const gpu_tracer *tracer, gpu_tracer_timings *timings);
+
 /* Frees the tracer's GL objects (not the context's program and packed scene). NULL is
  * ignored. */
 void gpu_tracer_destroy(gpu_tracer *tracer);
