@@ -163,10 +163,10 @@ static void show_existing(void *user, const render_job_image *image, const rende
     else if (image->sweep_row >= 0)
         snprintf(label, sizeof label, "row %d: ", image->sweep_row);
     const char *verb = decision->kind == RENDER_JOB_EXISTING_SKIP     ? "skipped"
-                       : decision->kind == RENDER_JOB_EXISTING_RESUME ? "resumed"
-                                                                      : "rendered again";
+                       : decision->kind == RENDER_JOB_EXISTING_RESUME ? "resuming"
+                                                                      : "rendering afresh";
     if (!shown->arguments->quiet)
-        fprintf(stderr, "rtspheres: %s%s %s: %s\n", label, verb, image->output, decision->reason);
+        fprintf(stderr, "rtspheres: %s%s: %s\n", label, verb, decision->reason);
     if (shown->stats != NULL && decision->kind == RENDER_JOB_EXISTING_SKIP) {
         rt_error ignored = {{0}};
         render_stats_add_other(shown->stats, image, RENDER_STATS_SKIPPED, decision->reason, &ignored);

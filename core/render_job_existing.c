@@ -99,7 +99,7 @@ static rt_status describe_difference(const char *path, const file_metadata *meta
     } else if (strcmp(metadata->options_hash, options) != 0) {
         /* Name the options a user most often changes when they are the difference. */
         char detail[96] = "";
-        if (strtoll(metadata->spp, NULL, 10) != image->samples_per_pixel)
+        if (metadata->spp[0] != '\0' && strtoll(metadata->spp, NULL, 10) != image->samples_per_pixel)
             snprintf(detail, sizeof detail, ": %s spp, this render %d", metadata->spp, image->samples_per_pixel);
         else if (strtoull(metadata->seed, NULL, 10) != expected->s->render.seed)
             snprintf(detail, sizeof detail, ": seed %s, this render %u", metadata->seed, expected->s->render.seed);
@@ -165,11 +165,18 @@ rt_status render_job_examine_existing(const render_job *job, const render_job_im
                                     error);
             if (status != RT_OK)
                 return status;
-            if (output_state[0] == '\0' && strcmp(metadata.complete, "1") == 0) {
+            /* 8-bit formats and HDR keep only the string keys (OpenImageIO writes text chunks
+             * of strings): there the stop reason tells, since only a render that ended by its
+             * own rule (spp, noise) writes its output with one of those. */
+            bool complete = strcmp(metadata.complete, "1") == 0
+                            || (metadata.complete[0] == '\0'
+                                && (strcmp(metadata.stop_reason, "spp") == 0
+                                    || strcmp(metadata.stop_reason, "noise") == 0));
+            if (output_state[0] == '\0' && complete) {
                 decision->kind = RENDER_JOB_EXISTING_SKIP;
                 snprintf(decision->reason, sizeof decision->reason,
-                         "%s is complete (%s spp, stopped by %s) and was rendered from the same scene and options",
-                         image->output, metadata.spp, metadata.stop_reason[0] ? metadata.stop_reason : "spp");
+                         "%s is complete (%s samples, stopped by %s) and was rendered from the same scene and "
+                         "options", image->output, metadata.samples, metadata.stop_reason);
                 return RT_OK;
             }
             if (output_state[0] == '\0') {
@@ -216,13 +223,14 @@ rt_status render_job_examine_existing(const render_job *job, const render_job_im
         }
         decision->kind = RENDER_JOB_EXISTING_RESUME;
         snprintf(decision->resume_path, sizeof decision->resume_path, "%s", path);
-        snprintf(decision->reason, sizeof decision->reason, "%s%sresuming %s (%s samples done)", output_state,
-                 output_state[0] != '\0' ? "; " : "", path, i == 0 ? metadata.samples : output_metadata.samples);
+        snprintf(decision->reason, sizeof decision->reason, "%s%s%s holds %s samples of this scene and options",
+                 output_state, output_state[0] != '\0' ? "; " : "", path,
+                 i == 0 ? metadata.samples : output_metadata.samples);
         return RT_OK;
     }
     /* 3. Nothing to keep: say what was there. */
     decision->kind = RENDER_JOB_EXISTING_RENDER;
-    snprintf(decision->reason, sizeof decision->reason, "%s%s%s; rendering it afresh", output_state,
+    snprintf(decision->reason, sizeof decision->reason, "%s%s%s", output_state,
              output_state[0] != '\0' && partial_state[0] != '\0' ? "; " : "", partial_state);
     return RT_OK;
 }
