@@ -258,8 +258,9 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * with the first rule broken, in this order: a define of frame or time with frames; the
  * first output name (batch.h's errors; several frames and no frame number in the
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
- * without EXR; variance without EXR; variance with resume; resume with several frames;
- * shard_by without shard; a shard by frames without frames, or with no frame; light groups
+ * without EXR; variance without EXR; variance with resume; skip_existing with resume;
+ * resume with several frames; shard_by without shard; a shard by frames without frames,
+ * or with no frame; light groups
  * (see the job); a shard by samples with a sample range; a shard by tiles with crop or
  * tile; light groups with a shard not by frames; a samples map with several frames or of an unknown
  * format; a minimum spp without a noise threshold; a noise threshold with a shard by samples,
