@@ -210,11 +210,13 @@ rt_status render_job_examine_existing(const render_job *job, const render_job_im
             if (partial_state[0] != '\0')
                 continue;
         }
+        if (refused != NULL && i == 0) {
+            snprintf(partial_state, sizeof partial_state, "%s is of this scene and options, but %s", path, refused);
+            continue;
+        }
         if (refused != NULL) {
-            snprintf(i == 0 ? partial_state : text, i == 0 ? sizeof partial_state : sizeof text,
-                     "%s would do, but %s", path, refused);
-            if (i == 1)
-                snprintf(output_state, sizeof output_state, "%s", text);
+            size_t used = strlen(output_state);
+            snprintf(output_state + used, sizeof output_state - used, ", but %s", refused);
             continue;
         }
         if (!load_for_resume(path, image, s, resume, resume_scene_hash, text, sizeof text)) {
@@ -223,9 +225,11 @@ rt_status render_job_examine_existing(const render_job *job, const render_job_im
         }
         decision->kind = RENDER_JOB_EXISTING_RESUME;
         snprintf(decision->resume_path, sizeof decision->resume_path, "%s", path);
-        snprintf(decision->reason, sizeof decision->reason, "%s%s%s holds %s samples of this scene and options",
-                 output_state, output_state[0] != '\0' ? "; " : "", path,
-                 i == 0 ? metadata.samples : output_metadata.samples);
+        if (i == 1)
+            snprintf(decision->reason, sizeof decision->reason, "%s; continuing it", output_state);
+        else
+            snprintf(decision->reason, sizeof decision->reason, "%s%s%s holds %s samples of this scene and options",
+                     output_state, output_state[0] != '\0' ? "; " : "", path, metadata.samples);
         return RT_OK;
     }
     /* 3. Nothing to keep: say what was there. */
