@@ -18,7 +18,7 @@
 #   RENDER OPTIONS passed to every `rtspheres render`, e.g. -- --spp 1024 --size 1920x1080
 #
 # An animation: with --frames among the render options, OUTPUT is a directory; the tasks
-# render their shares of the frames (by frames) to OUTPUT/frame-NNNN.exr, their logs go
+# render their shares of the frames (--shard-by frames) to OUTPUT/frame-NNNN.exr, their logs go
 # to OUTPUT/logs/, no merge job is submitted and merge_job= is printed empty. Submitting
 # the same command again (or requeueing a task: scontrol requeue JOBID_TASK) renders only
 # the frames that are not complete: the tasks run with --skip-existing.
