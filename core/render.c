@@ -170,6 +170,21 @@ static uint64_t scene_hash(const scene *s, const packed_scene *packed, const cam
     return hash_bytes(hash, shape, sizeof shape);
 }
 
+rt_status render_scene_hash(const scene *s, const render_options *options, uint64_t *hash, rt_error *error)
+{
+    render_options defaults = render_options_defaults();
+    camera_frame frame;
+    rt_status status = camera_frame_compute(&s->camera, s->render.width, s->render.height, &frame, error);
+    packed_scene packed;
+    if (status == RT_OK)
+        status = pack_scene(s, NULL, &packed, error);
+    if (status != RT_OK)
+        return status;
+    *hash = scene_hash(s, &packed, &frame, options != NULL ? options : &defaults);
+    packed_scene_free(&packed);
+    return RT_OK;
+}
+
 /* Reads the tracer's accumulation into a new width x height image of means (R, G, B) and
  * per-pixel finished samples; *samples receives their total. The caller frees image. */
 static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, float *luminance_squares,
@@ -418,9 +433,11 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     if (status != RT_OK)
         return status;
     packed_scene packed;
+    double pack_start = clock_seconds();
     status = pack_scene(s, NULL, &packed, error);
     if (status != RT_OK)
         return status;
+    result->pack_seconds = clock_seconds() - pack_start;
     result->bvh_depth = packed.bvh_depth;
     result->bvh_build_seconds = packed.bvh_build_seconds;
     result->packed_bytes = (uint64_t)packed.texel_count * 16u;
@@ -669,8 +686,15 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
         }
         if (status == RT_OK && report.unfinished_pixels == 0) {
             done = true;
-            if (adaptive.sampler != NULL)
+            if (adaptive.sampler != NULL) {
                 status = check_adaptive(tracer, &adaptive, &done, error);
+                adaptive_noise noise;
+                adaptive_get_noise(adaptive.sampler, &noise);
+                progress->noise_checks = noise.checks;
+                progress->noisy_pixels = noise.unconverged_pixels;
+                progress->going_pixels = noise.going_pixels;
+                progress->noise_error = noise.mean_error;
+            }
             if (done && adaptive.sampler != NULL && adaptive_stopped_early(adaptive.sampler))
                 *stop = RENDER_STOP_NOISE;
             continue;
@@ -762,11 +786,17 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         return status;
     result->reused_scene = gpu_tracer_reused_scene(tracer);
     result->compiled_program = gpu_tracer_compiled_program(tracer);
+    gpu_tracer_timings timings;
+    gpu_tracer_get_timings(tracer, &timings);
+    result->compile_seconds = timings.compile_seconds;
+    result->upload_seconds = timings.upload_seconds;
     int traced_width = traced[2] - traced[0], traced_height = traced[3] - traced[1];
 
     render_progress progress = {
         .samples_total = (uint64_t)traced_width * traced_height * s->render.samples_per_pixel,
         .samples_done = samples_resumed,
+        .pixel_count = traced_width * traced_height,
+        .noise_threshold = options->noise_threshold,
     };
     render_stop_reason stop = RENDER_STOP_SAMPLES;
     status = run_passes(context, tracer, options, (uint32_t)s->render.samples_per_pixel, traced, region, budget,
@@ -791,6 +821,12 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (status != RT_OK)
         return status;
 
+    result->samples_min = UINT32_MAX;
+    for (size_t i = 0; i < (size_t)result->image.width * result->image.height; i++) {
+        uint32_t count = (uint32_t)result->image.pixels[4 * i + 3];
+        result->samples_min = count < result->samples_min ? count : result->samples_min;
+        result->samples_max = count > result->samples_max ? count : result->samples_max;
+    }
     result->passes = progress.passes;
     result->stop_reason = stop;
     result->seconds = clock_seconds() - start;

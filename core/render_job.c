@@ -67,6 +67,7 @@ void job_image_metadata(const job_image *image, uint64_t samples, bool complete,
     const render_job *job = image->run->job;
     const scene_render_settings *settings = &image->scene.render;
     snprintf(texts->hash, sizeof texts->hash, "%016llx", (unsigned long long)result->scene_hash);
+    snprintf(texts->options_hash, sizeof texts->options_hash, "%016llx", (unsigned long long)image->plan.options_hash);
     /* The layers' names (the partial file keeps none). */
     texts->groups[0] = '\0';
     for (int g = 0; complete && job->light_groups && g < image->scene.light_group_count; g++)
@@ -75,6 +76,7 @@ void job_image_metadata(const job_image *image, uint64_t samples, bool complete,
     *metadata = (render_output_metadata){
         .scene = job->scene_path,
         .scene_hash = texts->hash,
+        .options_hash = texts->options_hash,
         .spp = settings->samples_per_pixel,
         .sample_start = image->plan.sample_start,
         .seed = settings->seed,
@@ -316,20 +318,28 @@ static void image_render_options(job_image *image, render_options *options)
     }
 }
 
-/* Renders the scene of image (loaded and planned) and finishes it. */
-static rt_status render_image(job_image *image, rt_error *error)
+/* Renders the scene of image (loaded and planned) and finishes it, continuing resume_image
+ * (with its scene hash) when it has pixels, else job->resume_path when set. Frees
+ * resume_image. */
+static rt_status render_image(job_image *image, rt_image resume_image, uint64_t resume_scene_hash, rt_error *error)
 {
     job_run *run = image->run;
     const render_job *job = run->job;
     render_options options;
     image_render_options(image, &options);
-    /* Too large for the device or the budget: tiles (render_job_tiles.c). */
+    /* Too large for the device or the budget: tiles (render_job_tiles.c). They keep no
+     * partial file, so a partial --skip-existing found is not continued: the image
+     * renders afresh (and the complete image supersedes the partial). */
     job_tile_grid grid;
     rt_status tiled = job_plan_tiles(image, &options, &grid, error);
-    if (tiled != RT_OK || grid.count > 1)
+    if (tiled != RT_OK || grid.count > 1) {
+        image_free(&resume_image);
         return tiled != RT_OK ? tiled : job_render_tiles(image, &options, &grid, error);
-    rt_image resume_image = {0};
-    if (job->resume_path != NULL) {
+    }
+    if (resume_image.pixels != NULL) {
+        options.resume = &resume_image;
+        options.resume_scene_hash = resume_scene_hash;
+    } else if (job->resume_path != NULL) {
         render_output_resume_check check = {.seed = image->scene.render.seed,
                                             .sample_start = image->plan.sample_start,
                                             .spp = image->scene.render.samples_per_pixel};
@@ -384,10 +394,22 @@ static rt_status run_image(job_run *run, int frame, const char *output, rt_error
     image->plan.output = output;
     render_output_partial_path(output, image->plan.partial, sizeof image->plan.partial);
     status = render_job_plan_image(job, &run->plan, &s->render, frame, &image->plan, error);
+    image->plan.sweep_row = run->sweep_row;
+    render_job_existing existing = {0};
+    rt_image resume = {0};
+    uint64_t resume_scene_hash = 0;
     if (status == RT_OK) {
         s->render.samples_per_pixel = image->plan.samples_per_pixel;
-        status = render_image(image, error);
+        image->plan.options_hash = render_job_options_hash(job, &image->plan, &s->render);
+        if (job->skip_existing)
+            status = render_job_examine_existing(job, &image->plan, s, &existing, &resume, &resume_scene_hash, error);
     }
+    if (status == RT_OK && existing.kind != RENDER_JOB_EXISTING_NONE && run->callbacks.existing_output != NULL)
+        run->callbacks.existing_output(run->callbacks.user, &image->plan, &existing);
+    if (status == RT_OK && existing.kind == RENDER_JOB_EXISTING_SKIP)
+        run->images_skipped++;
+    else if (status == RT_OK)
+        status = render_image(image, resume, resume_scene_hash, error);
     if (status == RT_OK)
         run->failure = RENDER_JOB_FAILURE_NONE;
     scene_free(s);
@@ -481,6 +503,7 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
         status = run_frames(&run, summary, error);
     }
     summary->seconds = clock_seconds() - start;
+    summary->images_skipped = run.images_skipped;
     summary->failure = status == RT_OK ? RENDER_JOB_FAILURE_NONE : run.failure;
     return status;
 }

@@ -14,6 +14,7 @@ typedef struct job_run {
     render_job_callbacks callbacks;      /* the caller's, or all NULL */
     render_job_failure failure;          /* where the run stopped short */
     bool image_begun;                    /* an image has begun (its limit counted from then) */
+    int images_skipped;                  /* skip_existing found them complete */
     int sweep_row;                       /* the sweep row being rendered, -1: none */
 } job_run;
 
@@ -29,6 +30,7 @@ typedef struct job_image {
 /* The texts a render_output_metadata points into. */
 typedef struct job_metadata_texts {
     char hash[24];
+    char options_hash[24];
     char groups[SCENE_LIGHT_GROUP_MAX * (SCENE_LIGHT_GROUP_NAME_MAX + 1) + 1];
 } job_metadata_texts;
 

@@ -297,6 +297,8 @@ static void add_tile(tile_run *run, const render_result *result, int tile)
         total->steady_seconds += result->steady_seconds;
         total->steady_samples += result->steady_samples;
         total->passes += result->passes;
+        total->samples_min = result->samples_min < total->samples_min ? result->samples_min : total->samples_min;
+        total->samples_max = result->samples_max > total->samples_max ? result->samples_max : total->samples_max;
     }
     run->any_time = run->any_time || result->stop_reason == RENDER_STOP_TIME;
     run->any_noise = run->any_noise || result->stop_reason == RENDER_STOP_NOISE;

@@ -38,7 +38,7 @@ static const rt_image *image_for_format(const char *path, const rt_image *image,
 
 /* The image attributes of metadata (metadata_keys.h), with the texts they point into. */
 typedef struct output_attributes {
-    image_attribute list[17];
+    image_attribute list[18];
     int count;
     char seed[24], sample_start[24], samples[24], segments[32];
 } output_attributes;
@@ -67,6 +67,9 @@ static void make_attributes(const render_output_metadata *metadata, output_attri
     };
     int count = (int)(sizeof always / sizeof always[0]);
     memcpy(attributes->list, always, sizeof always);
+    if (metadata->options_hash != NULL)
+        attributes->list[count++] = (image_attribute){
+            .name = METADATA_KEY_OPTIONS_HASH, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->options_hash};
     if (metadata->stop_reason != NULL) {   /* a render's keys (not a merge's) */
         attributes->list[count++] = (image_attribute){
             .name = METADATA_KEY_STOP_REASON, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->stop_reason};
