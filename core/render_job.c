@@ -24,6 +24,7 @@ typedef struct job_run {
     render_job_failure failure;          /* where the run stopped short */
     bool image_begun;                    /* an image has begun (its limit counted from then) */
     int sweep_row;                       /* the sweep row being rendered, -1: none */
+    pack_bvh_cache *bvh_cache;           /* with several images: their BVHs carried over */
 } job_run;
 
 /* One image being rendered: its scene (render settings after the job's overrides and
@@ -307,6 +308,7 @@ static void image_render_options(job_image *image, render_options *options)
     options->aovs = job->aovs || job->denoise;
     options->light_groups = job->light_groups;
     options->variance = job->variance;
+    options->bvh_cache = image->run->bvh_cache;
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;
     options->stop_requested = job->stop_requested;
@@ -471,6 +473,12 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
         summary->failure = RENDER_JOB_FAILURE_PLAN;
         return status;
     }
+    /* Frames and sweep rows that move no shape keep every BVH (pack.h, the BVH cache). */
+    int images = job->sweep != NULL ? job->sweep->row_count : job->frame_count;
+    if (images > 1 && pack_bvh_cache_create(&run.bvh_cache, error) != RT_OK) {
+        summary->failure = RENDER_JOB_FAILURE_IMAGE;
+        return RT_ERROR_RUNTIME;
+    }
     double start = clock_seconds();
     if (job->sweep != NULL) {
         status = run_sweep(&run, summary, error);
@@ -480,6 +488,7 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
     } else {
         status = run_frames(&run, summary, error);
     }
+    pack_bvh_cache_free(run.bvh_cache);
     summary->seconds = clock_seconds() - start;
     summary->failure = status == RT_OK ? RENDER_JOB_FAILURE_NONE : run.failure;
     return status;

@@ -57,7 +57,9 @@
  *   tracer                  how each image is traced (render.h; zero = its defaults; its
  *                           noise_threshold and min_spp: adaptive sampling). The job sets
  *                           its sample_start, region, aovs, variance, progress,
- *                           stop_requested, deadline, resume and checkpoint fields itself.
+ *                           stop_requested, deadline, resume, checkpoint and bvh_cache
+ *                           fields itself (a job of several frames or rows keeps one BVH
+ *                           cache, pack.h, for all of them).
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
  *   sweep                   NULL: none; else a sweep table (sweep.h): one image per row,
