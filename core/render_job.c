@@ -97,9 +97,11 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
     placed.full_height = settings->height;
     char hash[24];
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)result->scene_hash);
-    /* The layers' names (the partial file keeps none). */
+    /* The layers' names, with the output (also one a time limit ended; the partial file
+     * keeps no layers). */
+    bool layers = job->light_groups && strcmp(path, image->plan.output) == 0;
     char groups[SCENE_LIGHT_GROUP_MAX * (SCENE_LIGHT_GROUP_NAME_MAX + 1) + 1] = "";
-    for (int g = 0; complete && job->light_groups && g < image->scene.light_group_count; g++)
+    for (int g = 0; layers && g < image->scene.light_group_count; g++)
         snprintf(groups + strlen(groups), sizeof groups - strlen(groups), "%s%s", g > 0 ? "," : "",
                  image->scene.light_groups[g]);
     render_output_metadata metadata = {
