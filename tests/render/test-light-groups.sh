@@ -52,6 +52,12 @@ done
 groups=$(metadata "$scratch/groups.exr" light_groups)
 if [ "$groups" = "default,sky,panel,key,fill,sun" ]; then pass "rtspheres:light_groups lists the groups"
 else fail "rtspheres:light_groups lists the groups" "'$groups'"; fi
+# A render a time limit ended names its groups too (relight finds the layers by them).
+"$program" render "$scene" -o "$scratch/timed.exr" --quiet --light-groups --size 16x9 --spp 1000000 --time-limit 0.5
+stats_of "$scratch/timed.exr"
+timed="$(stat_metadata stop_reason) $(stat_metadata light_groups)"
+if [ "$timed" = "time default,sky,panel,key,fill,sun" ]; then pass "a time-limited render lists its light groups"
+else fail "a time-limited render lists its light groups" "stop reason and groups: '$timed'"; fi
 stats_of "$scratch/groups.exr"
 missing=""
 for group in default sky panel key fill sun; do
