@@ -83,6 +83,7 @@ else fail "the key layer holds light" "key.R mean $key of R $all"; fi
     --group panel=0 --group fill=0 --group sun=0
 "$program" stats "$scratch/groups.exr" | grep '^channel .*\.[RGB]:' >"$scratch/whole.layers"
 for split in "samples 1e-5 half0 half1" "tiles 0 band0 band1"; do
+    # shellcheck disable=SC2086 # $split is a list of words
     set -- $split
     kind=$1 tolerance=$2 merged=$scratch/merged-$1.exr
     problem=$(merge_problem "$scratch/groups.exr" "$tolerance" 16 "$merged" "$scratch/$3.exr" "$scratch/$4.exr")

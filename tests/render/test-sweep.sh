@@ -45,6 +45,7 @@ same "a shard's row equals the whole sweep's" "$scratch/shard1/r1.exr" "$scratch
 # the changed 16 KiB blocks of the packed scene (the light section's), not the geometry; a
 # row that moves a shape builds its BVH again. 400 small spheres make the packed scene
 # several blocks long. Each image is still that of its own render.
+# shellcheck disable=SC2016 # the $NAME are the scene's variables, not the shell's
 {
     echo 'set lx -2'
     echo 'set red 1'
