@@ -23,6 +23,8 @@
 # Knobs
 #   V=1        show the commands (and with `test`, every check a passing test makes)
 #   TESTS      with `test`: the names of the tests to run (default: all of them)
+#   TEST_JOBS  with `test`: how many tests run at once (default: the number of cores;
+#              tests/run.sh). TEST_JOBS=1 for one at a time
 #   RTSPHERES_TEST_TIMEOUT  with `test`: seconds each test may take (environment;
 #              default 120 s a unit binary, 600 s a render script; tests/run.sh)
 #   SAN=1      build with AddressSanitizer + UndefinedBehaviorSanitizer (into build-san/)

@@ -11,8 +11,9 @@
 
 static void print_help(FILE *stream)
 {
-    fprintf(stream, "usage: rtspheres info [--device N]\n"
-                    "  --device N   use EGL device N (0-based, as listed under \"EGL devices\") instead of choosing\n");
+    fprintf(stream, "usage: rtspheres info [--device N] [--threads N]\n"
+                    "  --device N   use EGL device N (0-based, as listed under \"EGL devices\") instead of choosing\n"
+                    "  --threads N  CPU threads of a software device (llvmpipe), as render --threads sets them\n");
 }
 
 /* Lists the EGL devices with their numbers (what --device N takes) and what EGL tells of
@@ -53,6 +54,7 @@ int command_info(int argc, char **argv)
 {
     static const struct option long_options[] = {
         {"device", required_argument, NULL, 'd'},
+        {"threads", required_argument, NULL, 't'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
     };
@@ -67,6 +69,16 @@ int command_info(int argc, char **argv)
                 return EXIT_BAD_INPUT;
             }
             options.device = (int)device + 1;
+            break;
+        }
+        case 't': {
+            long long threads;
+            if (command_parse_integer(optarg, 1, GPU_MAX_THREADS, &threads) != 0) {
+                fprintf(stderr, "rtspheres info: --threads wants a whole number from 1 to %d, not '%s'\n",
+                        GPU_MAX_THREADS, optarg);
+                return EXIT_BAD_INPUT;
+            }
+            options.threads = (int)threads;
             break;
         }
         default:
@@ -97,6 +109,11 @@ int command_info(int argc, char **argv)
     printf("EGL:              %s, %s\n", info.egl_vendor, info.egl_version);
     printf("GL vendor:        %s\n", info.gl_vendor);
     printf("GL renderer:      %s%s\n", info.gl_renderer, info.software ? " (software, on the CPU)" : "");
+    if (info.software)
+        printf("CPU threads:      %d llvmpipe rasteriser thread%s (--threads N, LP_NUM_THREADS)\n",
+               info.software_threads, info.software_threads == 1 ? "" : "s");
+    else if (info.threads_ignored)
+        printf("CPU threads:      --threads does nothing on a hardware device\n");
     printf("GL version:       %s\n", info.gl_version);
     printf("GLSL version:     %s\n", info.glsl_version);
     printf("max texture size: %d\n", info.max_texture_size);

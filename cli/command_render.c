@@ -11,8 +11,10 @@
 #include "commands.h"
 #include "gpu.h"
 #include "display_tev.h"
+#include "paths.h"
 #include "render_arguments.h"
 #include "render_job.h"
+#include "render_stats.h"
 
 static volatile sig_atomic_t stop_requested = 0;
 
@@ -30,10 +32,14 @@ static void on_stop_signal(int signal_number)
 
 typedef struct presentation {
     const render_arguments *arguments;
-    bool tty;                    /* stderr is a terminal and not --quiet: draw the bar */
+    bool tty;                    /* draw the bar (--progress bar, or auto on a terminal) */
+    bool lines;                  /* write progress lines (--progress lines, or auto elsewhere) */
     double command_start;        /* monotonic seconds when the command started */
+    render_stats *stats;         /* --stats-json's figures, or NULL */
     /* Of the image being rendered: */
-    char label[64];              /* "frame N " with frames, else "" */
+    char label[64];              /* "frame N " with frames, "row N " with a sweep, else "" */
+    bool resumed;                /* --skip-existing resumes it */
+    double last_line;            /* elapsed seconds of the last progress line */
     double last_draw;
     double first_pass;           /* seconds from the command's start to its first pass's end */
     int compiles;                /* images whose tracer program was compiled (not cached) */
@@ -67,8 +73,28 @@ static void start_bar(void *user, const render_job_image *image)
     shown->label[0] = '\0';
     if (image->frame >= 0)
         snprintf(shown->label, sizeof shown->label, "frame %d ", image->frame);
+    else if (image->sweep_row >= 0)
+        snprintf(shown->label, sizeof shown->label, "row %d ", image->sweep_row);
     shown->last_draw = -1;
+    shown->last_line = 0;
     shown->first_pass = 0;
+}
+
+/* A progress line for logs (--progress lines): how far, how long, how long still, and how
+ * noisy the image still is with adaptive sampling. Never a carriage return. */
+static void write_progress_line(const presentation *shown, const render_progress *progress)
+{
+    double fraction = (double)progress->samples_done / (double)progress->samples_total;
+    double eta = fraction > 0 ? progress->elapsed_seconds * (1.0 - fraction) / fraction : 0;
+    char noise[200] = "";
+    if (progress->noise_checks > 0 && progress->pixel_count > 0)
+        snprintf(noise, sizeof noise, "; noise: %.1f%% of pixels at or above %g (mean error %.3g), %d still sampling",
+                 100.0 * progress->noisy_pixels / progress->pixel_count, progress->noise_threshold,
+                 progress->noise_error, progress->going_pixels);
+    fprintf(stderr, "rtspheres: %sprogress %.1f%%, %llu of %llu samples, %.1f s elapsed, ETA %.1f s, pass %d%s\n",
+            shown->label, 100.0 * fraction, (unsigned long long)progress->samples_done,
+            (unsigned long long)progress->samples_total, progress->elapsed_seconds, eta, progress->passes, noise);
+    fflush(stderr);
 }
 
 /* render_job_callbacks.progress: redraws the bar at most every 0.1 s (and at the end). */
@@ -77,6 +103,11 @@ static void draw_progress(void *user, const render_progress *progress)
     presentation *shown = user;
     if (progress->passes == 1)
         shown->first_pass = clock_seconds() - shown->command_start;
+    if (shown->lines && progress->samples_total > 0
+        && progress->elapsed_seconds - shown->last_line >= shown->arguments->progress_interval) {
+        shown->last_line = progress->elapsed_seconds;
+        write_progress_line(shown, progress);
+    }
     if (!shown->tty || progress->samples_total == 0)
         return;
     double fraction = (double)progress->samples_done / (double)progress->samples_total;
@@ -95,14 +126,52 @@ static void draw_progress(void *user, const render_progress *progress)
     fflush(stderr);
 }
 
-/* render_job_callbacks.render_finished: ends the bar's line. */
+/* Writes --stats-json as it stands; a failure is a warning (the render goes on). */
+static void write_stats(const presentation *shown)
+{
+    if (shown->stats == NULL)
+        return;
+    rt_error error = {{0}};
+    if (render_stats_write(shown->stats, shown->arguments->stats_json, &error) != RT_OK)
+        fprintf(stderr, "rtspheres render: warning: --stats-json: %s\n", error.message);
+}
+
+/* render_job_callbacks.render_finished: ends the bar's line; a failed or interrupted
+ * image goes into the statistics. */
 static void end_bar(void *user, const render_job_image *image, rt_status status)
 {
-    (void)image;
-    (void)status;
     presentation *shown = user;
     if (shown->tty)
         fprintf(stderr, "\n");
+    if (shown->stats != NULL && status != RT_OK) {
+        rt_error ignored = {{0}};
+        render_stats_add_other(shown->stats, image,
+                               status == RT_ERROR_INTERRUPTED ? RENDER_STATS_INTERRUPTED : RENDER_STATS_FAILED, NULL,
+                               &ignored);
+        write_stats(shown);
+    }
+}
+
+/* render_job_callbacks.existing_output: what --skip-existing found, one line per image. */
+static void show_existing(void *user, const render_job_image *image, const render_job_existing *decision)
+{
+    presentation *shown = user;
+    shown->resumed = decision->kind == RENDER_JOB_EXISTING_RESUME;
+    char label[64] = "";
+    if (image->frame >= 0)
+        snprintf(label, sizeof label, "frame %d: ", image->frame);
+    else if (image->sweep_row >= 0)
+        snprintf(label, sizeof label, "row %d: ", image->sweep_row);
+    const char *verb = decision->kind == RENDER_JOB_EXISTING_SKIP     ? "skipped"
+                       : decision->kind == RENDER_JOB_EXISTING_RESUME ? "resuming"
+                                                                      : "rendering afresh";
+    if (!shown->arguments->quiet)
+        fprintf(stderr, "rtspheres: %s%s: %s\n", label, verb, decision->reason);
+    if (shown->stats != NULL && decision->kind == RENDER_JOB_EXISTING_SKIP) {
+        rt_error ignored = {{0}};
+        render_stats_add_other(shown->stats, image, RENDER_STATS_SKIPPED, decision->reason, &ignored);
+        write_stats(shown);
+    }
 }
 
 /* render_job_callbacks.warning. */
@@ -149,6 +218,13 @@ static void show_summary(void *user, const render_job_image *image, const render
     presentation *shown = user;
     shown->compiles += result->compiled_program;
     show_on_display(shown, &result->image);
+    if (shown->stats != NULL) {
+        rt_error error = {{0}};
+        if (render_stats_add_rendered(shown->stats, image, result, shown->resumed, shown->first_pass, &error) != RT_OK)
+            fprintf(stderr, "rtspheres render: warning: --stats-json: %s\n", error.message);
+        write_stats(shown);
+    }
+    shown->resumed = false;
     if (shown->arguments->verbose) {
         uint64_t geometry_bytes = result->packed_bytes - result->image_bytes;
         fprintf(stderr,
@@ -194,6 +270,7 @@ static int open_gpu(const render_arguments *arguments, gpu_context **context)
     gpu.device = arguments->device >= 0 ? arguments->device + 1 : 0;
     gpu.debug_output = arguments->verbose;
     gpu.log = log_to_stderr;
+    gpu.threads = arguments->threads;
     rt_error error = {{0}};
     rt_status status = gpu_create(&gpu, context, &error);
     if (status != RT_OK) {
@@ -206,20 +283,38 @@ static int open_gpu(const render_arguments *arguments, gpu_context **context)
         *context = NULL;
         return EXIT_RUNTIME;
     }
-    if (arguments->verbose) {
-        gpu_info info;
-        gpu_get_info(*context, &info);
+    gpu_info info;
+    gpu_get_info(*context, &info);
+    if (info.threads_ignored)
+        fprintf(stderr, "rtspheres render: warning: --threads %d does nothing on %s, a hardware device\n",
+                arguments->threads, info.gl_renderer);
+    if (arguments->verbose)
         fprintf(stderr, "rtspheres: rendering on %s (%s, %s)\n", info.gl_renderer, info.platform, info.gl_version);
-    }
+    if (arguments->verbose && info.software)
+        fprintf(stderr, "rtspheres: %d llvmpipe rasteriser thread%s\n", info.software_threads,
+                info.software_threads == 1 ? "" : "s");
     return EXIT_OK;
 }
 
 /* Runs the job on context and says how it ended. Returns the exit code. */
 static int run_job(gpu_context *context, const render_arguments *arguments, display_tev *display,
-                   double command_start)
+                   double command_start, double context_seconds)
 {
-    presentation shown = {.arguments = arguments, .tty = !arguments->quiet && isatty(STDERR_FILENO),
+    bool terminal = isatty(STDERR_FILENO);
+    render_progress_mode mode = arguments->progress;
+    if (mode == PROGRESS_AUTO)
+        mode = terminal ? PROGRESS_BAR : PROGRESS_LINES;
+    presentation shown = {.arguments = arguments, .tty = !arguments->quiet && mode == PROGRESS_BAR,
+                          .lines = !arguments->quiet && mode == PROGRESS_LINES,
                           .command_start = command_start, .last_draw = -1, .display = display};
+    render_stats stats;
+    if (arguments->stats_json != NULL) {
+        gpu_info info;
+        gpu_get_info(context, &info);
+        render_stats_init(&stats, &info, arguments->threads, context_seconds, arguments->job.scene_path,
+                          arguments->job.output);
+        shown.stats = &stats;
+    }
     render_job job = arguments->job;
     if (display != NULL) {
         job.tracer.preview = send_preview;
@@ -233,11 +328,19 @@ static int run_job(gpu_context *context, const render_arguments *arguments, disp
         .progress = draw_progress,
         .render_finished = end_bar,
         .checkpoint_written = show_checkpoint,
+        .existing_output = show_existing,
         .image_written = show_summary,
     };
     render_job_summary summary;
     rt_error error = {{0}};
     rt_status status = render_job_run(context, &job, &callbacks, &summary, &error);
+    if (shown.stats != NULL) {
+        stats.job_finished = true;
+        stats.job_seconds = summary.seconds;
+        stats.job_error = status != RT_OK ? error.message : NULL;
+        write_stats(&shown);
+        render_stats_free(&stats);
+    }
     if (status != RT_OK && summary.failure == RENDER_JOB_FAILURE_SCENE)
         fprintf(stderr, "%s\n", error.message);  /* the parser's message names the file already */
     else if (status != RT_OK && summary.failure != RENDER_JOB_FAILURE_STOPPED)
@@ -245,7 +348,10 @@ static int run_job(gpu_context *context, const render_arguments *arguments, disp
     int rendered = summary.images_started;
     bool list = arguments->job.frame_count > 0 || arguments->job.sweep != NULL;
     const char *unit = arguments->job.sweep != NULL ? "sweep row" : "frame";
-    if (list && !arguments->quiet && rendered > 0)
+    if (list && !arguments->quiet && rendered > 0 && summary.images_skipped > 0)
+        fprintf(stderr, "rtspheres: %d %s%s in %.2f s, %d of them skipped as complete\n", rendered, unit,
+                rendered == 1 ? "" : "s", summary.seconds, summary.images_skipped);
+    else if (list && !arguments->quiet && rendered > 0)
         fprintf(stderr, "rtspheres: %d %s%s in %.2f s (%.3g %ss/s)\n", rendered, unit, rendered == 1 ? "" : "s",
                 summary.seconds, rendered / summary.seconds, unit);
     if (list && arguments->verbose)
@@ -269,6 +375,12 @@ int command_render(int argc, char **argv)
             exit_code = EXIT_BAD_INPUT;
         }
     }
+    if (exit_code == EXIT_OK && !help_shown && arguments.stats_json != NULL
+        && !path_directory_writable(arguments.stats_json)) {
+        fprintf(stderr, "rtspheres render: --stats-json: cannot create a file in the directory of '%s'\n",
+                arguments.stats_json);
+        exit_code = EXIT_BAD_INPUT;
+    }
     display_tev *display = NULL;
     if (exit_code == EXIT_OK && !help_shown && arguments.display != NULL) {
         rt_error error = {{0}};
@@ -291,9 +403,10 @@ int command_render(int argc, char **argv)
     arguments.job.stop_requested = &stop_requested;
     arguments.job.time_limit_start = command_start;  /* --time-limit counts from here */
     gpu_context *context = NULL;
+    double context_start = clock_seconds();
     exit_code = open_gpu(&arguments, &context);
     if (exit_code == EXIT_OK) {
-        exit_code = run_job(context, &arguments, display, command_start);
+        exit_code = run_job(context, &arguments, display, command_start, clock_seconds() - context_start);
         gpu_destroy(context);
     }
     display_tev_destroy(display);

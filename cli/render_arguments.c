@@ -90,7 +90,15 @@ static void print_help(FILE *stream)
             "      --pass-budget N    fixed work units per pixel per GPU pass (default: adapted\n"
             "                         so a pass takes about 0.25 s, 1 s on llvmpipe; the image is the same)\n"
             "      --device N         use EGL device N (see `rtspheres info`)\n"
-            "  -q, --quiet            no progress bar and no summary line\n"
+            "      --threads N        CPU threads of the software device (llvmpipe's LP_NUM_THREADS);\n"
+            "                         on a GPU a warning that it does nothing\n"
+            "      --skip-existing    leave an output that is complete and was rendered from the same\n"
+            "                         scene and options alone; resume its partial file; say why\n"
+            "      --progress MODE    auto (default: the bar on a terminal, else lines), bar, lines\n"
+            "                         (one line every --progress-interval seconds) or none\n"
+            "      --progress-interval SECS  seconds between progress lines (default 5; 0: every pass)\n"
+            "      --stats-json FILE  write the render's figures as JSON (docs/stats-json.md)\n"
+            "  -q, --quiet            no progress and no summary line\n"
             "  -v, --verbose          OpenGL debug messages and set-up details on stderr\n"
             "  -h, --help             this text\n");
 }
@@ -101,6 +109,7 @@ enum {
     OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
     OPTION_LIGHT_GROUPS, OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
     OPTION_CAMERA, OPTION_NOISE_THRESHOLD, OPTION_MIN_SPP, OPTION_TIME_LIMIT, OPTION_SAMPLES_MAP,
+    OPTION_PROGRESS, OPTION_PROGRESS_INTERVAL, OPTION_STATS_JSON, OPTION_THREADS, OPTION_SKIP_EXISTING,
 };
 
 /* One word an option takes and the value it stands for. */
@@ -142,8 +151,8 @@ static bool parse_pair(const char *text, char separator, long long minimum_a, lo
            && !command_parse_integer(middle + 1, minimum_b, maximum_b, b);
 }
 
-/* The options that take a whole number, with their ranges. Returns the complaint, or
- * NULL when value is good. */
+/* The options that take a whole number, with their ranges, and the command's own
+ * options (threads, progress). Returns the complaint, or NULL when value is good. */
 static const char *take_whole_number(int option, const char *value, render_arguments *arguments)
 {
     render_job *job = &arguments->job;
@@ -184,6 +193,25 @@ static const char *take_whole_number(int option, const char *value, render_argum
         if (command_parse_integer(value, 0, 255, &number))
             return "--device wants a device number (0, 1, ...)";
         arguments->device = (int)number;
+        return NULL;
+    case OPTION_THREADS:
+        if (command_parse_integer(value, 1, GPU_MAX_THREADS, &number))
+            return "--threads wants a whole number from 1 to 1024";
+        arguments->threads = (int)number;
+        return NULL;
+    case OPTION_PROGRESS: {
+        static const choice modes[] = {
+            {"auto", PROGRESS_AUTO}, {"bar", PROGRESS_BAR}, {"lines", PROGRESS_LINES}, {"none", PROGRESS_NONE}};
+        int word = 0;
+        if (!parse_choice(value, modes, 4, &word))
+            return "--progress wants auto, bar, lines or none";
+        arguments->progress = (render_progress_mode)word;
+        return NULL;
+    }
+    case OPTION_PROGRESS_INTERVAL:
+        if (!parse_real(value, &arguments->progress_interval) || !(arguments->progress_interval >= 0)
+            || arguments->progress_interval > 1e7)
+            return "--progress-interval wants a number of seconds (0: a line after every pass)";
         return NULL;
     }
     return NULL;
@@ -375,6 +403,8 @@ static int take_option(int option, const char *value, render_arguments *argument
     case OPTION_VARIANCE: job->variance = true; break;
     case OPTION_DENOISE: job->denoise = true; break;
     case OPTION_FULL_TRACER: job->tracer.full_tracer = true; break;
+    case OPTION_STATS_JSON: arguments->stats_json = value; break;
+    case OPTION_SKIP_EXISTING: job->skip_existing = true; break;
     case 'q': arguments->quiet = true; break;
     case 'v': arguments->verbose = true; break;
     case 's':
@@ -384,6 +414,9 @@ static int take_option(int option, const char *value, render_arguments *argument
     case OPTION_ROULETTE_DEPTH:
     case OPTION_MIN_SPP:
     case OPTION_DEVICE:
+    case OPTION_THREADS:
+    case OPTION_PROGRESS:
+    case OPTION_PROGRESS_INTERVAL:
         complaint = take_whole_number(option, value, arguments);
         break;
     case OPTION_FRAMES:
@@ -453,6 +486,11 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
         {"denoise", no_argument, NULL, OPTION_DENOISE},
         {"blur", required_argument, NULL, OPTION_BLUR},
         {"tonemap", required_argument, NULL, OPTION_TONEMAP},
+        {"threads", required_argument, NULL, OPTION_THREADS},
+        {"skip-existing", no_argument, NULL, OPTION_SKIP_EXISTING},
+        {"progress", required_argument, NULL, OPTION_PROGRESS},
+        {"progress-interval", required_argument, NULL, OPTION_PROGRESS_INTERVAL},
+        {"stats-json", required_argument, NULL, OPTION_STATS_JSON},
         {"quiet", no_argument, NULL, 'q'},
         {"verbose", no_argument, NULL, 'v'},
         {"help", no_argument, NULL, 'h'},
@@ -461,6 +499,7 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
     memset(arguments, 0, sizeof *arguments);
     arguments->job = render_job_defaults();
     arguments->device = -1;
+    arguments->progress_interval = RENDER_ARGUMENTS_DEFAULT_PROGRESS_INTERVAL;
     arguments->messages = messages;
     arguments->message_prefix = prefix;
     *help_shown = false;

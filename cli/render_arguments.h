@@ -15,9 +15,23 @@
 
 #define RENDER_ARGUMENTS_MAX_DEFINES 256
 
+/* --progress: how a running render shows how far it is. */
+typedef enum render_progress_mode {
+    PROGRESS_AUTO = 0,           /* the bar on a terminal, else lines */
+    PROGRESS_BAR,                /* a bar redrawn with carriage returns */
+    PROGRESS_LINES,              /* a line every progress_interval seconds */
+    PROGRESS_NONE,
+} render_progress_mode;
+
+#define RENDER_ARGUMENTS_DEFAULT_PROGRESS_INTERVAL 5.0
+
 typedef struct render_arguments {
     render_job job;              /* its frames and defines point into this struct */
     bool quiet, verbose;
+    render_progress_mode progress;
+    double progress_interval;    /* --progress-interval SECONDS (default 5; 0: every pass) */
+    const char *stats_json;      /* --stats-json FILE, or NULL */
+    int threads;                 /* --threads N, or 0: the device's default */
     int device;                  /* --device N, or -1: let gpu.h choose */
     frame_list frames;
     sweep_table sweep;           /* --sweep's table (job.sweep points here) */

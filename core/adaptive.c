@@ -16,6 +16,7 @@ struct adaptive_sampler {
     uint8_t *tile_going;         /* per tile: a pixel of it is going */
     uint8_t *tile_stopped_now;   /* per tile: the last check stopped its last pixel */
     bool stopped_early;
+    adaptive_noise noise;        /* of the last check */
 };
 
 float adaptive_pixel_error(float luminance_sum, float luminance_squares, uint32_t n)
@@ -136,12 +137,22 @@ static void update_tiles(adaptive_sampler *sampler)
 int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *luminance_squares)
 {
     size_t pixels = (size_t)sampler->width * sampler->height;
+    double error_sum = 0;
+    int checked = 0, unconverged = 0;
     for (size_t i = 0; i < pixels; i++) {
         const float *pixel = rgba + 4 * i;
         float luminance = 0.2126f * pixel[0] + 0.7152f * pixel[1] + 0.0722f * pixel[2];
-        sampler->unconverged[i] = sampler->going[i] && adaptive_pixel_error(luminance, luminance_squares[i],
-                                                                             (uint32_t)pixel[3]) >= sampler->threshold;
+        float error = sampler->going[i] ? adaptive_pixel_error(luminance, luminance_squares[i], (uint32_t)pixel[3]) : 0;
+        sampler->unconverged[i] = sampler->going[i] && error >= sampler->threshold;
+        if (sampler->going[i] && isfinite(error)) {
+            error_sum += error;
+            checked++;
+        }
+        unconverged += sampler->unconverged[i];
     }
+    sampler->noise.checks++;
+    sampler->noise.unconverged_pixels = unconverged;
+    sampler->noise.mean_error = checked > 0 ? (float)(error_sum / checked) : 0.0f;
     int going = 0;
     for (int y = 0; y < sampler->height; y++)
         for (int x = 0; x < sampler->width; x++) {
@@ -163,7 +174,13 @@ int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *lu
             }
         }
     update_tiles(sampler);
+    sampler->noise.going_pixels = going;
     return going;
+}
+
+void adaptive_get_noise(const adaptive_sampler *sampler, adaptive_noise *noise)
+{
+    *noise = sampler->noise;
 }
 
 int adaptive_rectangle_capacity(const adaptive_sampler *sampler)

@@ -80,6 +80,17 @@ const uint32_t *adaptive_limits(const adaptive_sampler *sampler);
  * next check. Returns the pixels still going (0: the render is done). */
 int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *luminance_squares);
 
+/* How noisy the image was at the last check (all zero before the first): for progress
+ * reports. */
+typedef struct adaptive_noise {
+    int checks;                  /* checks made so far */
+    int unconverged_pixels;      /* pixels still going whose error was >= the threshold */
+    int going_pixels;            /* pixels going on after the check */
+    float mean_error;            /* the mean error (above) of the pixels the check looked at */
+} adaptive_noise;
+
+void adaptive_get_noise(const adaptive_sampler *sampler, adaptive_noise *noise);
+
 /* True when some pixel stopped below max_spp (the threshold, not --spp, ended it). */
 bool adaptive_stopped_early(const adaptive_sampler *sampler);
 

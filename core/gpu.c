@@ -1,6 +1,7 @@
 /* gpu.c: the EGL context: devices, context creation, what the device offers. With
  * core/gpu_tracer.c (the tracer) the only files that call egl* and gl*. See gpu.h for the
  * order of set-up and how failures are told apart. */
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -219,13 +220,104 @@ static void read_gl_info(gpu_context *context)
     set_work_limits(info);
 }
 
+/* Counts this process's llvmpipe rasteriser threads: llvmpipe names each "llvmpipe-N"
+ * (its thread index), which /proc/self/task/TID/comm shows. Returns the count, or -1 when
+ * /proc cannot be read. */
+static int count_software_threads(void)
+{
+    DIR *tasks = opendir("/proc/self/task");
+    if (tasks == NULL)
+        return -1;
+    int count = 0;
+    struct dirent *entry;
+    while ((entry = readdir(tasks)) != NULL) {
+        if (entry->d_name[0] == '.')
+            continue;
+        char path[300], name[64] = "";
+        snprintf(path, sizeof path, "/proc/self/task/%s/comm", entry->d_name);
+        FILE *file = fopen(path, "r");
+        if (file == NULL)
+            continue;
+        if (fgets(name, sizeof name, file) != NULL && strncmp(name, "llvmpipe-", 9) == 0)
+            count++;
+        fclose(file);
+    }
+    closedir(tasks);
+    return count;
+}
+
+/* The environment's LP_NUM_THREADS before gpu_create() changed it, to put back. */
+typedef struct thread_setting {
+    bool changed;
+    char *previous;              /* NULL: it was not set */
+} thread_setting;
+
+/* Sets LP_NUM_THREADS to threads (> 0) for the context about to be made, keeping what was
+ * there in *saved; threads 0 leaves the environment alone. */
+static void set_software_threads(int threads, thread_setting *saved)
+{
+    memset(saved, 0, sizeof *saved);
+    if (threads <= 0)
+        return;
+    const char *previous = getenv("LP_NUM_THREADS");
+    saved->previous = previous != NULL ? strdup(previous) : NULL;
+    saved->changed = true;
+    char value[16];
+    snprintf(value, sizeof value, "%d", threads);
+    setenv("LP_NUM_THREADS", value, 1);
+}
+
+/* Puts LP_NUM_THREADS back as *saved has it (llvmpipe has read it by now), so child
+ * processes and later contexts see the caller's environment. */
+static void restore_software_threads(thread_setting *saved)
+{
+    if (!saved->changed)
+        return;
+    if (saved->previous != NULL)
+        setenv("LP_NUM_THREADS", saved->previous, 1);
+    else
+        unsetenv("LP_NUM_THREADS");
+    free(saved->previous);
+    memset(saved, 0, sizeof *saved);
+}
+
+static rt_status create_display_and_context(gpu_context *context, rt_error *error);
+
 rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *error)
 {
     *out = NULL;
+    int threads = options != NULL ? options->threads : 0;
+    if (threads < 0 || threads > GPU_MAX_THREADS)
+        return rt_error_set(error, RT_ERROR_INPUT, "GPU: %d threads asked for; 1 to %d, or 0 for the default",
+                            threads, GPU_MAX_THREADS);
     gpu_context *context = calloc(1, sizeof *context);
     if (context == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory");
     context->options = options ? *options : gpu_options_defaults();
+    thread_setting saved;
+    set_software_threads(threads, &saved);
+    rt_status status = create_display_and_context(context, error);
+    restore_software_threads(&saved);
+    if (status != RT_OK) {
+        free(context);
+        return status;
+    }
+    read_gl_info(context);
+    context->info.software_threads = count_software_threads();
+    context->info.threads_ignored = threads > 0 && !context->info.software;
+    if (context->options.debug_output && epoxy_has_gl_extension("GL_KHR_debug")) {
+        glEnable(GL_DEBUG_OUTPUT);
+        glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+        glDebugMessageCallback(debug_message_callback, context);
+    }
+    *out = context;
+    return RT_OK;
+}
+
+/* The EGL half of gpu_create(): finds a device or platform and makes the context current
+ * on it (see gpu.h for the order). On failure context is left for the caller to free. */
+static rt_status create_display_and_context(gpu_context *context, rt_error *error)
+{
     context->info.device_index = -1;
 
     const char *client_extensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
@@ -252,7 +344,6 @@ rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *er
         /* options.device is N + 1 for --device N (0 means "choose"). */
         int index = context->options.device - 1;
         if (index >= device_count) {
-            free(context);
             if (device_count == 0)
                 return rt_error_set(error, RT_ERROR_INPUT, "GPU: --device %d asked for, but there are no EGL devices "
                                     "(%s)", index, platform_surfaceless
@@ -318,7 +409,6 @@ rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *er
     }
 
     if (status != RT_OK) {
-        free(context);
         if (tried[0] != '\0')
             return rt_error_set(error, RT_ERROR_RUNTIME, "%s", tried);
         if (attempt.message[0] != '\0')
@@ -328,14 +418,6 @@ rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *er
                             "surfaceless platform is missing. Install Mesa (apt-get install libegl-mesa0 "
                             "libgl1-mesa-dri) or your GPU vendor's EGL driver");
     }
-
-    read_gl_info(context);
-    if (context->options.debug_output && epoxy_has_gl_extension("GL_KHR_debug")) {
-        glEnable(GL_DEBUG_OUTPUT);
-        glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
-        glDebugMessageCallback(debug_message_callback, context);
-    }
-    *out = context;
     return RT_OK;
 }
 

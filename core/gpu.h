@@ -14,7 +14,16 @@
  * The tracer part runs the GLSL tracer (glsl/, joined as core/shader_sources.S lists it)
  * over ping-pong state textures, one bounded pass at a time (see render.h for why).
  *
- * Defaults of gpu_options (all zero): automatic device choice, no GL debug output.
+ * Defaults of gpu_options (all zero): automatic device choice, no GL debug output, the
+ * software device's own thread count (llvmpipe: LP_NUM_THREADS as the environment has it,
+ * else one thread per CPU).
+ *
+ * Threads (gpu_options.threads > 0): llvmpipe reads LP_NUM_THREADS when its screen and
+ * context are made, so gpu_create() sets it for the duration of the set-up and puts the
+ * environment back as it was afterwards. A hardware device ignores it:
+ * gpu_info.threads_ignored says so, for the caller to warn. gpu_info.software_threads is
+ * what the device really runs: the llvmpipe worker threads (named "llvmpipe-N") counted in
+ * /proc/self/task once the context exists.
  */
 #ifndef RT_GPU_H
 #define RT_GPU_H
@@ -30,7 +39,12 @@ typedef struct gpu_options {
     bool debug_output;           /* KHR_debug messages to the debug callback (--verbose) */
     void (*log)(void *log_context, const char *message);  /* where debug messages go */
     void *log_context;
+    int threads;                 /* 0: the device's default; N >= 1: CPU threads of a software
+                                  * device (llvmpipe's LP_NUM_THREADS); see "Threads" above */
 } gpu_options;
+
+/* The most threads gpu_options.threads may ask for (llvmpipe's own cap is lower). */
+#define GPU_MAX_THREADS 1024
 
 /* The EGL devices of EGL_EXT_device_enumeration are listed (at most GPU_MAX_DEVICES), in
  * EGL's order: --device N and gpu_options.device N + 1 pick devices[N]. */
@@ -62,6 +76,11 @@ typedef struct gpu_info {
     int max_color_attachments;
     int max_fragment_atomic_counters;
     bool software;               /* a CPU rasteriser (llvmpipe, softpipe) */
+    int software_threads;        /* llvmpipe rasteriser threads running for this context
+                                  * (0: rasterising in the calling thread, or not llvmpipe;
+                                  * -1: /proc/self/task cannot be read) */
+    bool threads_ignored;        /* gpu_options.threads was given but the device is not a
+                                  * software one: it changed nothing */
     /* The work bound (glsl/work.glsl). On llvmpipe, which ends all
      * loops of an invocation after 65,535 iterations together and runs simd_lanes pixels
      * as one invocation: work_cap = 65535 / (simd_lanes + 1) - 1024 (1024: what a pixel
@@ -261,6 +280,18 @@ uint64_t gpu_tracer_uploaded_bytes(const gpu_tracer *tracer);
  * the context's program cache already held its variant (frames and sweep rows after the
  * first, whose variant does not change). */
 bool gpu_tracer_compiled_program(const gpu_tracer *tracer);
+
+/* How long gpu_tracer_create() took for its parts, in seconds (0 for a part it did not
+ * need: a program from the cache, a scene already on the device). On llvmpipe the
+ * shader's machine code is made at its first draw, so compile_seconds is the GLSL
+ * compile and link only and the first pass carries the rest. */
+typedef struct gpu_tracer_timings {
+    double compile_seconds;               /* compiling and linking the tracer program */
+    double upload_seconds;                /* the packed scene into its buffer texture */
+    double state_seconds;                 /* state textures, framebuffers, resumed sums */
+} gpu_tracer_timings;
+
+void gpu_tracer_get_timings(const gpu_tracer *tracer, gpu_tracer_timings *timings);
 
 /* Frees the tracer's GL objects (not the context's program and packed scene). NULL is
  * ignored. */

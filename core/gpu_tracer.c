@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "clock.h"
 #include "gpu_internal.h"
 #include "hash.h"
 #include "shader_sources.h"
@@ -31,6 +32,7 @@ struct gpu_tracer {
     bool reused_scene;           /* the packed scene was already on the device */
     uint64_t uploaded_bytes;     /* of the packed scene, uploaded for this tracer */
     bool compiled_program;       /* its program was compiled for it (not in the cache) */
+    gpu_tracer_timings timings;
 };
 
 /* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
@@ -512,7 +514,10 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->context = context;
     tracer->width = parameters->shader.image_size[0];
     tracer->height = parameters->shader.image_size[1];
+    double step_start = clock_seconds();
     rt_status status = build_program(tracer, parameters, error);
+    tracer->timings.compile_seconds = tracer->compiled_program ? clock_seconds() - step_start : 0;
+    step_start = clock_seconds();
     bool same_size = context->packed_texture != 0 && context->packed_texel_count == texel_count;
     if (status == RT_OK && same_size && context->packed_hash == texel_hash) {
         tracer->packed_texture = context->packed_texture;
@@ -547,10 +552,14 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
             note_packed_blocks(context, packed_texels, texel_count);
         }
     }
+    if (!tracer->reused_scene)
+        tracer->timings.upload_seconds = clock_seconds() - step_start;
+    step_start = clock_seconds();
     if (status == RT_OK)
         status = create_state(tracer, error);
     if (status == RT_OK && parameters->resume != NULL)
         status = load_resume_state(tracer, parameters->resume, error);
+    tracer->timings.state_seconds = clock_seconds() - step_start;
     if (status != RT_OK) {
         gpu_tracer_destroy(tracer);
         return status;
@@ -801,6 +810,11 @@ uint64_t gpu_tracer_uploaded_bytes(const gpu_tracer *tracer)
 bool gpu_tracer_compiled_program(const gpu_tracer *tracer)
 {
     return tracer->compiled_program;
+}
+
+void gpu_tracer_get_timings(const gpu_tracer *tracer, gpu_tracer_timings *timings)
+{
+    *timings = tracer->timings;
 }
 
 void gpu_tracer_destroy(gpu_tracer *tracer)

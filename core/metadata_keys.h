@@ -24,6 +24,9 @@
  *   min_spp           int       --min-spp as used (0 without adaptive sampling); renders only
  *   render_seconds    float     the render's time (a merge: summed over its parts)
  *   merged_parts      int       only in a merge's output: how many parts it merged
+ *   options_hash      string    render_job_options_hash() as 16 hex digits: the options that
+ *                               change the pixels beyond the scene hash (render_job.h says
+ *                               which); renders and partials only. --skip-existing compares it
  *   light_groups      string    only with light group layers (--light-groups, relight): the
  *                               groups' names, comma-separated; group NAME's layer is the
  *                               channels NAME.R, NAME.G, NAME.B
@@ -50,13 +53,15 @@
 #define METADATA_KEY_NOISE_THRESHOLD "rtspheres:noise_threshold"
 #define METADATA_KEY_MIN_SPP "rtspheres:min_spp"
 #define METADATA_KEY_LIGHT_GROUPS "rtspheres:light_groups"
+#define METADATA_KEY_OPTIONS_HASH "rtspheres:options_hash"
 
 /* Every key, in the order `rtspheres stats` prints them: an initializer for an array of
  * METADATA_KEY_COUNT strings. */
-#define METADATA_KEY_COUNT 17
+#define METADATA_KEY_COUNT 18
 #define METADATA_KEYS_IN_STATS_ORDER                                                                         \
     {                                                                                                        \
-        METADATA_KEY_VERSION, METADATA_KEY_SCENE, METADATA_KEY_SCENE_HASH, METADATA_KEY_FRAME, METADATA_KEY_SPP, \
+        METADATA_KEY_VERSION, METADATA_KEY_SCENE, METADATA_KEY_SCENE_HASH, METADATA_KEY_OPTIONS_HASH,          \
+            METADATA_KEY_FRAME, METADATA_KEY_SPP,                                                             \
             METADATA_KEY_SEED, METADATA_KEY_MAX_DEPTH, METADATA_KEY_SAMPLE_START, METADATA_KEY_SAMPLES_FINISHED, \
             METADATA_KEY_PATH_SEGMENTS, METADATA_KEY_COMPLETE, METADATA_KEY_STOP_REASON,                      \
             METADATA_KEY_NOISE_THRESHOLD, METADATA_KEY_MIN_SPP, METADATA_KEY_RENDER_SECONDS,                 \

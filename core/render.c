@@ -154,6 +154,21 @@ static uint64_t scene_hash(const scene *s, const packed_scene *packed, const cam
     return hash_bytes(hash, shape, sizeof shape);
 }
 
+rt_status render_scene_hash(const scene *s, const render_options *options, uint64_t *hash, rt_error *error)
+{
+    render_options defaults = render_options_defaults();
+    camera_frame frame;
+    rt_status status = camera_frame_compute(&s->camera, s->render.width, s->render.height, &frame, error);
+    packed_scene packed;
+    if (status == RT_OK)
+        status = pack_scene(s, NULL, &packed, error);
+    if (status != RT_OK)
+        return status;
+    *hash = scene_hash(s, &packed, &frame, options != NULL ? options : &defaults);
+    packed_scene_free(&packed);
+    return RT_OK;
+}
+
 /* Reads the tracer's accumulation into a new width x height image of means (R, G, B) and
  * per-pixel finished samples; *samples receives their total. The caller frees image. */
 static rt_status read_image(gpu_tracer *tracer, int width, int height, rt_image *image, float *luminance_squares,
@@ -394,11 +409,13 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     if (status != RT_OK)
         return status;
     packed_scene packed;
+    double pack_start = clock_seconds();
     pack_options pack = pack_options_defaults();
     pack.bvh_cache = options->bvh_cache;
     status = pack_scene(s, &pack, &packed, error);
     if (status != RT_OK)
         return status;
+    result->pack_seconds = clock_seconds() - pack_start;
     result->bvh_built = packed.bvh_built;
     result->bvh_reused = packed.bvh_reused;
     result->bvh_depth = packed.bvh_depth;
@@ -649,8 +666,15 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
         }
         if (status == RT_OK && report.unfinished_pixels == 0) {
             done = true;
-            if (adaptive.sampler != NULL)
+            if (adaptive.sampler != NULL) {
                 status = check_adaptive(tracer, &adaptive, &done, error);
+                adaptive_noise noise;
+                adaptive_get_noise(adaptive.sampler, &noise);
+                progress->noise_checks = noise.checks;
+                progress->noisy_pixels = noise.unconverged_pixels;
+                progress->going_pixels = noise.going_pixels;
+                progress->noise_error = noise.mean_error;
+            }
             if (done && adaptive.sampler != NULL && adaptive_stopped_early(adaptive.sampler))
                 *stop = RENDER_STOP_NOISE;
             continue;
@@ -743,11 +767,17 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     result->reused_scene = gpu_tracer_reused_scene(tracer);
     result->uploaded_bytes = gpu_tracer_uploaded_bytes(tracer);
     result->compiled_program = gpu_tracer_compiled_program(tracer);
+    gpu_tracer_timings timings;
+    gpu_tracer_get_timings(tracer, &timings);
+    result->compile_seconds = timings.compile_seconds;
+    result->upload_seconds = timings.upload_seconds;
     int traced_width = traced[2] - traced[0], traced_height = traced[3] - traced[1];
 
     render_progress progress = {
         .samples_total = (uint64_t)traced_width * traced_height * s->render.samples_per_pixel,
         .samples_done = samples_resumed,
+        .pixel_count = traced_width * traced_height,
+        .noise_threshold = options->noise_threshold,
     };
     render_stop_reason stop = RENDER_STOP_SAMPLES;
     status = run_passes(context, tracer, options, (uint32_t)s->render.samples_per_pixel, traced, region, budget,

@@ -64,6 +64,13 @@ typedef struct render_progress {
     uint64_t samples_total;
     double elapsed_seconds;
     int passes;
+    /* With a noise threshold, after the first check (noise_checks > 0; core/adaptive.h):
+     * of the pixel_count pixels traced, those whose error was still at or above
+     * noise_threshold, those still taking samples, and the mean error of those checked. */
+    int noise_checks;
+    int pixel_count;
+    int noisy_pixels, going_pixels;
+    float noise_error, noise_threshold;
 } render_progress;
 
 /* Why the passes ended. */
@@ -148,6 +155,10 @@ typedef struct render_result {
     double steady_seconds;       /* the passes after the first (set-up and compile done) */
     uint64_t steady_samples;     /* samples those passes finished: their ratio is the
                                   * cost of a sample, whatever the set-up cost */
+    double pack_seconds;         /* pack_scene(): collecting, BVH builds (bvh_build_seconds
+                                  * of it) and packing, on the CPU */
+    double compile_seconds;      /* the tracer program's compile and link (0: cached) */
+    double upload_seconds;       /* the packed scene to the device (0: already there) */
     double path_segments;        /* rays traced, counted by the shader */
     int passes;
     render_stop_reason stop_reason;
@@ -171,6 +182,13 @@ typedef struct render_result {
 
 /* Returns options with every field at its default (all zero). */
 render_options render_options_defaults(void);
+
+/* Computes the scene hash render_scene() would give s with options (render_result.
+ * scene_hash) into *hash without a GPU: frames the camera and packs the scene on the CPU
+ * (BVH builds included), then frees the packing. For telling whether an existing file was
+ * rendered from this scene (--skip-existing). Errors: those of camera framing and
+ * pack_scene(). */
+rt_status render_scene_hash(const scene *s, const render_options *options, uint64_t *hash, rt_error *error);
 
 /* Renders s with the scene's render settings on context. options may be NULL. On RT_OK
  * and on RT_ERROR_INTERRUPTED, result->image holds the image (the caller frees it with

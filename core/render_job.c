@@ -23,6 +23,7 @@ typedef struct job_run {
     render_job_callbacks callbacks;      /* the caller's, or all NULL */
     render_job_failure failure;          /* where the run stopped short */
     bool image_begun;                    /* an image has begun (its limit counted from then) */
+    int images_skipped;                  /* skip_existing found them complete */
     int sweep_row;                       /* the sweep row being rendered, -1: none */
     pack_bvh_cache *bvh_cache;           /* with several images: their BVHs carried over */
 } job_run;
@@ -95,8 +96,9 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
     placed.y = result->region[1];
     placed.full_width = settings->width;
     placed.full_height = settings->height;
-    char hash[24];
+    char hash[24], options_hash[24];
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)result->scene_hash);
+    snprintf(options_hash, sizeof options_hash, "%016llx", (unsigned long long)image->plan.options_hash);
     /* The layers' names, with the output (also one a time limit ended; the partial file
      * keeps no layers). */
     bool layers = job->light_groups && strcmp(path, image->plan.output) == 0;
@@ -107,6 +109,7 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
     render_output_metadata metadata = {
         .scene = job->scene_path,
         .scene_hash = hash,
+        .options_hash = options_hash,
         .spp = settings->samples_per_pixel,
         .sample_start = image->plan.sample_start,
         .seed = settings->seed,
@@ -327,15 +330,19 @@ static void image_render_options(job_image *image, render_options *options)
     }
 }
 
-/* Renders the scene of image (loaded and planned) and finishes it. */
-static rt_status render_image(job_image *image, rt_error *error)
+/* Renders the scene of image (loaded and planned) and finishes it, continuing resume_image
+ * (with its scene hash) when it has pixels, else job->resume_path when set. Frees
+ * resume_image. */
+static rt_status render_image(job_image *image, rt_image resume_image, uint64_t resume_scene_hash, rt_error *error)
 {
     job_run *run = image->run;
     const render_job *job = run->job;
     render_options options;
     image_render_options(image, &options);
-    rt_image resume_image = {0};
-    if (job->resume_path != NULL) {
+    if (resume_image.pixels != NULL) {
+        options.resume = &resume_image;
+        options.resume_scene_hash = resume_scene_hash;
+    } else if (job->resume_path != NULL) {
         render_output_resume_check check = {.seed = image->scene.render.seed,
                                             .sample_start = image->plan.sample_start,
                                             .spp = image->scene.render.samples_per_pixel};
@@ -388,10 +395,22 @@ static rt_status run_image(job_run *run, int frame, const char *output, rt_error
     image->plan.output = output;
     render_output_partial_path(output, image->plan.partial, sizeof image->plan.partial);
     status = render_job_plan_image(job, &run->plan, &s->render, frame, &image->plan, error);
+    image->plan.sweep_row = run->sweep_row;
+    render_job_existing existing = {0};
+    rt_image resume = {0};
+    uint64_t resume_scene_hash = 0;
     if (status == RT_OK) {
         s->render.samples_per_pixel = image->plan.samples_per_pixel;
-        status = render_image(image, error);
+        image->plan.options_hash = render_job_options_hash(job, &image->plan, &s->render);
+        if (job->skip_existing)
+            status = render_job_examine_existing(job, &image->plan, s, &existing, &resume, &resume_scene_hash, error);
     }
+    if (status == RT_OK && existing.kind != RENDER_JOB_EXISTING_NONE && run->callbacks.existing_output != NULL)
+        run->callbacks.existing_output(run->callbacks.user, &image->plan, &existing);
+    if (status == RT_OK && existing.kind == RENDER_JOB_EXISTING_SKIP)
+        run->images_skipped++;
+    else if (status == RT_OK)
+        status = render_image(image, resume, resume_scene_hash, error);
     if (status == RT_OK)
         run->failure = RENDER_JOB_FAILURE_NONE;
     scene_free(s);
@@ -492,6 +511,7 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
     }
     pack_bvh_cache_free(run.bvh_cache);
     summary->seconds = clock_seconds() - start;
+    summary->images_skipped = run.images_skipped;
     summary->failure = status == RT_OK ? RENDER_JOB_FAILURE_NONE : run.failure;
     return status;
 }

@@ -63,6 +63,8 @@
  *                           cache, pack.h, for all of them).
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
+ *   skip_existing           false: render every image; true: before each image, look at
+ *                           what its output and partial file hold (see "Existing outputs")
  *   sweep                   NULL: none; else a sweep table (sweep.h): one image per row,
  *                           each row's values as defines after the job's, the output
  *                           pattern formatted per row (sweep_output_name); rows shard
@@ -85,6 +87,15 @@
  * (never over the output) as a checkpoint does: the raw means and sample counts, not
  * post-processed, since --resume adds samples to them; then it ends the job. One between
  * frames ends it before the next frame. The first failing image ends the job.
+ *
+ * ## Existing outputs (skip_existing)
+ * Each image, once its scene is loaded and planned, is looked at as
+ * render_job_examine_existing() says: an output that is complete (rtspheres:complete 1)
+ * with this image's scene hash and options hash (render_job_options_hash()) is skipped
+ * (nothing written, its partial file left alone); else a partial file of this image's
+ * scene and options is resumed, or an incomplete output of them (--time-limit wrote it)
+ * when it is a raw EXR; anything else is rendered afresh. The callback existing_output
+ * says which and why, for every image whose output or partial file exists.
  *
  * Messages name the job's fields by the render command's options (--crop, --shard, ...),
  * the words a user sets them in, and carry no module tag: the command prints them after
@@ -151,6 +162,7 @@ typedef struct render_job {
     render_options tracer;
     const volatile sig_atomic_t *stop_requested;
     const sweep_table *sweep;
+    bool skip_existing;
 } render_job;
 
 /* What render_job_check() found: the first output name and the shard resolved. */
@@ -173,7 +185,23 @@ typedef struct render_job_image {
     int samples_per_pixel;
     int region[4];               /* render_options.region: all zero for the whole image */
     int window[4];               /* the pixels it covers: region, or the whole image */
+    uint64_t options_hash;       /* render_job_options_hash() of the image */
+    int sweep_row;               /* -1: the job has no sweep */
 } render_job_image;
+
+/* What skip_existing decided for an image (render_job_examine_existing()). */
+typedef enum render_job_existing_kind {
+    RENDER_JOB_EXISTING_NONE = 0,    /* neither output nor partial file is there: render */
+    RENDER_JOB_EXISTING_SKIP,        /* the output is complete, of this scene and options */
+    RENDER_JOB_EXISTING_RESUME,      /* continue the file named in the decision */
+    RENDER_JOB_EXISTING_RENDER,      /* something is there but will not do: render afresh */
+} render_job_existing_kind;
+
+typedef struct render_job_existing {
+    render_job_existing_kind kind;
+    char resume_path[RENDER_JOB_PATH_MAX];   /* RESUME: the partial file or the output */
+    char reason[1024];                       /* one sentence: what is there and why this */
+} render_job_existing;
 
 /* How far each frame's scene variables need room: $frame's and $time's values. */
 typedef struct render_job_frame_values {
@@ -194,6 +222,9 @@ typedef struct render_job_callbacks {
     void (*render_finished)(void *user, const render_job_image *image, rt_status status);
     /* A checkpoint wrote samples (over all pixels) to image->partial. */
     void (*checkpoint_written)(void *user, const render_job_image *image, uint64_t samples);
+    /* skip_existing looked at the image's files (decision->kind is not NONE): a skip (no
+     * other callback follows for the image), a resume or a render afresh, and why. */
+    void (*existing_output)(void *user, const render_job_image *image, const render_job_existing *decision);
     /* The complete image is written to image->output; result is render_scene()'s. */
     void (*image_written)(void *user, const render_job_image *image, const render_result *result);
 } render_job_callbacks;
@@ -214,6 +245,7 @@ typedef enum render_job_failure {
 typedef struct render_job_summary {
     int images_started;          /* images the job went on to (loading their scene), the
                                   * last of which may have failed */
+    int images_skipped;          /* of those, skipped as complete (skip_existing) */
     double seconds;              /* from the first image's start to the last one's end */
     render_job_failure failure;
 } render_job_summary;
@@ -229,8 +261,9 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * with the first rule broken, in this order: a define of frame or time with frames; the
  * first output name (batch.h's errors; several frames and no frame number in the
  * pattern); its format; its directory; the scene file as output; crop with tile; aovs
- * without EXR; variance without EXR; variance with resume; resume with several frames;
- * shard_by without shard; a shard by frames without frames, or with no frame; light groups
+ * without EXR; variance without EXR; variance with resume; skip_existing with resume;
+ * resume with several frames; shard_by without shard; a shard by frames without frames,
+ * or with no frame; light groups
  * (see the job); a shard by samples with a sample range; a shard by tiles with crop or
  * tile; a samples map with several frames or of an unknown
  * format; a minimum spp without a noise threshold; a noise threshold with a shard by samples,
@@ -263,6 +296,28 @@ void render_job_apply_overrides(const render_job *job, scene_render_settings *se
 rt_status render_job_plan_image(const render_job *job, const render_job_plan *plan,
                                 const scene_render_settings *settings, int frame, render_job_image *image,
                                 rt_error *error);
+
+/* Returns the options hash of image (planned from settings, the scene's after
+ * render_job_apply_overrides()): FNV-1a over what changes its pixels or layers beyond the
+ * scene hash (render.h scene_hash: packed scene, camera, sky, size, depth, integrator,
+ * sampler, light sampling): size, depth, seed, the image's samples (first index and
+ * count), its region (crop, tile, shard by tiles), Russian roulette depth, noise threshold
+ * and min spp, AOVs, light groups, variance, denoise, blur, tone mapping and exposure.
+ * Not: frames/sweep/shard lists, time limit, checkpoints, the pass budget, --full-tracer,
+ * the device, threads, progress, statistics or the display, which change no pixel. */
+uint64_t render_job_options_hash(const render_job *job, const render_job_image *image,
+                                 const scene_render_settings *settings);
+
+/* Looks at what image's output and partial file hold (see "Existing outputs" above) for a
+ * render from s (loaded, planned; the hashes are computed from it as render_scene() would,
+ * packing it on the CPU only when a file is there to compare), and fills *decision. With
+ * RENDER_JOB_EXISTING_RESUME, *resume (else empty) holds the file's pixels and
+ * *resume_scene_hash its hash, as render_options.resume takes them; free it with
+ * image_free(). Errors: only those of packing the scene (a file that cannot be read is a
+ * reason to render afresh, not an error). In render_job_existing.c. */
+rt_status render_job_examine_existing(const render_job *job, const render_job_image *image, const scene *s,
+                                      render_job_existing *decision, rt_image *resume, uint64_t *resume_scene_hash,
+                                      rt_error *error);
 
 /* Plans job (render_job_check(), so the caller need not) and renders its images on
  * context (see "Running" above), telling callbacks (may be NULL) what happens. Returns

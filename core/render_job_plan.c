@@ -215,6 +215,9 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--variance needs the squares of every sample, which a partial file does not keep; "
                             "render without --resume");
+    if (job->skip_existing && job->resume_path != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "--skip-existing finds and resumes each image's partial file itself; not with --resume");
     if (job->resume_path != NULL && job->frame_count > 1)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--resume continues one image; render the frames one at a time");

@@ -65,9 +65,12 @@ rt_status render_output_write(const char *path, const rt_image *image, const rt_
         {.name = METADATA_KEY_PATH_SEGMENTS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = segments_text},
         {.name = METADATA_KEY_COMPLETE, .type = IMAGE_ATTRIBUTE_INT, .int_value = metadata->complete},
         {.name = METADATA_KEY_RENDER_SECONDS, .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = metadata->render_seconds},
-        {0}, {0}, {0}, {0}, {0},   /* the optional keys, added below when they apply */
+        {0}, {0}, {0}, {0}, {0}, {0},   /* the optional keys, added below when they apply */
     };
-    int count = (int)(sizeof attributes / sizeof attributes[0]) - 5;
+    int count = (int)(sizeof attributes / sizeof attributes[0]) - 6;
+    if (metadata->options_hash != NULL)
+        attributes[count++] = (image_attribute){.name = METADATA_KEY_OPTIONS_HASH, .type = IMAGE_ATTRIBUTE_STRING,
+                                                .string_value = metadata->options_hash};
     if (metadata->stop_reason != NULL) {   /* a render's keys (not a merge's) */
         attributes[count++] = (image_attribute){.name = METADATA_KEY_STOP_REASON, .type = IMAGE_ATTRIBUTE_STRING,
                                                 .string_value = metadata->stop_reason};

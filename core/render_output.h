@@ -25,6 +25,7 @@
 typedef struct render_output_metadata {
     const char *scene;                   /* the scene file's path */
     const char *scene_hash;              /* 16 hex digits */
+    const char *options_hash;            /* 16 hex digits, or NULL: no such key (a merge) */
     long long spp;
     unsigned long long sample_start;
     unsigned long long seed;

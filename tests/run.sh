@@ -12,6 +12,11 @@
 # A passing test prints one line, "ok   NAME (N checks, T s)"; V=1 prints its whole output
 # before that line. A failing test prints its whole output, then "FAIL NAME (why)".
 #
+# Tests run TEST_JOBS at a time (environment; default the number of cores, `nproc`): most
+# of a test's time is single-threaded (process start-up, shader compiles, image files,
+# the fuzz build), so a second test fills the core the first leaves idle. Their lines
+# come out in the list's order whatever order they end in; TEST_JOBS=1 runs one at a time.
+#
 # Each test has a time-out: RTSPHERES_TEST_TIMEOUT seconds when set, else 120 s for a unit
 # binary and 600 s for a render script (four times that in a sanitizer run, which is
 # several times slower). A test that runs out of time is sent SIGTERM, then SIGKILL 5 s
@@ -70,10 +75,17 @@ end_session() {
     [ -z "$left" ] || kill -KILL $left 2>/dev/null
 }
 
-# An interrupted run (Ctrl-C, a job killed) ends the test in flight too: it runs in a
+# An interrupted run (Ctrl-C, a job killed) ends the tests in flight too: each runs in a
 # session of its own, so the terminal's signals do not reach it.
-trap 'echo "tests/run.sh: interrupted${session:+ during $name, which was ended}" >&2
-[ -z "$session" ] || end_session "$session"; rm -rf "$scratch"; exit 130' INT TERM HUP
+trap 'ended=""; sessions=""
+for file in "$scratch"/*.log.session; do
+    [ -f "$file" ] || continue
+    test_name=$(basename "$file" .log.session); ended="${ended:+$ended, }$test_name"
+    sessions="$sessions $(cat "$file")"
+done
+case $ended in *,*) ended=" during $ended, which were ended" ;; ?*) ended=" during $ended, which was ended" ;; esac
+echo "tests/run.sh: interrupted$ended" >&2
+for sid in $sessions; do end_session "$sid"; done; rm -rf "$scratch"; exit 130' INT TERM HUP
 trap 'rm -rf "$scratch"' EXIT
 
 # run_test SECONDS LOG COMMAND...: runs COMMAND as a test (see the top) with its output in
@@ -87,6 +99,7 @@ run_test() {
     # setsid does not fork: $! is the session (and process group) of the test.
     setsid timeout -k 5 "$limit" "$@" </dev/null >"$log" 2>&1 &
     session=$!
+    echo "$session" >"$log.session"
     wait "$session"
     status=$?
     seconds=$(($(date +%s) - start))
@@ -94,6 +107,7 @@ run_test() {
     [ "$status" != 137 ] || [ "$seconds" -lt "$limit" ] || status=124
     stray=$(session_processes "$session" | wc -l | tr -d ' ')
     end_session "$session"
+    rm -f "$log.session"
     session=""
 }
 
@@ -156,7 +170,18 @@ else
     done
 fi
 
-while read -r kind name; do
+jobs=${TEST_JOBS:-$(nproc 2>/dev/null || echo 1)}
+case $jobs in
+'' | *[!0-9]* | 0*)
+    echo "tests/run.sh: TEST_JOBS wants a whole number of tests at a time, found '$jobs'" >&2
+    exit 2
+    ;;
+esac
+
+# run_one KIND NAME: runs one test (in the background: see start) and leaves what report
+# needs in $scratch/NAME.result: status, seconds, stray, passes, failures, skips.
+run_one() {
+    kind=$1 name=$2
     log="$scratch/$name.log"
     if [ "$kind" = unit ]; then
         # Unit tests make their scratch directories under TMPDIR: here, so that a test
@@ -169,13 +194,44 @@ while read -r kind name; do
     else
         mkdir -p "$scratch/$name"
         run_test "$render_seconds" "$log" sh "$render_dir/$name.sh" "$program" "$scratch/$name"
-        grep '^SKIP ' "$log" | sed "s/^SKIP /  $name: /" >>"$scratch/skipped"
+        grep '^SKIP ' "$log" | sed "s/^SKIP /  $name: /" >"$scratch/$name.skipped"
         n_pass=$(grep -c '^PASS ' "$log")
         n_fail=$(grep -c '^FAIL ' "$log")
         n_skip=$(grep -c '^SKIP ' "$log")
     fi
+    # Written whole, then renamed: the main loop takes the file as the sign it is done.
+    echo "$status $seconds $stray $n_pass $n_fail $n_skip $limit" >"$scratch/$name.result.tmp"
+    mv "$scratch/$name.result.tmp" "$scratch/$name.result"
+}
+
+# The tests in order, one "KIND NAME" line each. started counts the tests begun, reported
+# those printed (always the first ones of the list, so the lines keep the list's order),
+# finished those done but not yet printed (their .result files): a test that ends ahead
+# of the next one to print frees its slot at once.
+total=$(wc -l <"$scratch/chosen" | tr -d ' ')
+started=0
+reported=0
+while [ "$reported" -lt "$total" ]; do
+    finished=$(find "$scratch" -maxdepth 1 -name '*.result' | wc -l)
+    while [ "$started" -lt "$total" ] && [ $((started - reported - finished)) -lt "$jobs" ]; do
+        started=$((started + 1))
+        # shellcheck disable=SC2046 # the line is "KIND NAME"
+        (run_one $(sed -n "${started}p" "$scratch/chosen")) &
+    done
+    name=$(sed -n "$((reported + 1))p" "$scratch/chosen" | cut -d' ' -f2)
+    if [ ! -f "$scratch/$name.result" ]; then
+        # POSIX sh has no `wait -n`: look again shortly.
+        sleep 0.2
+        continue
+    fi
+    read -r status seconds stray n_pass n_fail n_skip limit <"$scratch/$name.result"
+    rm -f "$scratch/$name.result"
+    log="$scratch/$name.log"
+    [ ! -f "$scratch/$name.skipped" ] || cat "$scratch/$name.skipped" >>"$scratch/skipped"
     report "$name" "$n_pass" "$n_fail" "$n_skip"
-done <"$scratch/chosen"
+    reported=$((reported + 1))
+done
+wait
 
 # The sanitizer run (make test SAN=1) has the sanitizers write every report to a file in
 # $RTSPHERES_SANITIZER_REPORTS: each one fails the run, even when the test that ran the

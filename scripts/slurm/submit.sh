@@ -17,6 +17,12 @@
 #                  the merge job then waits for them and merges all N parts
 #   RENDER OPTIONS passed to every `rtspheres render`, e.g. -- --spp 1024 --size 1920x1080
 #
+# An animation: with --frames among the render options, OUTPUT is a directory; the tasks
+# render their shares of the frames (--shard-by frames) to OUTPUT/frame-NNNN.exr, their logs go
+# to OUTPUT/logs/, no merge job is submitted and merge_job= is printed empty. Submitting
+# the same command again (or requeueing a task: scontrol requeue JOBID_TASK) renders only
+# the frames that are not complete: the tasks run with --skip-existing.
+#
 # Environment: RTSPHERES, the rtspheres program the jobs run (default: `rtspheres` on
 # PATH, else the one built in this checkout); SLURM_CONF and the SBATCH_* variables of
 # sbatch work as usual (e.g. SBATCH_ACCOUNT, SBATCH_TIMELIMIT).
@@ -66,8 +72,16 @@ case $shards in
 '' | *[!0-9]* | 0) echo "submit.sh: --shards wants a whole number of at least 1" >&2; usage ;;
 esac
 [ -f "$scene" ] || { echo "submit.sh: no scene file '$scene'" >&2; exit 2; }
-case $output in
-*.exr) ;;
+frames=no
+for option in "$@"; do
+    case $option in
+    --frames | --frames=*) frames=yes ;;
+    esac
+done
+case $frames/$output in
+yes/*.exr) echo "submit.sh: with --frames the output is a directory for the frames, not '$output'" >&2; exit 2 ;;
+yes/*) ;;
+*/*.exr) ;;
 *) echo "submit.sh: the output should be .exr (it keeps the samples channel and metadata)" >&2; exit 2 ;;
 esac
 
@@ -86,6 +100,10 @@ RTSPHERES=$(absolute "$RTSPHERES")
 export RTSPHERES
 scene=$(absolute "$scene")
 output=$(absolute "$output")
+if [ "$frames" = yes ]; then
+    [ -z "$part_dir" ] || { echo "submit.sh: --parts does not go with --frames (the frames go to OUTPUT)" >&2; exit 2; }
+    part_dir=$output
+fi
 [ -n "$part_dir" ] || part_dir=${output%.exr}.parts
 part_dir=$(absolute "$part_dir")
 mkdir -p "$part_dir/logs"
@@ -102,6 +120,12 @@ render_job=$(sbatch --parsable $partition_option --array="$array" \
     exit 1
 }
 render_job=${render_job%%;*}
+if [ "$frames" = yes ]; then
+    echo "render_job=$render_job"
+    echo "merge_job="
+    echo "submit.sh: render array $render_job (tasks $array of $shards) -> frames in $part_dir; nothing to merge" >&2
+    exit 0
+fi
 merge_job=$(sbatch --parsable $partition_option --dependency="afterok:$render_job" --kill-on-invalid-dep=yes \
     --output="$part_dir/logs/merge-%j.log" \
     "$here/merge.sbatch" "$output" "$part_dir" "$shards") || {

@@ -3,7 +3,7 @@
 # directory (so the real run never finds them, and the copy of run.sh there runs only
 # them): the counts of the Total line, one line for a passing test and the whole output
 # of a failing one, V=1, the SKIP list, running tests by name, an unknown name, a crashed
-# unit binary, a bad RTSPHERES_TEST_TIMEOUT, and the time-out and a stopped run, which
+# unit binary, a bad RTSPHERES_TEST_TIMEOUT, tests at once (TEST_JOBS), and the time-out and a stopped run, which
 # must leave no process of the test behind.
 #   usage: sh tests/render/test-runner.sh PROGRAM SCRATCH_DIR
 # PROGRAM is not used: the fake tests render nothing.
@@ -142,6 +142,50 @@ if [ "$code" = 2 ] && grep -qF "there is no test named 'test-nonesuch'" "$unknow
    grep -qx '  test_unit_ok' "$unknown" && ! grep -q '^ok ' "$unknown"; then
     pass "an unknown name is an error that lists the tests, and nothing runs"
 else fail "an unknown name is an error" "exit $code: $(tr '\n' '|' <"$unknown" | head -c 600)"; fi
+
+# --- tests at once (TEST_JOBS): two fake tests that each wait for the other to start pass
+# only when both run together; the first ends after the second, yet prints first.
+together=$scratch/together
+rm -rf "$together"
+mkdir -p "$together/tests/render" "$together/build/tests"
+cp "$(dirname "$0")/../run.sh" "$together/tests/run.sh"
+# meet SELF OTHER DELAY: a fake test that marks itself started, waits up to 5 s for OTHER,
+# then sleeps DELAY seconds before its verdict.
+meet() {
+    printf '#!/bin/sh
+d=$(dirname "$0")
+: >"$d/%s.started"
+i=0
+while [ ! -f "$d/%s.started" ] && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1)); done
+sleep %s
+if [ -f "$d/%s.started" ]; then echo "PASS %s met %s"; else echo "FAIL %s: %s never started"; fi
+' \
+        "$1" "$2" "$3" "$2" "$1" "$2" "$1" "$2" >"$together/tests/render/test-$1.sh"
+}
+meet a b 1
+meet b a 0
+# run_together OUTPUT JOBS: the tree's run.sh with TEST_JOBS=JOBS; prints its exit status.
+run_together() {
+    rm -f "$together"/tests/render/*.started
+    (cd "$together" && unset RTSPHERES_SANITIZER_REPORTS V &&
+        TEST_JOBS=$2 RTSPHERES_TEST_TIMEOUT=20 sh tests/run.sh build fake-program >"$1" 2>&1)
+    echo $?
+}
+code=$(run_together "$scratch/jobs2.out" 2)
+if [ "$code" = 0 ] && grep -qx "Total: 2 passed, 0 failed, 0 skipped" "$scratch/jobs2.out"; then
+    pass "TEST_JOBS=2 runs two tests at once"
+else fail "TEST_JOBS=2 runs two tests at once" "exit $code: $(tr '\n' '|' <"$scratch/jobs2.out" | head -c 600)"; fi
+if [ "$(grep -o '^ok   test-[ab]' "$scratch/jobs2.out" | tr '\n' ' ')" = "ok   test-a ok   test-b " ]; then
+    pass "lines keep the list's order when a later test ends first"
+else fail "lines keep the list's order" "$(tr '\n' '|' <"$scratch/jobs2.out" | head -c 600)"; fi
+code=$(run_together "$scratch/jobs1.out" 1)
+if [ "$code" = 1 ] && grep -qF "FAIL a: b never started" "$scratch/jobs1.out"; then
+    pass "TEST_JOBS=1 runs one test at a time"
+else fail "TEST_JOBS=1 runs one test at a time" "exit $code: $(tr '\n' '|' <"$scratch/jobs1.out" | head -c 600)"; fi
+if (cd "$tree" && TEST_JOBS=two sh tests/run.sh build fake-program test-pass >"$scratch/badjobs.out" 2>&1); then
+    fail "TEST_JOBS=two is refused" "it ran: $(cat "$scratch/badjobs.out")"
+else has "TEST_JOBS=two is refused" "$scratch/badjobs.out" \
+    "tests/run.sh: TEST_JOBS wants a whole number of tests at a time, found 'two'"; fi
 
 if (cd "$tree" && RTSPHERES_TEST_TIMEOUT=10s sh tests/run.sh build fake-program test-pass >"$scratch/bad.out" 2>&1); then
     fail "RTSPHERES_TEST_TIMEOUT=10s is refused" "it ran: $(cat "$scratch/bad.out")"

@@ -11,7 +11,9 @@
 # 3. Submits a job array of rtspheres shards plus the dependent merge with submit.sh and
 #    compares the merged image with a single-machine render (diff --fail 1e-5); then
 #    makes one shard fail and checks the failure is visible and the merge never runs;
-#    then renders only that shard again (submit.sh --array) and checks the merge.
+#    then renders only that shard again (submit.sh --array) and checks the merge; the job
+#    logs show progress lines; an animation by frames, one of whose tasks is requeued and
+#    skips the frames it had finished.
 # 4. Stops the daemons it started, by their PIDs (TERM, then KILL after a deadline), and
 #    removes the temporary directory, also when interrupted.
 #
@@ -347,7 +349,7 @@ fi
 name=slurm-array-merge
 array_start=$(now)
 merged=$tmp/out/merged.exr
-if submit_jobs "$name" "$scene" "$merged" --shards 8 -- $render_options; then
+if submit_jobs "$name" "$scene" "$merged" --shards 8 -- $render_options --progress-interval 0; then
     if ! wait_jobs 90 "$render_job" "$merge_job"; then
         fail "$name" "jobs not done after 90 s: $(job_states "$render_job" | tr '\n' ' ') merge: $(job_states "$merge_job")"
     elif [ "$(job_states "$render_job" | grep -c ' COMPLETED 0:0$')" != 8 ]; then
@@ -359,6 +361,15 @@ if submit_jobs "$name" "$scene" "$merged" --shards 8 -- $render_options; then
     else
         pass "$name"
         echo "test-slurm: 8-task array + merge done in $(elapsed "$array_start") s"
+    fi
+    # The job logs show progress lines (render-array.sbatch renders with --progress lines;
+    # --progress-interval 0 makes one per pass of these tiny parts), never a carriage return.
+    log=$tmp/out/merged.parts/logs/render-${render_job}_3.log
+    if grep -q "^rtspheres: progress [0-9.]*%, [0-9]* of [0-9]* samples, .* elapsed, ETA" "$log" 2>/dev/null &&
+       [ "$(tr -cd '\r' <"$log" | wc -c)" = 0 ]; then
+        pass "slurm-logs-show-progress"
+    else
+        fail "slurm-logs-show-progress" "$log: $(head -c 400 "$log" 2>/dev/null | tr '\n' ' ')"
     fi
 fi
 
@@ -409,6 +420,55 @@ if submit_jobs "$name" "$scene" "$merged" --shards 4 --array 2 -- $render_option
     else
         pass "$name"
         echo "test-slurm: re-run of one shard + merge done in $(elapsed "$rerun_start") s"
+    fi
+fi
+
+# release_requeued JOBID_TASK: slurmctld holds a requeued job back (BeginTime, for its
+# epilog); on this idle test cluster let it start at once.
+release_requeued() {
+    timeout 10 scontrol update "JobId=$1" StartTime=now >/dev/null 2>&1 || true
+}
+
+# (d) An animation by frames (submit.sh with --frames: no merge): 2 tasks render frames
+# 0-3; then task 0 is requeued (as Slurm does after a node failure or preemption): it
+# skips its finished frames 0 and 2 (--skip-existing), says so in its log, and leaves
+# them as they were.
+name=slurm-requeued-task-skips-finished-frames
+frames_dir=$tmp/out/frames
+render_job=""
+if ! "$submit" "$scene" "$frames_dir" --shards 2 -- $render_options --frames 0-3 >"$tmp/submit.out" 2>"$tmp/submit.err"; then
+    fail "$name" "submit.sh failed: $(tr '\n' ' ' <"$tmp/submit.err")"
+else
+    eval "$(grep -E '^render_job=[0-9]+$' "$tmp/submit.out")"
+    if [ -z "$render_job" ] || ! grep -qx "merge_job=" "$tmp/submit.out"; then
+        fail "$name" "submit.sh printed: $(tr '\n' ' ' <"$tmp/submit.out")"
+    elif ! wait_jobs 90 "$render_job"; then
+        fail "$name" "frames not done after 90 s: $(job_states "$render_job" | tr '\n' ' ')"
+    elif [ "$(job_states "$render_job" | grep -c ' COMPLETED 0:0$')" != 2 ] ||
+         ! ls "$frames_dir"/frame-0000.exr "$frames_dir"/frame-0001.exr "$frames_dir"/frame-0002.exr \
+             "$frames_dir"/frame-0003.exr >/dev/null 2>&1; then
+        fail "$name" "tasks: $(job_states "$render_job" | tr '\n' ' '); frames: $(ls "$frames_dir" | tr '\n' ' ')"
+    else
+        cksum "$frames_dir"/frame-0000.exr "$frames_dir"/frame-0002.exr >"$tmp/frames.before"
+        log=$frames_dir/logs/render-${render_job}_0.log
+        if ! timeout 10 scontrol requeue "${render_job}_0" >"$tmp/requeue.out" 2>&1; then
+            fail "$name" "scontrol requeue ${render_job}_0 failed: $(tr '\n' ' ' <"$tmp/requeue.out")"
+        elif ! release_requeued "${render_job}_0" || ! wait_jobs 90 "$render_job"; then
+            fail "$name" "requeued task not done after 90 s: $(job_states "$render_job" | tr '\n' ' ')"
+        else
+            cksum "$frames_dir"/frame-0000.exr "$frames_dir"/frame-0002.exr >"$tmp/frames.after"
+            if ! job_states "$render_job" | grep -q '^0 COMPLETED 0:0$'; then
+                fail "$name" "requeued task 0: $(job_states "$render_job" | tr '\n' ' ')"
+            elif ! grep -q "^rtspheres: frame 0: skipped: .*frame-0000.exr is complete" "$log" ||
+                 ! grep -q "^rtspheres: frame 2: skipped: .*frame-0002.exr is complete" "$log"; then
+                fail "$name" "the requeued task's log does not say it skipped frames 0 and 2: $(tr '\n' ' ' <"$log" | head -c 600)"
+            elif ! cmp -s "$tmp/frames.before" "$tmp/frames.after"; then
+                fail "$name" "the requeued task rewrote its finished frames"
+            else
+                pass "$name"
+                echo "test-slurm: requeued task 0: $(grep -c ': skipped: ' "$log") frames skipped"
+            fi
+        fi
     fi
 fi
 

@@ -108,6 +108,62 @@ static void image_refused(const render_job *job, const scene_render_settings *se
     assert_string_equal(error.message, message);
 }
 
+/* The options hash (--skip-existing) of job's one image planned from settings. */
+static uint64_t options_hash_of(const render_job *job, const scene_render_settings *settings)
+{
+    render_job_image image;
+    assert_int_equal(plan_one(job, settings, -1, &image, NULL), RT_OK);
+    return render_job_options_hash(job, &image, settings);
+}
+
+/* The options that change pixels change the hash; those that do not (time limit,
+ * checkpoints, pass budget, the full tracer, skip_existing itself) leave it alone. */
+static void options_hash(void **state)
+{
+    (void)state;
+    render_job base = job_for("hash.exr");
+    uint64_t hash = options_hash_of(&base, &scene_settings);
+    assert_true(hash == options_hash_of(&base, &scene_settings));
+    scene_render_settings other = scene_settings;
+    other.samples_per_pixel = 11;
+    assert_true(hash != options_hash_of(&base, &other));
+    other = scene_settings;
+    other.seed = 2;
+    assert_true(hash != options_hash_of(&base, &other));
+    other = scene_settings;
+    other.width = 41;
+    assert_true(hash != options_hash_of(&base, &other));
+    render_job changed = base;
+    changed.crop[2] = 20, changed.crop[3] = 10;
+    assert_true(hash != options_hash_of(&changed, &scene_settings));
+    changed = base;
+    changed.sample_start = 2, changed.sample_count = 4;
+    assert_true(hash != options_hash_of(&changed, &scene_settings));
+    changed = base;
+    changed.tracer.sampler = 1;
+    assert_true(hash != options_hash_of(&changed, &scene_settings));
+    changed = base;
+    changed.tracer.noise_threshold = 0.05f;
+    assert_true(hash != options_hash_of(&changed, &scene_settings));
+    changed = base;
+    changed.denoise = true;
+    assert_true(hash != options_hash_of(&changed, &scene_settings));
+    changed = base;
+    changed.exposure = 1;
+    assert_true(hash != options_hash_of(&changed, &scene_settings));
+    changed = base;
+    changed.time_limit_seconds = 5;
+    changed.checkpoint_seconds = 10;
+    changed.tracer.pass_work_budget = 100;
+    changed.tracer.full_tracer = true;
+    changed.skip_existing = true;
+    assert_true(hash == options_hash_of(&changed, &scene_settings));
+    changed = base;
+    changed.skip_existing = true;
+    changed.resume_path = "x.partial.exr";
+    refused(&changed, "--skip-existing finds and resumes each image's partial file itself; not with --resume");
+}
+
 static void defaults_are_zero(void **state)
 {
     (void)state;
@@ -687,6 +743,7 @@ int main(void)
         cmocka_unit_test(image_samples),
         cmocka_unit_test(image_regions),
         cmocka_unit_test(overrides_and_variables),
+        cmocka_unit_test(options_hash),
         cmocka_unit_test(metadata_round_trip),
         cmocka_unit_test(partials),
         cmocka_unit_test(runs_that_stop_early),
