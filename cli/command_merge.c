@@ -24,7 +24,7 @@ static void print_help(FILE *stream)
             "combined weighted by their per-pixel sample counts; regions are put in place by\n"
             "their data windows. Parts must share scene, size, seed, max depth and frame; sample\n"
             "ranges of one region must not overlap, regions must not overlap, and every pixel\n"
-            "must be covered.\n"
+            "must be covered. Light group layers (--light-groups) are merged as the colour is.\n"
             "\n"
             "options:\n"
             "  -o, --output FILE   the merged image (.exr keeps the samples channel and metadata;\n"
@@ -37,9 +37,11 @@ static void print_help(FILE *stream)
             "missing parts, unreadable files)\n");
 }
 
-/* Writes merged to output with the merged metadata (render_output.h: all four channels
- * for EXR, the colour only for the 8-bit and HDR formats). Returns an exit code. */
-static int write_merged(const char *output, const rt_image *merged, const merge_summary *summary)
+/* Writes merged to output with the merged metadata and light group layers (render_output.h:
+ * all four channels and the layers for EXR, the colour only for the 8-bit and HDR
+ * formats). Returns an exit code. */
+static int write_merged(const char *output, const rt_image *merged, const rt_image *layers,
+                        const merge_summary *summary)
 {
     render_output_metadata metadata = {
         .scene = summary->metadata.scene,
@@ -54,9 +56,10 @@ static int write_merged(const char *output, const rt_image *merged, const merge_
         .complete = summary->complete,
         .render_seconds = summary->render_seconds,
         .merged_parts = summary->part_count,
+        .light_groups = layers->pixels != NULL ? summary->metadata.light_groups : NULL,
     };
     rt_error error = {{0}};
-    rt_status status = render_output_write(output, merged, NULL, &metadata, 0.0f, &error);
+    rt_status status = render_output_write(output, merged, layers, &metadata, 0.0f, &error);
     if (status != RT_OK) {
         fprintf(stderr, "rtspheres merge: %s\n", error.message);
         return exit_code_for_status(status);
@@ -128,12 +131,15 @@ int command_merge(int argc, char **argv)
             image_free(&part);
         }
     }
-    rt_image merged = {0};
+    rt_image merged = {0}, layers = {0};
     merge_summary summary;
     if (status == RT_OK)
         status = merger_finish(m, &options, &merged, &summary, &error);
+    if (status == RT_OK)
+        status = merger_light_groups(m, &layers, &error);
     merger_free(m);
     if (status != RT_OK) {
+        image_free(&merged);
         fprintf(stderr, "rtspheres merge: %s\n", error.message);
         return exit_code_for_status(status);
     }
@@ -146,8 +152,9 @@ int command_merge(int argc, char **argv)
         fprintf(stderr, "rtspheres merge: warning: %lld pixels not covered by any part are left black "
                         "(--allow-missing)\n", summary.missing_pixels);
 
-    int exit_code = write_merged(output, &merged, &summary);
+    int exit_code = write_merged(output, &merged, &layers, &summary);
     image_free(&merged);
+    image_free(&layers);
     if (exit_code == EXIT_OK && !quiet)
         fprintf(stderr, "rtspheres merge: %d part%s (%d region%s) -> %s: %dx%d, %lld to %lld samples per pixel%s\n",
                 summary.part_count, summary.part_count == 1 ? "" : "s", summary.region_count,

@@ -200,6 +200,27 @@ static void show_checkpoint(void *user, const render_job_image *image, uint64_t 
         fprintf(stderr, "rtspheres: checkpoint: %llu samples in %s\n", (unsigned long long)samples, image->partial);
 }
 
+/* With --verbose, per image: which set-up steps it redid and which it took from the image
+ * before (frames, sweep rows): the BVHs (pack.h's cache), the packed scene on the device
+ * (all, none or the changed blocks uploaded), the tracer program. The records are packed
+ * again for every image: that is what tells which of them changed. */
+static void show_reuse(const render_job_image *image, const render_result *result)
+{
+    uint32_t trees = result->bvh_built + result->bvh_reused;
+    uint64_t packed = result->packed_bytes;
+    char upload[160];
+    if (result->reused_scene)
+        snprintf(upload, sizeof upload, "upload reused (the device held the packed scene)");
+    else if (result->uploaded_bytes < packed)
+        snprintf(upload, sizeof upload, "upload partial (%llu of %llu bytes: the blocks that changed)",
+                 (unsigned long long)result->uploaded_bytes, (unsigned long long)packed);
+    else
+        snprintf(upload, sizeof upload, "upload whole (%llu bytes)", (unsigned long long)packed);
+    fprintf(stderr, "rtspheres: set-up of %s: records packed; BVH %s (%u of %u trees reused); %s; shader %s\n",
+            image->output, result->bvh_reused == trees ? "reused" : result->bvh_reused > 0 ? "partly reused" : "built",
+            result->bvh_reused, trees, upload, result->compiled_program ? "compiled" : "reused");
+}
+
 /* render_job_callbacks.image_written: the set-up details with --verbose, then the
  * summary line unless --quiet. */
 static void show_summary(void *user, const render_job_image *image, const render_result *result)
@@ -228,6 +249,7 @@ static void show_summary(void *user, const render_job_image *image, const render
                 (unsigned long long)result->steady_samples,
                 result->steady_samples ? result->steady_seconds / (double)result->steady_samples * 1e6 : 0.0,
                 result->compiled_program ? "compiled" : "from the context's cache");
+        show_reuse(image, result);
     }
     if (!shown->arguments->quiet)
         fprintf(stderr,

@@ -210,7 +210,8 @@ typedef struct gpu_tracer_totals {
 typedef struct gpu_tracer gpu_tracer;
 
 /* Compiles the tracer (once per context), uploads the packed scene (unless the context
- * already holds exactly these texels) (texel_count texels of 4 uint32 each,
+ * already holds exactly these texels; of a scene of the same size only the blocks that
+ * differ, see gpu_tracer_uploaded_bytes()) (texel_count texels of 4 uint32 each,
  * see packed_layout.h; texel_hash: their hash, pack.h's packed_scene.texel_hash, which
  * tells whether the context holds them) and creates the state textures for
  * parameters->width x height. Wider or taller than gpu_info.max_tile_side is RT_ERROR_INPUT
@@ -279,6 +280,12 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
  * context (frames of an animation whose scene did not change) and did not upload it. The
  * compiled tracer program is always kept by the context between tracers. */
 bool gpu_tracer_reused_scene(const gpu_tracer *tracer);
+
+/* The bytes of the packed scene gpu_tracer_create() uploaded: 0 when it was on the device;
+ * all of it for a scene of another size; for one of the same size only the 16 KiB blocks
+ * whose texels changed (the context keeps a hash per block), so that a sweep row or frame
+ * that changes a light or a material uploads those sections' blocks, not the geometry. */
+uint64_t gpu_tracer_uploaded_bytes(const gpu_tracer *tracer);
 
 /* True when gpu_tracer_create() compiled the tracer program for this tracer; false when
  * the context's program cache already held its variant (frames and sweep rows after the

@@ -29,7 +29,13 @@ struct gpu_context {
     GLuint packed_buffer;
     uint64_t packed_hash;
     uint32_t packed_texel_count;
+    uint64_t *packed_block_hashes;        /* hash of each GPU_PACKED_BLOCK_TEXELS texels of the
+                                           * scene uploaded, so that the next scene of the
+                                           * same size uploads only the blocks that differ */
 };
+
+/* Texels per block of the packed scene's partial upload (16 KiB). */
+#define GPU_PACKED_BLOCK_TEXELS 1024u
 
 /* Frees what the tracer keeps on the context (compiled programs, the packed scene);
  * gpu_destroy() calls it while the context is still current. In gpu_tracer.c. */

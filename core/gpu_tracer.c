@@ -8,6 +8,7 @@
 
 #include "clock.h"
 #include "gpu_internal.h"
+#include "hash.h"
 #include "shader_sources.h"
 
 struct gpu_tracer {
@@ -29,6 +30,7 @@ struct gpu_tracer {
     int current;                 /* which state set holds the latest pass */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
     bool reused_scene;           /* the packed scene was already on the device */
+    uint64_t uploaded_bytes;     /* of the packed scene, uploaded for this tracer */
     bool compiled_program;       /* its program was compiled for it (not in the cache) */
     gpu_tracer_timings timings;
 };
@@ -323,6 +325,55 @@ static rt_status state_out_of_memory(const gpu_tracer *tracer, const char *what,
                         tracer->width, tracer->height, gib ? mib / 1024 : mib, gib ? "GiB" : "MiB", what);
 }
 
+/* The number of GPU_PACKED_BLOCK_TEXELS blocks of texel_count texels (the last may be short). */
+static uint32_t packed_block_count(uint32_t texel_count)
+{
+    return (uint32_t)(((uint64_t)texel_count + GPU_PACKED_BLOCK_TEXELS - 1) / GPU_PACKED_BLOCK_TEXELS);
+}
+
+/* Hashes block b of texel_count texels. */
+static uint64_t packed_block_hash(const uint32_t *texels, uint32_t texel_count, uint32_t b, size_t *bytes)
+{
+    uint64_t first = (uint64_t)b * GPU_PACKED_BLOCK_TEXELS;
+    uint64_t count = texel_count - first < GPU_PACKED_BLOCK_TEXELS ? texel_count - first : GPU_PACKED_BLOCK_TEXELS;
+    *bytes = (size_t)count * 16u;
+    return hash_bytes(HASH_START, texels + 4 * first, *bytes);
+}
+
+/* Notes the block hashes of the scene just uploaded on the context (without them, a
+ * later scene of the same size is uploaded whole). */
+static void note_packed_blocks(gpu_context *context, const uint32_t *texels, uint32_t texel_count)
+{
+    free(context->packed_block_hashes);
+    uint32_t blocks = packed_block_count(texel_count);
+    context->packed_block_hashes = malloc(((size_t)blocks + 1) * sizeof *context->packed_block_hashes);
+    size_t bytes;
+    for (uint32_t b = 0; context->packed_block_hashes != NULL && b < blocks; b++)
+        context->packed_block_hashes[b] = packed_block_hash(texels, texel_count, b, &bytes);
+}
+
+/* Replaces the context's packed scene, of the same texel count, by texels: only the blocks
+ * whose hash changed are uploaded (a sweep row that changes a light or a material, not
+ * the geometry, uploads a block or two). Adds the bytes uploaded to tracer->uploaded_bytes. */
+static rt_status update_packed_scene(gpu_tracer *tracer, const uint32_t *texels, uint32_t texel_count,
+                                     rt_error *error)
+{
+    gpu_context *context = tracer->context;
+    glBindBuffer(GL_TEXTURE_BUFFER, context->packed_buffer);
+    for (uint32_t b = 0; b < packed_block_count(texel_count); b++) {
+        size_t bytes;
+        uint64_t hash = packed_block_hash(texels, texel_count, b, &bytes);
+        if (hash == context->packed_block_hashes[b])
+            continue;
+        size_t offset = (size_t)b * GPU_PACKED_BLOCK_TEXELS * 16u;
+        glBufferSubData(GL_TEXTURE_BUFFER, (GLintptr)offset, (GLsizeiptr)bytes, (const char *)texels + offset);
+        context->packed_block_hashes[b] = hash;
+        tracer->uploaded_bytes += bytes;
+    }
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    return check_gl("updating the packed scene", error);
+}
+
 /* Creates both sets of state textures (zeroed) and their framebuffers. */
 static rt_status create_state(gpu_tracer *tracer, rt_error *error)
 {
@@ -489,11 +540,23 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     rt_status status = build_program(tracer, parameters, error);
     tracer->timings.compile_seconds = tracer->compiled_program ? clock_seconds() - step_start : 0;
     step_start = clock_seconds();
-    if (status == RT_OK && context->packed_texture != 0 && context->packed_hash == texel_hash
-        && context->packed_texel_count == texel_count) {
+    bool same_size = context->packed_texture != 0 && context->packed_texel_count == texel_count;
+    if (status == RT_OK && same_size && context->packed_hash == texel_hash) {
         tracer->packed_texture = context->packed_texture;
         tracer->packed_buffer = context->packed_buffer;
         tracer->reused_scene = true;
+    } else if (status == RT_OK && same_size && context->packed_block_hashes != NULL) {
+        tracer->packed_texture = context->packed_texture;
+        tracer->packed_buffer = context->packed_buffer;
+        context->packed_hash = 0;
+        status = update_packed_scene(tracer, packed_texels, texel_count, error);
+        if (status == RT_OK) {
+            context->packed_hash = texel_hash;
+        } else {
+            /* What the buffer holds is unknown now: the next scene goes up whole. */
+            free(context->packed_block_hashes);
+            context->packed_block_hashes = NULL;
+        }
     } else if (status == RT_OK) {
         if (context->packed_texture != 0) {
             glDeleteTextures(1, &context->packed_texture);
@@ -507,6 +570,8 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
             context->packed_buffer = tracer->packed_buffer;
             context->packed_hash = texel_hash;
             context->packed_texel_count = texel_count;
+            tracer->uploaded_bytes = (uint64_t)texel_count * 16u;
+            note_packed_blocks(context, packed_texels, texel_count);
         }
     }
     if (!tracer->reused_scene)
@@ -759,6 +824,11 @@ bool gpu_tracer_reused_scene(const gpu_tracer *tracer)
     return tracer->reused_scene;
 }
 
+uint64_t gpu_tracer_uploaded_bytes(const gpu_tracer *tracer)
+{
+    return tracer->uploaded_bytes;
+}
+
 bool gpu_tracer_compiled_program(const gpu_tracer *tracer)
 {
     return tracer->compiled_program;
@@ -999,4 +1069,6 @@ void gpu_tracer_release(gpu_context *context)
         glDeleteTextures(1, &context->packed_texture);
     if (context->packed_buffer)
         glDeleteBuffers(1, &context->packed_buffer);
+    free(context->packed_block_hashes);
+    context->packed_block_hashes = NULL;
 }

@@ -35,6 +35,8 @@ struct merger {
     int full_width, full_height;
     /* Per pixel of the full image: R*n, G*n, B*n, n, summed over the parts in double. */
     double *sums;
+    relight_layers layers;       /* the first part's light groups (count 0: none) */
+    double *layer_sums;          /* per pixel: each layer's R*n, G*n, B*n, as sums */
 };
 
 /* A half-open sample range [start, start + count). */
@@ -66,6 +68,7 @@ void merger_free(merger *m)
     free(m->parts);
     free(m->regions);
     free(m->sums);
+    free(m->layer_sums);
     free(m);
 }
 
@@ -170,6 +173,32 @@ static rt_status place_part(const merger *m, const char *name, const rt_image *i
     return RT_OK;
 }
 
+/* Finds the light group layers of a part into *layers (count 0: none): those its
+ * rtspheres:light_groups names, which must be the first part's groups. */
+static rt_status find_light_groups(const merger *m, const char *name, const rt_image *image,
+                                   const merge_metadata *metadata, relight_layers *layers, rt_error *error)
+{
+    memset(layers, 0, sizeof *layers);
+    if (m->part_count > 0 && strcmp(metadata->light_groups, m->parts[0].metadata.light_groups) != 0) {
+        const char *first = m->parts[0].metadata.light_groups;
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "MERGE: '%s' has light groups %s%s%s but '%s' %s%s%s; merge parts rendered alike (all "
+                            "with --light-groups or none)", m->parts[0].name, first[0] ? "'" : "",
+                            first[0] ? first : "none", first[0] ? "'" : "", name, metadata->light_groups[0] ? "'" : "",
+                            metadata->light_groups[0] ? metadata->light_groups : "none",
+                            metadata->light_groups[0] ? "'" : "");
+    }
+    if (metadata->light_groups[0] == '\0')
+        return RT_OK;
+    rt_error found = {{0}};
+    if (relight_find_layers(image, metadata->light_groups, layers, &found) != RT_OK) {
+        const char *why = strncmp(found.message, "RELIGHT: ", 9) == 0 ? found.message + 9 : found.message;
+        return rt_error_set(error, RT_ERROR_INPUT, "MERGE: '%s' lists light groups '%s' but its layers are not all "
+                            "there: %s", name, metadata->light_groups, why);
+    }
+    return RT_OK;
+}
+
 rt_status merger_add(merger *m, const char *name, const rt_image *image, const merge_metadata *metadata,
                      rt_error *error)
 {
@@ -216,6 +245,10 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
         if (status != RT_OK)
             return status;
     }
+    relight_layers layers = {0};
+    status = find_light_groups(m, name, image, metadata, &layers, error);
+    if (status != RT_OK)
+        return status;
 
     /* Everything that can fail for lack of memory happens before the merger changes. */
     char *name_copy = strdup(name);
@@ -236,6 +269,15 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
         m->full_width = full_width;
         m->full_height = full_height;
     }
+    if (m->layer_sums == NULL && layers.count > 0) {
+        size_t full_values = (size_t)full_width * full_height * 3 * (size_t)layers.count;
+        if ((m->layer_sums = calloc(full_values, sizeof(double))) == NULL) {
+            free(name_copy);
+            return rt_error_set(error, RT_ERROR_RUNTIME, "MERGE: out of memory for %d light group layers",
+                                layers.count);
+        }
+        m->layers = layers;
+    }
 
     if (region_index == m->region_count) {
         m->regions[m->region_count++] = (region){.x = image->x, .y = image->y, .width = image->width,
@@ -249,10 +291,15 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
             double n = pixel[channel[3]];
             if (n == 0)
                 continue;  /* nothing rendered here; its colour means nothing */
-            double *sum = &m->sums[((size_t)(image->y + row) * full_width + image->x + column) * 4];
+            size_t at = (size_t)(image->y + row) * full_width + image->x + column;
+            double *sum = &m->sums[at * 4];
             for (int c = 0; c < 3; c++)
                 sum[c] += (double)pixel[channel[c]] * n;
             sum[3] += n;
+            double *layer_sum = m->layer_sums + at * 3 * (size_t)layers.count;
+            for (int g = 0; g < layers.count; g++)
+                for (int c = 0; c < 3; c++)
+                    layer_sum[3 * g + c] += (double)pixel[layers.channels[g][c]] * n;
         }
     return RT_OK;
 }
@@ -459,6 +506,29 @@ rt_status merger_finish(merger *m, const merge_options *options, rt_image *out, 
     return RT_OK;
 }
 
+rt_status merger_light_groups(const merger *m, rt_image *layers, rt_error *error)
+{
+    memset(layers, 0, sizeof *layers);
+    int count = m->layers.count;
+    if (count == 0 || m->layer_sums == NULL)
+        return RT_OK;
+    rt_status status = image_create(layers, m->full_width, m->full_height, 3 * count, error);
+    if (status != RT_OK)
+        return status;
+    static const char channels[3] = {'R', 'G', 'B'};
+    for (int g = 0; g < count; g++)
+        for (int c = 0; c < 3; c++)
+            snprintf(layers->channel_names[3 * g + c], IMAGE_CHANNEL_NAME_MAX, "%s.%c", m->layers.names[g],
+                     channels[c]);
+    size_t values = 3 * (size_t)count;
+    for (size_t i = 0; i < (size_t)m->full_width * m->full_height; i++) {
+        double n = m->sums[i * 4 + 3];
+        for (size_t v = 0; v < values; v++)
+            layers->pixels[i * values + v] = n > 0 ? (float)(m->layer_sums[i * values + v] / n) : 0.0f;
+    }
+    return RT_OK;
+}
+
 /* Reads the attribute name of path as text into value. Returns RT_OK, or RT_ERROR_INPUT
  * saying the file is not an rtspheres part when required and absent; an absent optional
  * attribute leaves value "" and returns RT_OK. */
@@ -546,6 +616,7 @@ rt_status merge_read_part(const char *path, rt_image *image, merge_metadata *met
     metadata->render_seconds = text[0] ? strtod(text, NULL) : 0;
     read_text(path, METADATA_KEY_PATH_SEGMENTS, false, text, sizeof text, NULL);
     metadata->path_segments = text[0] ? strtod(text, NULL) : 0;
+    read_text(path, METADATA_KEY_LIGHT_GROUPS, false, metadata->light_groups, MERGE_LIGHT_GROUPS_MAX, NULL);
     return RT_OK;
 
 failed:

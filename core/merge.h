@@ -21,6 +21,12 @@
  *   - The summary's complete is true only when every part is complete, each region's
  *     sample ranges are contiguous, every region has the same ranges and every pixel is
  *     covered.
+ *   - Light group layers (render --light-groups: NAME.R/G/B per group, the groups listed
+ *     in rtspheres:light_groups) are merged as the colour is, weighted by the samples of
+ *     each pixel and put in place by region, so that they still sum to the merged colour
+ *     (to float rounding) and a tile's are exactly the whole render's. Every part must
+ *     list the same groups as the first, or none when it lists none: RT_ERROR_INPUT
+ *     otherwise. Other layers (AOVs, variance) are not merged.
  *
  * Use: merger_create, merger_add once per part (it validates the part against the ones
  * added before and adds its pixels to running double sums, so the caller may free the
@@ -33,11 +39,13 @@
 #include <stdbool.h>
 
 #include "image_io.h"
+#include "relight.h"
 #include "status.h"
 
 #define MERGE_TEXT_MAX 512
 #define MERGE_MAX_WARNINGS 8
 #define MERGE_WARNING_MAX 512
+#define MERGE_LIGHT_GROUPS_MAX (SCENE_LIGHT_GROUP_MAX * SCENE_NAME_MAX)
 
 /* The rtspheres:* metadata of one part that the merge checks or carries over (the keys
  * and what they hold: metadata_keys.h). */
@@ -52,6 +60,7 @@ typedef struct merge_metadata {
     bool complete;                       /* rtspheres:complete */
     double render_seconds;               /* rtspheres:render_seconds, 0 when absent */
     double path_segments;                /* rtspheres:path_segments, 0 when absent */
+    char light_groups[MERGE_LIGHT_GROUPS_MAX];   /* rtspheres:light_groups, "" when absent */
 } merge_metadata;
 
 typedef struct merge_options {
@@ -101,6 +110,12 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
  * or missing pieces without allow_missing: RT_ERROR_INPUT; out is then left empty. */
 rt_status merger_finish(merger *m, const merge_options *options, rt_image *out, merge_summary *summary,
                         rt_error *error);
+
+/* Returns the merged light group layers into *layers (NAME.R/G/B for each group of
+ * summary.metadata.light_groups in that order, full size; allocated, free with
+ * image_free()) after a successful merger_finish(); empty (RT_OK) when the parts have no
+ * layers. RT_ERROR_RUNTIME when memory runs out. */
+rt_status merger_light_groups(const merger *m, rt_image *layers, rt_error *error);
 
 /* Reads the part file at path: its pixels into *image (allocated; free with image_free())
  * and its rtspheres metadata into *metadata. A file that cannot be read, lacks the

@@ -226,6 +226,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
         p.texels = NULL;
     }
     finish_packer(&p);
+    pack_bvh_cache_finish(p.options->bvh_cache, status == RT_OK);
     if (status != RT_OK) {
         double seconds = out->bvh_build_seconds;
         memset(out, 0, sizeof *out);

@@ -18,7 +18,16 @@
  * pack_internal.h.
  *
  * Defaults of pack_options (all zero): BVHs built with bvh_build_config defaults, a bake
- * budget of PACK_DEFAULT_BAKE_BUDGET (262,144) primitives, placements baked by the rule.
+ * budget of PACK_DEFAULT_BAKE_BUDGET (262,144) primitives, placements baked by the rule,
+ * no BVH cache.
+ *
+ * The BVH cache (pack_bvh_cache): a BVH is a pure function of its primitives' boxes and
+ * the build config (bvh.h), so a packer given a cache takes each tree whose boxes and
+ * config equal, bit for bit, those of a tree the previous pack_scene() with that cache
+ * built, instead of building it again; the texels are the same either way. The cache then
+ * holds the trees of this pack (those of the one before are dropped), so it costs one
+ * scene's BVHs and boxes. A sweep or an animation whose rows change lights, materials or
+ * the camera but no shape keeps every tree (core/render_job.c makes one per job).
  */
 #ifndef RT_PACK_H
 #define RT_PACK_H
@@ -33,8 +42,11 @@
 /* The default of pack_options.bake_budget. */
 #define PACK_DEFAULT_BAKE_BUDGET 262144
 
+typedef struct pack_bvh_cache pack_bvh_cache;
+
 typedef struct pack_options {
     const bvh_build_config *bvh_config;  /* NULL: defaults */
+    pack_bvh_cache *bvh_cache;           /* NULL: every BVH built; else see "The BVH cache" */
     uint32_t bake_budget;    /* an object's placements with a transform are baked into the
                               * top level while the copies beyond the first hold at most
                               * this many primitives (core/pack_collect.c says when else);
@@ -82,6 +94,9 @@ typedef struct packed_scene {
     uint32_t triangle_count;     /* triangles stored (mesh triangles once per object) */
     int bvh_depth;               /* deepest level of any BVH */
     double bvh_build_seconds;    /* all BVH builds together */
+    uint32_t bvh_built;          /* BVHs built by this pack (the top level and one per
+                                  * instanced object) */
+    uint32_t bvh_reused;         /* BVHs taken from pack_options.bvh_cache instead */
     pack_summary summary;        /* what the sections hold */
     uint64_t texel_hash;         /* hash_bytes (hash.h) of the texels from HASH_START: the
                                   * one hash of the packed scene (the device's copy, the
@@ -96,6 +111,11 @@ pack_options pack_options_defaults(void);
  * RT_ERROR_INPUT; an instance whose transform cannot be inverted too. The caller frees
  * *out with packed_scene_free(). */
 rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *out, rt_error *error);
+
+/* Creates an empty BVH cache into *out (RT_ERROR_RUNTIME when memory runs out). Free it
+ * with pack_bvh_cache_free() (NULL is allowed there). */
+rt_status pack_bvh_cache_create(pack_bvh_cache **out, rt_error *error);
+void pack_bvh_cache_free(pack_bvh_cache *cache);
 
 /* Frees out->texels and zeroes *out. */
 void packed_scene_free(packed_scene *packed);

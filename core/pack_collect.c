@@ -242,8 +242,129 @@ static bvh_box transform_box(const bvh_box *box, const float m[3][4])
 
 /* ---- BVHs ---------------------------------------------------------------------------- */
 
-/* Builds the BVH of list (the list stays in caller order; tree.primitive_indices orders it). */
-static rt_status build_tree(built_tree *built, const pack_options *options, double *seconds, rt_error *error)
+/* One tree of a BVH cache (pack.h): the boxes and config it was built from, and it. */
+typedef struct cached_tree {
+    bvh_box *boxes;
+    uint32_t count;
+    bvh_build_config config;
+    bvh tree;
+} cached_tree;
+
+struct pack_bvh_cache {
+    cached_tree *kept;           /* the trees of the last finished pack; boxes NULL: taken */
+    int kept_count;
+    cached_tree *made;           /* the trees of the pack under way */
+    int made_count;
+    size_t made_capacity;
+};
+
+rt_status pack_bvh_cache_create(pack_bvh_cache **out, rt_error *error)
+{
+    *out = calloc(1, sizeof **out);
+    return *out != NULL ? RT_OK : rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory for the BVH cache");
+}
+
+/* Frees count trees of a cache's list and the list. */
+static void free_cached_trees(cached_tree *trees, int count)
+{
+    for (int i = 0; i < count; i++) {
+        free(trees[i].boxes);
+        bvh_free(&trees[i].tree);
+    }
+    free(trees);
+}
+
+void pack_bvh_cache_free(pack_bvh_cache *cache)
+{
+    if (cache == NULL)
+        return;
+    free_cached_trees(cache->kept, cache->kept_count);
+    free_cached_trees(cache->made, cache->made_count);
+    free(cache);
+}
+
+void pack_bvh_cache_finish(pack_bvh_cache *cache, bool succeeded)
+{
+    if (cache == NULL)
+        return;
+    if (succeeded) {
+        free_cached_trees(cache->kept, cache->kept_count);
+        cache->kept = cache->made;
+        cache->kept_count = cache->made_count;
+    } else {
+        free_cached_trees(cache->made, cache->made_count);
+    }
+    cache->made = NULL;
+    cache->made_count = 0;
+    cache->made_capacity = 0;
+}
+
+/* True when a and b build the same tree: the same fields (zero meaning default in both). */
+static bool same_config(const bvh_build_config *a, const bvh_build_config *b)
+{
+    return a->max_leaf_size == b->max_leaf_size && a->bin_count == b->bin_count && a->max_depth == b->max_depth
+           && a->traversal_cost == b->traversal_cost && a->intersection_cost == b->intersection_cost;
+}
+
+/* Copies tree into *copy (allocated; the caller frees it with bvh_free()). */
+static rt_status copy_tree(const bvh *tree, bvh *copy, rt_error *error)
+{
+    *copy = *tree;
+    copy->nodes = malloc(((size_t)tree->node_count + 1) * sizeof *copy->nodes);
+    copy->primitive_indices = malloc(((size_t)tree->primitive_count + 1) * sizeof *copy->primitive_indices);
+    if (copy->nodes == NULL || copy->primitive_indices == NULL) {
+        bvh_free(copy);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+    }
+    memcpy(copy->nodes, tree->nodes, (size_t)tree->node_count * sizeof *copy->nodes);
+    memcpy(copy->primitive_indices, tree->primitive_indices, (size_t)tree->primitive_count * sizeof *copy->primitive_indices);
+    return RT_OK;
+}
+
+/* Looks for a tree over exactly these boxes and config in the cache: the last pack's
+ * (moved into this pack's list, so that the next pack finds it too) or this pack's.
+ * Returns it, or NULL. */
+static const cached_tree *find_cached_tree(pack_bvh_cache *cache, const bvh_box *boxes, uint32_t count,
+                                           const bvh_build_config *config)
+{
+    for (int i = 0; i < cache->made_count; i++) {
+        const cached_tree *made = &cache->made[i];
+        if (made->count == count && same_config(&made->config, config)
+            && memcmp(made->boxes, boxes, (size_t)count * sizeof *boxes) == 0)
+            return made;
+    }
+    for (int i = 0; i < cache->kept_count; i++) {
+        cached_tree *kept = &cache->kept[i];
+        if (kept->boxes == NULL || kept->count != count || !same_config(&kept->config, config)
+            || memcmp(kept->boxes, boxes, (size_t)count * sizeof *boxes) != 0)
+            continue;
+        if (!array_reserve((void **)&cache->made, &cache->made_capacity, (size_t)cache->made_count + 1,
+                           sizeof *cache->made))
+            return NULL;
+        cache->made[cache->made_count] = *kept;
+        memset(kept, 0, sizeof *kept);
+        return &cache->made[cache->made_count++];
+    }
+    return NULL;
+}
+
+/* Keeps a tree just built in the cache's list of this pack: boxes (taken over; *boxes
+ * becomes NULL) and a copy of tree. Running out of memory only leaves it out. */
+static void cache_tree(pack_bvh_cache *cache, bvh_box **boxes, uint32_t count, const bvh_build_config *config,
+                       const bvh *tree)
+{
+    cached_tree entry = {.boxes = *boxes, .count = count, .config = *config};
+    if (!array_reserve((void **)&cache->made, &cache->made_capacity, (size_t)cache->made_count + 1,
+                       sizeof *cache->made)
+        || copy_tree(tree, &entry.tree, NULL) != RT_OK)
+        return;
+    cache->made[cache->made_count++] = entry;
+    *boxes = NULL;
+}
+
+/* Builds the BVH of list (the list stays in caller order; tree.primitive_indices orders
+ * it), or copies the cache's tree over the same boxes; counts which in p->out. */
+static rt_status build_tree(packer *p, built_tree *built, rt_error *error)
 {
     uint32_t count = built->primitives.count;
     bvh_box *boxes = malloc((count ? count : 1) * sizeof *boxes);
@@ -251,9 +372,21 @@ static rt_status build_tree(built_tree *built, const pack_options *options, doub
         return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
     for (uint32_t i = 0; i < count; i++)
         boxes[i] = built->primitives.items[i].box;
-    double start = clock_seconds();
-    rt_status status = bvh_build(boxes, count, options->bvh_config, &built->tree, error);
-    *seconds += clock_seconds() - start;
+    pack_bvh_cache *cache = p->options->bvh_cache;
+    bvh_build_config config = p->options->bvh_config != NULL ? *p->options->bvh_config : (bvh_build_config){0};
+    const cached_tree *cached = cache != NULL ? find_cached_tree(cache, boxes, count, &config) : NULL;
+    rt_status status;
+    if (cached != NULL) {
+        status = copy_tree(&cached->tree, &built->tree, error);
+        p->out->bvh_reused++;
+    } else {
+        double start = clock_seconds();
+        status = bvh_build(boxes, count, p->options->bvh_config, &built->tree, error);
+        p->out->bvh_build_seconds += clock_seconds() - start;
+        p->out->bvh_built++;
+        if (status == RT_OK && cache != NULL)
+            cache_tree(cache, &boxes, count, &config, &built->tree);
+    }
     free(boxes);
     return status;
 }
@@ -649,7 +782,7 @@ rt_status pack_build_trees(packer *p, rt_error *error)
         if (status == RT_OK && p->objects[o].primitives.count == 0)
             status = rt_error_set(error, RT_ERROR_INPUT, "PACK: object %d placed by an instance is empty", o);
         if (status == RT_OK)
-            status = build_tree(&p->objects[o], p->options, &out->bvh_build_seconds, error);
+            status = build_tree(p, &p->objects[o], error);
         if (status == RT_OK && p->objects[o].tree.depth > out->bvh_depth)
             out->bvh_depth = p->objects[o].tree.depth;
     }
@@ -666,7 +799,7 @@ rt_status pack_build_trees(packer *p, rt_error *error)
         item->box = transform_box(&p->objects[instance->object].tree.nodes[0].box, instance->object_to_world);
     }
     if (status == RT_OK)
-        status = build_tree(&p->top, p->options, &out->bvh_build_seconds, error);
+        status = build_tree(p, &p->top, error);
     if (status == RT_OK && p->top.tree.depth > out->bvh_depth)
         out->bvh_depth = p->top.tree.depth;
     return status;

@@ -143,6 +143,10 @@ rt_status pack_build_trees(packer *p, rt_error *error);
  * lights: emissive, or pbr with an emission and no alpha mask. */
 bool pack_is_emissive(const scene *s, uint32_t material);
 
+/* Ends a pack for its BVH cache (NULL: nothing): on success the trees of this pack become
+ * the ones the next pack may take, the rest are dropped; on failure this pack's are. */
+void pack_bvh_cache_finish(pack_bvh_cache *cache, bool succeeded);
+
 /* Inverts the affine 3x4 matrix m into inverse. Returns false when it is singular. */
 bool pack_invert_affine(const float m[3][4], float inverse[3][4]);
 

@@ -434,10 +434,14 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
         return status;
     packed_scene packed;
     double pack_start = clock_seconds();
-    status = pack_scene(s, NULL, &packed, error);
+    pack_options pack = pack_options_defaults();
+    pack.bvh_cache = options->bvh_cache;
+    status = pack_scene(s, &pack, &packed, error);
     if (status != RT_OK)
         return status;
     result->pack_seconds = clock_seconds() - pack_start;
+    result->bvh_built = packed.bvh_built;
+    result->bvh_reused = packed.bvh_reused;
     result->bvh_depth = packed.bvh_depth;
     result->bvh_build_seconds = packed.bvh_build_seconds;
     result->packed_bytes = (uint64_t)packed.texel_count * 16u;
@@ -785,6 +789,7 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
     if (status != RT_OK)
         return status;
     result->reused_scene = gpu_tracer_reused_scene(tracer);
+    result->uploaded_bytes = gpu_tracer_uploaded_bytes(tracer);
     result->compiled_program = gpu_tracer_compiled_program(tracer);
     gpu_tracer_timings timings;
     gpu_tracer_get_timings(tracer, &timings);

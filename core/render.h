@@ -27,7 +27,7 @@
  *   sample_start 0, the whole image, no progress callback, no stop flag,
  *   noise_threshold 0: no adaptive sampling (every pixel takes samples_per_pixel),
  *   min_spp ADAPTIVE_DEFAULT_MIN_SPP (16, core/adaptive.h) with a threshold,
- *   deadline 0: none.
+ *   deadline 0: none, no BVH cache.
  *
  * Adaptive sampling (noise_threshold > 0): pixels stop as core/adaptive.h says, each
  * pass runs only the tiles with pixels still going, and the samples channel holds each
@@ -51,6 +51,7 @@
 
 #include "gpu.h"
 #include "image_io.h"
+#include "pack.h"
 #include "scene.h"
 #include "status.h"
 
@@ -125,6 +126,10 @@ typedef struct render_options {
     double preview_seconds;
     void (*preview)(void *preview_context, const rt_image *partial);
     void *preview_context;
+    /* NULL: every BVH is built; else the packer's BVH cache (pack.h), which the caller
+     * keeps between renders (a job's frames and sweep rows): trees over the same boxes as
+     * the last render's are taken from it, not built again. The image is the same. */
+    pack_bvh_cache *bvh_cache;
 } render_options;
 
 typedef struct render_result {
@@ -165,6 +170,10 @@ typedef struct render_result {
     uint32_t triangle_count;     /* triangles stored (a mesh once however often placed) */
     uint32_t primitive_count, instance_count, light_count;
     bool reused_scene;           /* the device already held this packed scene (frames) */
+    uint32_t bvh_built, bvh_reused;   /* BVHs built, and taken from options.bvh_cache */
+    uint64_t uploaded_bytes;     /* of the packed scene sent to the device for this render:
+                                  * all, none (reused_scene) or the blocks that changed
+                                  * (gpu.h gpu_tracer_uploaded_bytes()) */
     bool compiled_program;       /* the tracer program was compiled for this render (not
                                   * found in the context's cache) */
     uint64_t scene_hash;         /* FNV-1a of what decides the image apart from the samples:

@@ -61,16 +61,18 @@ static rt_status load_scene(job_run *run, int frame, scene *s, rt_error *error)
     return status;
 }
 
-void job_image_metadata(const job_image *image, uint64_t samples, bool complete, bool checkpoint,
-                        const render_result *result, render_output_metadata *metadata, job_metadata_texts *texts)
+void job_image_metadata(const job_image *image, const char *path, uint64_t samples, bool complete,
+                        bool checkpoint, const render_result *result, render_output_metadata *metadata, job_metadata_texts *texts)
 {
     const render_job *job = image->run->job;
     const scene_render_settings *settings = &image->scene.render;
     snprintf(texts->hash, sizeof texts->hash, "%016llx", (unsigned long long)result->scene_hash);
     snprintf(texts->options_hash, sizeof texts->options_hash, "%016llx", (unsigned long long)image->plan.options_hash);
-    /* The layers' names (the partial file keeps none). */
+    /* The layers' names, with the output (also one a time limit ended; the partial file
+     * keeps no layers). */
+    bool layers = job->light_groups && strcmp(path, image->plan.output) == 0;
     texts->groups[0] = '\0';
-    for (int g = 0; complete && job->light_groups && g < image->scene.light_group_count; g++)
+    for (int g = 0; layers && g < image->scene.light_group_count; g++)
         snprintf(texts->groups + strlen(texts->groups), sizeof texts->groups - strlen(texts->groups), "%s%s",
                  g > 0 ? "," : "", image->scene.light_groups[g]);
     *metadata = (render_output_metadata){
@@ -119,7 +121,7 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
     placed.full_height = settings->height;
     render_output_metadata metadata;
     job_metadata_texts texts;
-    job_image_metadata(image, samples, complete, checkpoint, result, &metadata, &texts);
+    job_image_metadata(image, path, samples, complete, checkpoint, result, &metadata, &texts);
     return render_output_write(path, &placed, &result->aovs, &metadata, job_output_exposure(image->run->job), error);
 }
 
@@ -302,6 +304,7 @@ static void image_render_options(job_image *image, render_options *options)
     options->aovs = job->aovs || job->denoise;
     options->light_groups = job->light_groups;
     options->variance = job->variance;
+    options->bvh_cache = image->run->bvh_cache;
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;
     options->stop_requested = job->stop_requested;
@@ -493,6 +496,12 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
         summary->failure = RENDER_JOB_FAILURE_PLAN;
         return status;
     }
+    /* Frames and sweep rows that move no shape keep every BVH (pack.h, the BVH cache). */
+    int images = job->sweep != NULL ? job->sweep->row_count : job->frame_count;
+    if (images > 1 && pack_bvh_cache_create(&run.bvh_cache, error) != RT_OK) {
+        summary->failure = RENDER_JOB_FAILURE_IMAGE;
+        return RT_ERROR_RUNTIME;
+    }
     double start = clock_seconds();
     if (job->sweep != NULL) {
         status = run_sweep(&run, summary, error);
@@ -502,6 +511,7 @@ rt_status render_job_run(gpu_context *context, const render_job *job, const rend
     } else {
         status = run_frames(&run, summary, error);
     }
+    pack_bvh_cache_free(run.bvh_cache);
     summary->seconds = clock_seconds() - start;
     summary->images_skipped = run.images_skipped;
     summary->failure = status == RT_OK ? RENDER_JOB_FAILURE_NONE : run.failure;

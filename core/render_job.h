@@ -35,8 +35,9 @@
  *   checkpoint_seconds      0: never; else write the partial file that often
  *   aovs                    add the AOV layers (render.h) to an EXR
  *   light_groups            add a layer per light group (render.h render_result.light_groups,
- *                           NAME.R/G/B) to an EXR; not with denoise, blur, resume, sample
- *                           ranges, tiles or shards other than by frames
+ *                           NAME.R/G/B) to an EXR; not with denoise or blur (the layers
+ *                           would not sum to the image) nor resume (a partial file keeps
+ *                           no layers); tiles, crops, sample ranges and shards merge them
  *   variance                add the variance layers variance.R/G/B (render.h) to an EXR
  *   denoise                 postprocess_denoise() guided by the AOVs; an EXR keeps the noisy
  *                           colour as noisy.R/G/B
@@ -59,7 +60,9 @@
  *   tracer                  how each image is traced (render.h; zero = its defaults; its
  *                           noise_threshold and min_spp: adaptive sampling). The job sets
  *                           its sample_start, region, aovs, variance, progress,
- *                           stop_requested, deadline, resume and checkpoint fields itself.
+ *                           stop_requested, deadline, resume, checkpoint and bvh_cache
+ *                           fields itself (a job of several frames or rows keeps one BVH
+ *                           cache, pack.h, for all of them).
  *   stop_requested          NULL: never; else a non-zero value ends the job: the pass in
  *                           flight finishes and its samples go to the partial file
  *   skip_existing           false: render every image; true: before each image, look at
@@ -293,7 +296,7 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * resume with several frames; shard_by without shard; a shard by frames without frames,
  * or with no frame; light groups
  * (see the job); a shard by samples with a sample range; a shard by tiles with crop or
- * tile; light groups with a shard not by frames; a samples map with several frames or of an unknown
+ * tile; a samples map with several frames or of an unknown
  * format; a minimum spp without a noise threshold; a noise threshold with a shard by samples,
  * a sample range or resume; a sweep with frames, resume or a define
  * of one of its columns, two of its rows writing one file (the table's file:line). */

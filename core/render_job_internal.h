@@ -3,6 +3,7 @@
 #ifndef RT_RENDER_JOB_INTERNAL_H
 #define RT_RENDER_JOB_INTERNAL_H
 
+#include "pack.h"
 #include "render_job.h"
 #include "render_output.h"
 
@@ -16,6 +17,7 @@ typedef struct job_run {
     bool image_begun;                    /* an image has begun (its limit counted from then) */
     int images_skipped;                  /* skip_existing found them complete */
     int sweep_row;                       /* the sweep row being rendered, -1: none */
+    pack_bvh_cache *bvh_cache;           /* with several images: their BVHs carried over */
 } job_run;
 
 /* One image being rendered: its scene (render settings after the job's overrides and
@@ -34,11 +36,12 @@ typedef struct job_metadata_texts {
     char groups[SCENE_LIGHT_GROUP_MAX * (SCENE_LIGHT_GROUP_NAME_MAX + 1) + 1];
 } job_metadata_texts;
 
-/* Fills *metadata (pointing into *texts) for image's file: samples finished, complete
- * (the render ended by its own rule), checkpoint (a checkpoint's file: no stop reason);
- * result gives the scene hash, path segments, time and stop reason. */
-void job_image_metadata(const job_image *image, uint64_t samples, bool complete, bool checkpoint,
-                        const render_result *result, render_output_metadata *metadata, job_metadata_texts *texts);
+/* Fills *metadata (pointing into *texts) for image's file at path (the output lists its
+ * light groups; the partial file keeps no layers): samples finished, complete (the render
+ * ended by its own rule), checkpoint (a checkpoint's file: no stop reason); result gives
+ * the scene hash, path segments, time and stop reason. */
+void job_image_metadata(const job_image *image, const char *path, uint64_t samples, bool complete,
+                        bool checkpoint, const render_result *result, render_output_metadata *metadata, job_metadata_texts *texts);
 
 /* Returns the exposure the writer applies (image_write_options.exposure): the job's, but
  * 0 after a tone-mapping operator, which applied it already. */

@@ -85,8 +85,9 @@ static rt_status check_first_output(const render_job *job, const char *output, r
 }
 
 /* Checks --light-groups against the output and the other options: its layers need an
- * EXR; they must sum to the beauty, which denoise and blur change; a partial file and
- * merge keep no layers (no resume, sample ranges or tiles). */
+ * EXR; they must sum to the beauty, which denoise and blur change; a partial file keeps no
+ * layers (no resume). Tiles, crops, sample ranges and shards are fine: merge carries the
+ * layers (merge.h). */
 static rt_status check_light_groups(const render_job *job, const char *output, rt_error *error)
 {
     if (!job->light_groups)
@@ -99,12 +100,14 @@ static rt_status check_light_groups(const render_job *job, const char *output, r
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--light-groups with --%s: the layers would no longer sum to the image; relight, "
                             "then post-process", job->denoise ? "denoise" : "blur");
+    /* The layers gather light as each path goes, so when a render stops they also hold
+     * parts of the paths in flight, which a resumed render traces again: carried in a
+     * partial file they would count those twice. */
     if (job->resume_path != NULL)
-        return rt_error_set(error, RT_ERROR_INPUT, "--light-groups cannot --resume: a partial file keeps no layers");
-    if (job->sample_count > 0 || job->tile_count)
         return rt_error_set(error, RT_ERROR_INPUT,
-                            "--light-groups with --%s: merge keeps no light group layers; render whole images",
-                            job->sample_count > 0 ? "samples" : "tile");
+                            "--light-groups cannot --resume: a partial file keeps no layers (at a stop they hold "
+                            "parts of the paths in flight, which the resumed render traces again); render the "
+                            "rest as a sample range (--samples) and merge the parts");
     return RT_OK;
 }
 
@@ -230,10 +233,6 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
     if (status != RT_OK)
         return status;
     status = plan_shard(job, plan, error);
-    if (status == RT_OK && job->light_groups && job->shard_count && plan->shard_by != RENDER_SHARD_FRAMES)
-        return rt_error_set(error, RT_ERROR_INPUT,
-                            "--light-groups with --shard by %s: merge keeps no light group layers; shard by frames",
-                            render_job_shard_kind_name(plan->shard_by));
     if (status == RT_OK && job->tracer.min_spp && !(job->tracer.noise_threshold > 0))
         return rt_error_set(error, RT_ERROR_INPUT, "--min-spp does nothing without --noise-threshold");
     if (status != RT_OK || !(job->tracer.noise_threshold > 0))

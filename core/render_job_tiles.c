@@ -13,6 +13,7 @@
 #include "adaptive.h"
 #include "clock.h"
 #include "image_io.h"
+#include "pack.h"
 #include "render_job_internal.h"
 
 /* Tiles of fewer rows than this are avoided while narrower tiles can have them: each
@@ -319,7 +320,7 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     memcpy(layout.channel_names, run->names, sizeof layout.channel_names);
     render_output_metadata metadata;
     job_metadata_texts texts;
-    job_image_metadata(image, run->total.samples, run->total.stop_reason != RENDER_STOP_TIME, false, &run->total,
+    job_image_metadata(image, image->plan.output, run->total.samples, run->total.stop_reason != RENDER_STOP_TIME, false, &run->total,
                        &metadata, &texts);
     render_output_stream *output = NULL;
     image_stream *map = NULL;
@@ -396,10 +397,21 @@ rt_status job_render_tiles(job_image *image, const render_options *options, cons
                                  grid->tile_height, grid->reason);
     if (callbacks->render_started != NULL)
         callbacks->render_started(callbacks->user, &image->plan);
+    /* Every tile packs the same scene: a job of one image has no BVH cache of its own, so
+     * the tiles get one, and only the first builds the BVHs (pack.h, "The BVH cache"). A
+     * cache that cannot be made costs only the rebuilds. */
+    pack_bvh_cache *tile_cache = NULL;
+    if (options->bvh_cache == NULL) {
+        rt_error ignored;
+        if (pack_bvh_cache_create(&tile_cache, &ignored) != RT_OK)
+            tile_cache = NULL;
+    }
     int tile = 0;
     for (int row = 0; row < grid->rows && status == RT_OK; row++) {
         for (int column = 0; column < grid->columns && status == RT_OK; column++, tile++) {
             render_options tile_options = *options;
+            if (tile_cache != NULL)
+                tile_options.bvh_cache = tile_cache;
             int *region = tile_options.region;
             region[0] = window[0] + column * grid->tile_width;
             region[1] = window[1] + row * grid->tile_height;
@@ -430,6 +442,7 @@ rt_status job_render_tiles(job_image *image, const render_options *options, cons
             image_free(&result.light_groups);
         }
     }
+    pack_bvh_cache_free(tile_cache);
     run.total.seconds = clock_seconds() - run.start;
     run.total.stop_reason = run.any_time ? RENDER_STOP_TIME : run.any_noise ? RENDER_STOP_NOISE : RENDER_STOP_SAMPLES;
     memcpy(run.total.region, window, sizeof run.total.region);

@@ -5,7 +5,8 @@
 # the output's name, size and channels R, G, B, and the last values it received are the
 # written image's pixels; a port where nothing listens, and a viewer that hangs up after
 # its first packets, are one warning each and the render goes on; a malformed address is
-# exit 2. Needs python3 (else SKIP). About 10 s on an idle machine.
+# exit 2; a sweep shows each row as its own image. Needs python3 (else SKIP). About 12 s
+# on an idle machine.
 #   usage: sh tests/render/test-display.sh PROGRAM SCRATCH_DIR
 here=$(dirname "$0")
 . "$here/lib.sh"
@@ -57,6 +58,26 @@ for xy in "0 0" "17 9" "39 19"; do
     image_value=$(channel_mean "$scratch/shown.exr" G "$x,$y,$((x + 1)),$((y + 1))")
     if within "$viewer_value" "$image_value" 1e-6; then pass "pixel ($x, $y) in the viewer is the image's"
     else fail "pixel ($x, $y) in the viewer is the image's" "viewer '$viewer_value', image '$image_value'"; fi
+done
+
+# A sweep shows each row's image as it renders: one CreateImage per row, named by its
+# output, and the viewer's last values of each are that row's written image.
+printf 'light_x\n1\n-1\n' >"$scratch/rows.tsv"
+start_viewer
+# shellcheck disable=SC2086
+"$program" render "$scene" -o "$scratch/row-%d.exr" $small --sweep "$scratch/rows.tsv" --display "127.0.0.1:$port" \
+    2>"$scratch/stderr"
+code=$?
+wait "$viewer"
+created=$(grep '^create ' "$scratch/tev.out" | tr '\n' ';')
+if [ "$code" = 0 ] && [ "$created" = "create $scratch/row-0.exr 40 20 R G B;create $scratch/row-1.exr 40 20 R G B;" ]
+then pass "a sweep creates one image per row in the viewer, named by its output"
+else fail "a sweep creates one image per row in the viewer, named by its output" "exit $code, '$created'"; fi
+for row in 0 1; do
+    shown=$(awk -v name="$scratch/row-$row.exr" '$1 == "pixel" && $2 == name && $3 == "R" { s += $6; n++ }
+        END { if (n == 800) printf "%.9g", s / n }' "$scratch/tev.out")
+    if within "$shown" "$(channel_mean "$scratch/row-$row.exr" R)" 1e-6; then pass "row $row's image in the viewer is the written one"
+    else fail "row $row's image in the viewer is the written one" "viewer R mean '$shown'"; fi
 done
 
 # Nothing listening: a port just closed. One warning, the image written, exit 0.

@@ -6,7 +6,8 @@
 # for a scene with every kind of light in its own group with light sampling on and off;
 # relight writes 8-bit outputs tone-mapped as render does; bad input is exit 2. The
 # statistics (a layer is its light alone, relight by k is the light times k) are
-# tests/unit/test_light_groups.c. About 85 s in `make test` on the loaded machine (43 s of CPU).
+# tests/unit/test_light_groups.c. Parts of split renders (sample ranges, tiles) merge
+# with their layers. About 85 s in `make test` on the loaded machine (43 s of CPU).
 #   usage: sh tests/render/test-light-groups.sh PROGRAM SCRATCH_DIR
 here=$(dirname "$0")
 . "$here/lib.sh"
@@ -51,6 +52,12 @@ done
 groups=$(metadata "$scratch/groups.exr" light_groups)
 if [ "$groups" = "default,sky,panel,key,fill,sun" ]; then pass "rtspheres:light_groups lists the groups"
 else fail "rtspheres:light_groups lists the groups" "'$groups'"; fi
+# A render a time limit ended names its groups too (relight finds the layers by them).
+"$program" render "$scene" -o "$scratch/timed.exr" --quiet --light-groups --size 16x9 --spp 1000000 --time-limit 0.5
+stats_of "$scratch/timed.exr"
+timed="$(stat_metadata stop_reason) $(stat_metadata light_groups)"
+if [ "$timed" = "time default,sky,panel,key,fill,sun" ]; then pass "a time-limited render lists its light groups"
+else fail "a time-limited render lists its light groups" "stop reason and groups: '$timed'"; fi
 stats_of "$scratch/groups.exr"
 missing=""
 for group in default sky panel key fill sun; do
@@ -61,6 +68,46 @@ if [ -z "$missing" ]; then pass "a layer NAME.R/G/B per group"; else fail "a lay
 key=$(stat_mean key.R) all=$(stat_mean R)
 if awk -v k="$key" -v a="$all" 'BEGIN { exit !(k > 0.05 * a && k < a) }'; then pass "the key layer holds light"
 else fail "the key layer holds light" "key.R mean $key of R $all"; fi
+
+# Split renders merge their layers (rtspheres merge) as they merge the colour: two sample
+# ranges of the 16 (0:5 by --shard 0/3, 5:11 by --samples, uneven so that the weights
+# matter) within float rounding of the whole render's groups.exr, two tiles bit for bit;
+# after the merge the layers still sum to the image, pixel by pixel, and each layer
+# matches the whole render's (the key layer pixel by pixel through relight, every
+# layer's mean, min and max through stats).
+"$program" render "$scene" -o "$scratch/half0.exr" --quiet --light-groups --shard 0/3
+"$program" render "$scene" -o "$scratch/half1.exr" --quiet --light-groups --samples 5:11
+"$program" render "$scene" -o "$scratch/band0.exr" --quiet --light-groups --tile 0/2
+"$program" render "$scene" -o "$scratch/band1.exr" --quiet --light-groups --shard 1/2 --shard-by tiles
+"$program" relight "$scratch/groups.exr" -o "$scratch/whole-key.exr" --quiet --group default=0 --group sky=0 \
+    --group panel=0 --group fill=0 --group sun=0
+"$program" stats "$scratch/groups.exr" | grep '^channel .*\.[RGB]:' >"$scratch/whole.layers"
+for split in "samples 1e-5 half0 half1" "tiles 0 band0 band1"; do
+    # shellcheck disable=SC2086 # $split is a list of words
+    set -- $split
+    kind=$1 tolerance=$2 merged=$scratch/merged-$1.exr
+    problem=$(merge_problem "$scratch/groups.exr" "$tolerance" 16 "$merged" "$scratch/$3.exr" "$scratch/$4.exr")
+    if [ -n "$problem" ]; then fail "two $kind parts with light groups merge into the whole render" "$problem"
+    else pass "two $kind parts with light groups merge into the whole render (within $tolerance)"; fi
+    groups=$(metadata "$merged" light_groups)
+    if [ "$groups" = "default,sky,panel,key,fill,sun" ]; then pass "the merge of $kind parts lists the groups"
+    else fail "the merge of $kind parts lists the groups" "'$groups'"; fi
+    sums "the layers sum to the image after merging $kind parts" "$merged"
+    "$program" relight "$merged" -o "$scratch/merged-key.exr" --quiet --group default=0 --group sky=0 \
+        --group panel=0 --group fill=0 --group sun=0
+    if "$program" diff "$scratch/merged-key.exr" "$scratch/whole-key.exr" --fail "$tolerance" --failpercent 0 \
+        >"$scratch/diff" 2>&1; then pass "the merged key layer of $kind parts is the whole render's (within $tolerance)"
+    else fail "the merged key layer of $kind parts is the whole render's" "$(tr '\n' ' ' <"$scratch/diff" | head -c 300)"; fi
+    "$program" stats "$merged" | grep '^channel .*\.[RGB]:' >"$scratch/merged.layers"
+    # Each layer's mean, min and max: equal to the whole's, to the tolerance relative to each.
+    worst=$(paste -d ' ' "$scratch/whole.layers" "$scratch/merged.layers" | awk -v t="$tolerance" '
+        { n++; if ($1 != $9 || $2 != $10) { bad = bad " " $2 "<>" $10; next }
+          for (k = 4; k <= 8; k += 2) { e = $k; g = $(k + 8); d = e - g; if (d < 0) d = -d; a = e < 0 ? -e : e
+              if (d > t * a) bad = bad " " $2 " " $(k - 1) " " g " vs " e } }
+        END { if (n != 18) bad = bad " " n " layer channels"; print bad }')
+    if [ -z "$worst" ]; then pass "every merged layer of $kind parts has the whole render's mean, min and max"
+    else fail "every merged layer of $kind parts has the whole render's mean, min and max" "$worst"; fi
+done
 
 # Relighting to 8 bits: with every weight 1 it is the render's own 8-bit image (exposure
 # and tone mapping as render applies them), within one 8-bit step.
@@ -96,10 +143,8 @@ expect_refusal "--light-groups to a PNG" "only .exr keeps" "$scratch/out" \
     "$program" render "$scene" -o "$scratch/out/x.png" --light-groups
 expect_refusal "--light-groups with --denoise" "no longer sum to the image" "$scratch/out" \
     "$program" render "$scene" -o "$scratch/out/x.exr" --light-groups --denoise
-expect_refusal "--light-groups with --samples" "merge keeps no light group layers" "$scratch/out" \
-    "$program" render "$scene" -o "$scratch/out/x.exr" --light-groups --samples 0:8
-expect_refusal "--light-groups with a shard by samples" "shard by frames" "$scratch/out" \
-    "$program" render "$scene" -o "$scratch/out/x.exr" --light-groups --shard 0/2
+expect_refusal "--light-groups with --resume" "a partial file keeps no layers .*render the rest as a sample range" \
+    "$scratch/out" "$program" render "$scene" -o "$scratch/out/x.exr" --light-groups --resume "$scratch/plain.exr"
 printf 'light point 0 1 0 group a.b\n' >"$scratch/bad.txt"
 expect_refusal "a group name with a dot" "bad.txt:1:25: light group name 'a.b' has a '.'" "$scratch/out" \
     "$program" render "$scratch/bad.txt" -o "$scratch/out/x.exr" --light-groups

@@ -472,10 +472,124 @@ static void test_read_part(void **state)
     image_free(&tile);
 }
 
+/* Adds light group layers "key" and "fill" to part: key (k, 2k, 3k) and fill its colour
+ * minus key, channels ordered as an EXR lists them (alphabetically), and names the groups
+ * in metadata. */
+static rt_image with_layers(rt_image part, float k, merge_metadata *metadata)
+{
+    rt_image layered;
+    rt_error error;
+    assert_int_equal(image_create(&layered, part.width, part.height, 10, &error), RT_OK);
+    static const char *const names[10] = {"B", "G", "R", "fill.B", "fill.G", "fill.R", "key.B", "key.G", "key.R",
+                                          "samples"};
+    for (int c = 0; c < 10; c++)
+        strcpy(layered.channel_names[c], names[c]);
+    for (int i = 0; i < part.width * part.height; i++) {
+        float *in = part.pixels + 4 * i, *out = layered.pixels + 10 * i;
+        for (int c = 0; c < 3; c++) {
+            out[2 - c] = in[c];
+            out[8 - c] = k * (float)(c + 1);
+            out[5 - c] = in[c] - out[8 - c];
+        }
+        out[9] = in[3];
+    }
+    layered.x = part.x;
+    layered.y = part.y;
+    layered.full_width = part.full_width;
+    layered.full_height = part.full_height;
+    image_free(&part);
+    strcpy(metadata->light_groups, "key,fill");
+    return layered;
+}
+
+/* Light group layers merge as the colour does: two sample ranges (key 0.25 with 6
+ * samples, 0.75 with 10: 0.5625 as in test_weighted_mean) weighted, and two tiles put in
+ * place exactly; the groups in the metadata's order. Parts with other groups, or one
+ * with layers and one without, are refused naming both. */
+static void test_light_group_layers(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    merge_metadata a = make_metadata(0, 6), b = make_metadata(6, 10);
+    rt_image part_a = with_layers(make_part(0, 0, 2, 1, 0, 0, 1, 1, 1, 6), 0.25f, &a);
+    rt_image part_b = with_layers(make_part(0, 0, 2, 1, 0, 0, 1, 1, 1, 10), 0.75f, &b);
+    assert_int_equal(add(m, "a.exr", part_a, a, &error), RT_OK);
+    assert_int_equal(add(m, "b.exr", part_b, b, &error), RT_OK);
+    rt_image out, layers;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(merger_light_groups(m, &layers, &error), RT_OK);
+    assert_string_equal(summary.metadata.light_groups, "key,fill");
+    assert_int_equal(layers.channels, 6);
+    assert_string_equal(layers.channel_names[0], "key.R");
+    assert_string_equal(layers.channel_names[5], "fill.B");
+    for (int x = 0; x < 2; x++)
+        for (int c = 0; c < 3; c++) {
+            float key = pixel(&layers, x, 0)[c], fill = pixel(&layers, x, 0)[3 + c];
+            assert_true(key == 0.5625f * (float)(c + 1));
+            assert_float_equal(key + fill, pixel(&out, x, 0)[c], 1e-6);
+        }
+    image_free(&out);
+    image_free(&layers);
+    merger_free(m);
+
+    /* Two bands of a 1x2 image, each with its own key: each pixel's exactly. */
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    a = make_metadata(0, 4);
+    b = make_metadata(0, 4);
+    assert_int_equal(add(m, "top", with_layers(make_part(0, 0, 1, 1, 1, 2, 1, 1, 1, 4), 0.1f, &a), a, &error),
+                     RT_OK);
+    assert_int_equal(add(m, "bottom", with_layers(make_part(0, 1, 1, 1, 1, 2, 1, 1, 1, 4), 0.3f, &b), b, &error),
+                     RT_OK);
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(merger_light_groups(m, &layers, &error), RT_OK);
+    assert_true(pixel(&layers, 0, 0)[0] == 0.1f);
+    assert_true(pixel(&layers, 0, 1)[0] == 0.3f);
+    assert_true(pixel(&layers, 0, 1)[3] == 1.0f - 0.3f);
+    image_free(&out);
+    image_free(&layers);
+    merger_free(m);
+
+    /* Without layers there are none to merge. */
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "plain", make_part(0, 0, 1, 1, 0, 0, 1, 1, 1, 4), make_metadata(0, 4), &error), RT_OK);
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(merger_light_groups(m, &layers, &error), RT_OK);
+    assert_null(layers.pixels);
+    image_free(&out);
+    merger_free(m);
+
+    /* Mismatches. */
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    a = make_metadata(0, 4);
+    assert_int_equal(add(m, "layered.exr", with_layers(make_part(0, 0, 1, 1, 0, 0, 1, 1, 1, 4), 0.1f, &a), a, &error),
+                     RT_OK);
+    assert_int_equal(add(m, "plain.exr", make_part(0, 0, 1, 1, 0, 0, 1, 1, 1, 4), make_metadata(4, 4), &error),
+                     RT_ERROR_INPUT);
+    assert_mentions(error.message, "'layered.exr' has light groups 'key,fill' but 'plain.exr' none", NULL);
+    b = make_metadata(4, 4);
+    rt_image other = with_layers(make_part(0, 0, 1, 1, 0, 0, 1, 1, 1, 4), 0.1f, &b);
+    strcpy(b.light_groups, "key");
+    assert_int_equal(add(m, "other.exr", other, b, &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "but 'other.exr' 'key'", NULL);
+    merger_free(m);
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    a = make_metadata(0, 4);
+    rt_image lacking = make_part(0, 0, 1, 1, 0, 0, 1, 1, 1, 4);
+    strcpy(a.light_groups, "key");
+    assert_int_equal(add(m, "lacking.exr", lacking, a, &error), RT_ERROR_INPUT);
+    assert_mentions(error.message, "'lacking.exr' lists light groups 'key' but its layers are not all there",
+                    "no channel key.R", NULL);
+    merger_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_weighted_mean),
+        cmocka_unit_test(test_light_group_layers),
         cmocka_unit_test(test_uneven_and_zero_counts),
         cmocka_unit_test(test_tiles_assembled),
         cmocka_unit_test(test_tiles_with_sample_ranges),

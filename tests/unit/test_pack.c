@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "pack.h"
+#include "scene_parse.h"
 #include "packed_traverse.h"
 #include "support.h"
 #include "pack_test_scenes.h"
@@ -936,6 +937,94 @@ static void vertex_colours_are_packed_when_asked_for(void **state)
     }
 }
 
+/* Parses a scene of two world spheres (the first at x = sphere_x), an object of three
+ * spheres placed three times (kept as instances) and a point light of colour red. */
+static void bvh_cache_scene(scene *s, float sphere_x, float red)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "material m lambertian 0.5 0.5 0.5\n"
+             "sphere %g 0 0 0.5 m\n"
+             "sphere 2 0 0 0.5 m\n"
+             "group rock material m {\n"
+             "    sphere 0 1 0 0.2\n"
+             "    sphere 0.3 1 0 0.2\n"
+             "    sphere 0 1.3 0 0.2\n"
+             "}\n"
+             "instance rock {\n    translate 1 0 0\n}\n"
+             "instance rock {\n    rotate 0 1 0 30\n}\n"
+             "light point 1 3 1 color %g 1 1 intensity 4\n",
+             sphere_x, red);
+    rt_error error = {{0}};
+    if (scene_load_string(text, "cache", NULL, s, &error) != RT_OK)
+        fail_msg("%s", error.message);
+}
+
+/* Packs s with the cache (may be NULL), keeping instances, into *packed. */
+static void pack_with_cache(const scene *s, pack_bvh_cache *cache, packed_scene *packed)
+{
+    pack_options options = pack_options_defaults();
+    options.keep_instances = true;
+    options.bvh_cache = cache;
+    rt_error error = {{0}};
+    if (pack_scene(s, &options, packed, &error) != RT_OK)
+        fail_msg("%s", error.message);
+}
+
+/* The BVH cache (pack.h): a pack with it writes the texels a pack without it writes;
+ * trees over the same boxes are taken from the last pack (a light's colour changes no
+ * tree, and only the light section's texels), and a moved world sphere rebuilds the top
+ * level only, the instanced object's tree still taken. */
+static void bvh_cache_takes_trees_over_the_same_boxes(void **state)
+{
+    (void)state;
+    pack_bvh_cache *cache = NULL;
+    assert_int_equal(pack_bvh_cache_create(&cache, NULL), RT_OK);
+    scene s;
+    packed_scene plain, first, again, relit, moved, moved_plain;
+    bvh_cache_scene(&s, 0, 1);
+    pack_with_cache(&s, NULL, &plain);
+    pack_with_cache(&s, cache, &first);
+    pack_with_cache(&s, cache, &again);
+    scene_free(&s);
+    assert_int_equal(plain.bvh_built, 2); /* the top level and the rock */
+    assert_int_equal(plain.bvh_reused, 0);
+    assert_int_equal(first.bvh_built, 2);
+    assert_int_equal(first.bvh_reused, 0);
+    assert_int_equal(again.bvh_built, 0);
+    assert_int_equal(again.bvh_reused, 2);
+    assert_int_equal(first.texel_count, plain.texel_count);
+    assert_memory_equal(first.texels, plain.texels, (size_t)plain.texel_count * 16);
+    assert_memory_equal(again.texels, plain.texels, (size_t)plain.texel_count * 16);
+    assert_int_equal(again.bvh_depth, plain.bvh_depth);
+
+    bvh_cache_scene(&s, 0, 0.25f);
+    pack_with_cache(&s, cache, &relit);
+    scene_free(&s);
+    assert_int_equal(relit.bvh_built, 0);
+    assert_int_equal(relit.bvh_reused, 2);
+    assert_int_equal(relit.texel_count, plain.texel_count);
+    uint32_t light_end = plain.light_offset + plain.light_count * PACKED_LIGHT_STRIDE;
+    assert_memory_equal(relit.texels, plain.texels, (size_t)plain.light_offset * 16);
+    assert_memory_not_equal(relit.texels + 4 * plain.light_offset, plain.texels + 4 * plain.light_offset,
+                            (size_t)(light_end - plain.light_offset) * 16);
+    assert_memory_equal(relit.texels + 4 * light_end, plain.texels + 4 * light_end,
+                        (size_t)(plain.texel_count - light_end) * 16);
+
+    bvh_cache_scene(&s, -3, 0.25f);
+    pack_with_cache(&s, cache, &moved);
+    pack_with_cache(&s, NULL, &moved_plain);
+    scene_free(&s);
+    assert_int_equal(moved.bvh_built, 1);
+    assert_int_equal(moved.bvh_reused, 1);
+    assert_int_equal(moved.texel_count, moved_plain.texel_count);
+    assert_memory_equal(moved.texels, moved_plain.texels, (size_t)moved_plain.texel_count * 16);
+    packed_scene *all[] = {&plain, &first, &again, &relit, &moved, &moved_plain};
+    for (size_t i = 0; i < sizeof all / sizeof *all; i++)
+        packed_scene_free(all[i]);
+    pack_bvh_cache_free(cache);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -951,6 +1040,7 @@ int main(void)
         cmocka_unit_test(mesh_vertices_are_stored_once),
         cmocka_unit_test(vertex_colours_are_packed_when_asked_for),
         cmocka_unit_test(degenerate_and_duplicate_triangles),
+        cmocka_unit_test(bvh_cache_takes_trees_over_the_same_boxes),
     };
     return cmocka_run_group_tests_name("pack", tests, NULL, NULL);
 }
