@@ -429,6 +429,7 @@ release_requeued() {
     timeout 10 scontrol update "JobId=$1" StartTime=now >/dev/null 2>&1 || true
 }
 
+
 # (d) An animation by frames (submit.sh with --frames: no merge): 2 tasks render frames
 # 0-3; then task 0 is requeued (as Slurm does after a node failure or preemption): it
 # skips its finished frames 0 and 2 (--skip-existing), says so in its log, and leaves
@@ -451,14 +452,36 @@ else
     else
         cksum "$frames_dir"/frame-0000.exr "$frames_dir"/frame-0002.exr >"$tmp/frames.before"
         log=$frames_dir/logs/render-${render_job}_0.log
-        if ! timeout 10 scontrol requeue "${render_job}_0" >"$tmp/requeue.out" 2>&1; then
-            fail "$name" "scontrol requeue ${render_job}_0 failed: $(tr '\n' ' ' <"$tmp/requeue.out")"
-        elif ! release_requeued "${render_job}_0" || ! wait_jobs 90 "$render_job"; then
-            fail "$name" "requeued task not done after 90 s: $(job_states "$render_job" | tr '\n' ' ')"
+        # requeue_task_0: requeues task 0 and waits for it; false when either fails.
+        requeue_task_0() {
+            if ! timeout 10 scontrol requeue "${render_job}_0" >"$tmp/requeue.out" 2>&1; then
+                fail "$name" "scontrol requeue ${render_job}_0 failed: $(tr '\n' ' ' <"$tmp/requeue.out")"
+                return 1
+            elif ! release_requeued "${render_job}_0" || ! wait_jobs 90 "$render_job"; then
+                fail "$name" "requeued task not done after 90 s: $(job_states "$render_job" | tr '\n' ' ')"
+                return 1
+            fi
+        }
+        launched=$(grep -c '^render-array.sbatch: task 0 ' "$log" 2>/dev/null)
+        requeued=yes
+        if ! requeue_task_0; then
+            requeued=no
+        elif ! job_states "$render_job" | grep -q '^0 COMPLETED 0:0$' &&
+             [ "$(grep -c '^render-array.sbatch: task 0 ' "$log" 2>/dev/null)" = "$launched" ]; then
+            # The requeued task failed without its script starting (its log has no second
+            # header line): seen in 1 of 2 to 1 of 10 runs here, slurmctld allocating the
+            # task and ending it with WEXITSTATUS 1 in the same millisecond, slurmd never
+            # launching it. That is Slurm's failure, not the rerun this check is about:
+            # requeue once more, and say so.
+            echo "test-slurm: the requeued task 0 failed before its script started (Slurm); requeued again"
+            requeue_task_0 || requeued=no
+        fi
+        if [ "$requeued" = no ]; then
+            :
         else
             cksum "$frames_dir"/frame-0000.exr "$frames_dir"/frame-0002.exr >"$tmp/frames.after"
             if ! job_states "$render_job" | grep -q '^0 COMPLETED 0:0$'; then
-                fail "$name" "requeued task 0: $(job_states "$render_job" | tr '\n' ' ')"
+                fail "$name" "requeued task 0: $(job_states "$render_job" | tr '\n' ' '); its log: $(tail -c 600 "$log" 2>/dev/null | tr '\n' ' '); slurmctld: $(grep -F "$render_job" "$tmp/log/slurmctld.log" 2>/dev/null | tail -n 6 | tr '\n' ' '); slurmd: $(tail -n 8 "$tmp/log/slurmd.log" 2>/dev/null | tr '\n' ' ')"
             elif ! grep -q "^rtspheres: frame 0: skipped: .*frame-0000.exr is complete" "$log" ||
                  ! grep -q "^rtspheres: frame 2: skipped: .*frame-0002.exr is complete" "$log"; then
                 fail "$name" "the requeued task's log does not say it skipped frames 0 and 2: $(tr '\n' ' ' <"$log" | head -c 600)"
