@@ -88,6 +88,19 @@ static void make_attributes(const render_output_metadata *metadata, output_attri
     attributes->count = count;
 }
 
+/* The write options of an output with metadata's attributes (held in *attributes, which
+ * must outlive the options) and exposure: what render_output_write and a stream share. */
+static image_write_options output_write_options(const render_output_metadata *metadata, float exposure,
+                                                output_attributes *attributes)
+{
+    make_attributes(metadata, attributes);
+    image_write_options options = image_write_options_defaults();
+    options.exposure = exposure;
+    options.attributes = attributes->list;
+    options.attribute_count = attributes->count;
+    return options;
+}
+
 rt_status render_output_write(const char *path, const rt_image *image, const rt_image *layers,
                               const render_output_metadata *metadata, float exposure, rt_error *error)
 {
@@ -99,11 +112,7 @@ rt_status render_output_write(const char *path, const rt_image *image, const rt_
         return status;
     }
     output_attributes attributes;
-    make_attributes(metadata, &attributes);
-    image_write_options options = image_write_options_defaults();
-    options.exposure = exposure;
-    options.attributes = attributes.list;
-    options.attribute_count = attributes.count;
+    image_write_options options = output_write_options(metadata, exposure, &attributes);
     status = image_write(path, written, &options, error);
     image_free(&made);
     return status;
@@ -128,11 +137,7 @@ rt_status render_output_stream_open(const char *path, const rt_image *layout, co
         memset(written.channel_names, 0, sizeof written.channel_names);
     }
     output_attributes attributes;
-    make_attributes(metadata, &attributes);
-    image_write_options options = image_write_options_defaults();
-    options.exposure = exposure;
-    options.attributes = attributes.list;
-    options.attribute_count = attributes.count;
+    image_write_options options = output_write_options(metadata, exposure, &attributes);
     rt_status status = image_stream_open(path, &written, &options, &(*out)->stream, error);
     if (status != RT_OK) {
         free(*out);
