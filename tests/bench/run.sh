@@ -199,12 +199,12 @@ bench() {
 # `render --sweep` against ROWS separate renders of the same rows, wall seconds each, as
 # the rows sweep-ROWS (the sweep) and sweep-ROWS-separate (the renders together).
 bench_sweep() {
-    rows=$1 size=$2 spp=$3
+    sweep_rows=$1 size=$2 spp=$3
     table=$work/sweep.tsv
     printf 'light_x\tlight_z\n' >"$table"
     i=0
-    while [ "$i" -lt "$rows" ]; do
-        printf '4*cos(2*pi*%d/%d)\t4*sin(2*pi*%d/%d)\n' "$i" "$rows" "$i" "$rows" >>"$table"
+    while [ "$i" -lt "$sweep_rows" ]; do
+        printf '4*cos(2*pi*%d/%d)\t4*sin(2*pi*%d/%d)\n' "$i" "$sweep_rows" "$i" "$sweep_rows" >>"$table"
         i=$((i + 1))
     done
     start=$(date +%s.%N)
@@ -212,17 +212,17 @@ bench_sweep() {
         --quiet || failures=$((failures + 1))
     middle=$(date +%s.%N)
     i=0
-    while [ "$i" -lt "$rows" ]; do
+    while [ "$i" -lt "$sweep_rows" ]; do
         "$program" render scenes/three-balls.txt -o "$work/separate-$i.exr" --size "$size" --spp "$spp" --quiet \
-            -D "light_x=4*cos(2*pi*$i/$rows)" -D "light_z=4*sin(2*pi*$i/$rows)" || failures=$((failures + 1))
+            -D "light_x=4*cos(2*pi*$i/$sweep_rows)" -D "light_z=4*sin(2*pi*$i/$sweep_rows)" || failures=$((failures + 1))
         i=$((i + 1))
     done
     end=$(date +%s.%N)
     sweep_wall=$(awk -v a="$start" -v b="$middle" 'BEGIN { printf "%.3f", b - a }')
     separate_wall=$(awk -v a="$middle" -v b="$end" 'BEGIN { printf "%.3f", b - a }')
-    record "sweep-$rows" "$size" "$spp" "$rows" 0 "$sweep_wall" - - - - - - - - - - "--sweep, one process"
-    record "sweep-$rows-separate" "$size" "$spp" "$rows" 0 "$separate_wall" - - - - - - - - - - \
-        "$rows separate renders"
+    record "sweep-$sweep_rows" "$size" "$spp" "$sweep_rows" 0 "$sweep_wall" - - - - - - - - - - "--sweep, one process"
+    record "sweep-$sweep_rows-separate" "$size" "$spp" "$sweep_rows" 0 "$separate_wall" - - - - - - - - - - \
+        "$sweep_rows separate renders"
 }
 
 # Renders the three-ball animation (frames 0 .. FRAMES-1 on one GPU context) as NAME and
