@@ -12,9 +12,6 @@ struct adaptive_sampler {
     uint32_t *limits;            /* per pixel, rows top to bottom */
     uint8_t *going;              /* 1: the pixel still takes samples */
     uint8_t *unconverged;        /* scratch of adaptive_check */
-    int tiles_x, tiles_y;
-    uint8_t *tile_going;         /* per tile: a pixel of it is going */
-    uint8_t *tile_stopped_now;   /* per tile: the last check stopped its last pixel */
     bool stopped_early;
     adaptive_noise noise;        /* of the last check */
 };
@@ -53,8 +50,6 @@ void adaptive_free(adaptive_sampler *sampler)
     free(sampler->limits);
     free(sampler->going);
     free(sampler->unconverged);
-    free(sampler->tile_going);
-    free(sampler->tile_stopped_now);
     free(sampler);
 }
 
@@ -65,17 +60,11 @@ rt_status adaptive_create(int width, int height, float threshold, uint32_t min_s
     adaptive_sampler *sampler = calloc(1, sizeof *sampler);
     size_t pixels = (size_t)width * height;
     if (sampler != NULL) {
-        sampler->tiles_x = (width + ADAPTIVE_TILE_SIZE - 1) / ADAPTIVE_TILE_SIZE;
-        sampler->tiles_y = (height + ADAPTIVE_TILE_SIZE - 1) / ADAPTIVE_TILE_SIZE;
-        size_t tiles = (size_t)sampler->tiles_x * sampler->tiles_y;
         sampler->limits = malloc(pixels * sizeof *sampler->limits);
         sampler->going = malloc(pixels);
         sampler->unconverged = malloc(pixels);
-        sampler->tile_going = malloc(tiles);
-        sampler->tile_stopped_now = calloc(tiles, 1);
     }
-    if (sampler == NULL || !sampler->limits || !sampler->going || !sampler->unconverged || !sampler->tile_going
-        || !sampler->tile_stopped_now) {
+    if (sampler == NULL || !sampler->limits || !sampler->going || !sampler->unconverged) {
         adaptive_free(sampler);
         return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for adaptive sampling");
     }
@@ -88,7 +77,6 @@ rt_status adaptive_create(int width, int height, float threshold, uint32_t min_s
     for (size_t i = 0; i < pixels; i++)
         sampler->limits[i] = first;
     memset(sampler->going, 1, pixels);
-    memset(sampler->tile_going, 1, (size_t)sampler->tiles_x * sampler->tiles_y);
     *out = sampler;
     return RT_OK;
 }
@@ -117,21 +105,6 @@ static bool neighbourhood_unconverged(const adaptive_sampler *sampler, int x, in
         }
     }
     return false;
-}
-
-/* Marks the tiles with a pixel going, and those whose last pixel just stopped. */
-static void update_tiles(adaptive_sampler *sampler)
-{
-    size_t tiles = (size_t)sampler->tiles_x * sampler->tiles_y;
-    uint8_t *was_going = sampler->tile_stopped_now;
-    memcpy(was_going, sampler->tile_going, tiles);
-    memset(sampler->tile_going, 0, tiles);
-    for (int y = 0; y < sampler->height; y++)
-        for (int x = 0; x < sampler->width; x++)
-            if (sampler->going[(size_t)y * sampler->width + x])
-                sampler->tile_going[(size_t)(y / ADAPTIVE_TILE_SIZE) * sampler->tiles_x + x / ADAPTIVE_TILE_SIZE] = 1;
-    for (size_t i = 0; i < tiles; i++)
-        was_going[i] = was_going[i] && !sampler->tile_going[i];
 }
 
 int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *luminance_squares)
@@ -173,7 +146,6 @@ int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *lu
                 sampler->limits[i] = samples;
             }
         }
-    update_tiles(sampler);
     sampler->noise.going_pixels = going;
     return going;
 }
@@ -183,31 +155,12 @@ void adaptive_get_noise(const adaptive_sampler *sampler, adaptive_noise *noise)
     *noise = sampler->noise;
 }
 
-int adaptive_rectangle_capacity(const adaptive_sampler *sampler)
-{
-    return sampler->tiles_x * sampler->tiles_y;
-}
-
-int adaptive_pass_rectangles(const adaptive_sampler *sampler, bool settle, int *rectangles)
+int adaptive_going_pixels(const adaptive_sampler *sampler, uint32_t *pixels)
 {
     int count = 0;
-    for (int ty = 0; ty < sampler->tiles_y; ty++) {
-        int run_start = -1;
-        for (int tx = 0; tx <= sampler->tiles_x; tx++) {
-            size_t t = (size_t)ty * sampler->tiles_x + tx;
-            bool drawn = tx < sampler->tiles_x && (sampler->tile_going[t] || (settle && sampler->tile_stopped_now[t]));
-            if (drawn && run_start < 0)
-                run_start = tx;
-            if (!drawn && run_start >= 0) {
-                int *r = rectangles + 4 * count++;
-                r[0] = run_start * ADAPTIVE_TILE_SIZE;
-                r[1] = ty * ADAPTIVE_TILE_SIZE;
-                int x1 = tx * ADAPTIVE_TILE_SIZE, y1 = (ty + 1) * ADAPTIVE_TILE_SIZE;
-                r[2] = x1 < sampler->width ? x1 : sampler->width;
-                r[3] = y1 < sampler->height ? y1 : sampler->height;
-                run_start = -1;
-            }
-        }
-    }
+    size_t total = (size_t)sampler->width * sampler->height;
+    for (size_t i = 0; i < total; i++)
+        if (sampler->going[i])
+            pixels[count++] = (uint32_t)i;
     return count;
 }

@@ -30,10 +30,10 @@
  * depends on the pixels within k of it: adaptive_reach() says how far, which is how far
  * core/render.c renders around a region so that tiles merge into the full render exactly.
  *
- * ## Tiles (for the passes, see core/gpu_tracer.c gpu_tracer_set_pass_rectangles)
- * The image is cut into ADAPTIVE_TILE_SIZE squares; a pass draws only tiles with a pixel
- * still going, and, for one pass after a check, the tiles that just stopped (the tracer's
- * ping-pong state sets must both hold a stopped tile's state before it is left alone).
+ * ## The passes
+ * After a check, passes trace only the pixels still going (adaptive_going_pixels), packed
+ * densely by the tracer (gpu.h gpu_tracer_set_pass_pixels, core/gpu_compact.c), so that
+ * no SIMD lane idles on a pixel that has stopped.
  */
 #ifndef RT_ADAPTIVE_H
 #define RT_ADAPTIVE_H
@@ -45,7 +45,6 @@
 
 #define ADAPTIVE_DEFAULT_MIN_SPP 16
 #define ADAPTIVE_LUMINANCE_FLOOR 0.2f
-#define ADAPTIVE_TILE_SIZE 8
 
 typedef struct adaptive_sampler adaptive_sampler;
 
@@ -94,13 +93,8 @@ void adaptive_get_noise(const adaptive_sampler *sampler, adaptive_noise *noise);
 /* True when some pixel stopped below max_spp (the threshold, not --spp, ended it). */
 bool adaptive_stopped_early(const adaptive_sampler *sampler);
 
-/* Writes the rectangles the next pass draws (x0, y0, x1, y1 of the image, rows from the
- * top, x1/y1 exclusive; horizontal runs of tiles joined) into rectangles (room for
- * adaptive_rectangle_capacity()) and returns their count. settle: the first pass after
- * a check, which also draws the tiles that check stopped. */
-int adaptive_pass_rectangles(const adaptive_sampler *sampler, bool settle, int *rectangles);
-
-/* The most rectangles adaptive_pass_rectangles() can write (4 ints each). */
-int adaptive_rectangle_capacity(const adaptive_sampler *sampler);
+/* Writes the pixels still going (indices y * width + x, rows from the top, in that
+ * order) into pixels (room for width * height) and returns their count. */
+int adaptive_going_pixels(const adaptive_sampler *sampler, uint32_t *pixels);
 
 #endif

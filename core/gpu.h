@@ -138,6 +138,11 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_ALPHA_MASK      no alpha-masked material (the traversal's alpha test)
  *   GPU_OMIT_VERTEX_COLORS   no vertex colour section
  *   GPU_OMIT_LIGHT_GROUPS    no light group layers asked for (render_options.light_groups)
+ *   GPU_OMIT_SPHERE_LIGHTS, GPU_OMIT_TRIANGLE_LIGHTS, GPU_OMIT_DELTA_LIGHTS (point, spot,
+ *   GPU_OMIT_ENVIRONMENT_LIGHT  sun)  no light of that kind in the light section
+ *   GPU_OMIT_MANY_LIGHTS     at most one light: no light to choose, no search for a hit
+ *                            emitter's light
+ *   GPU_OMIT_LAMBERTIAN, GPU_OMIT_METAL, GPU_OMIT_DIELECTRIC  no material of that kind
  *   GPU_FIX_UNIFORMS         the integrator, the sky type and the sampler compiled in as constants
  *                            (the values in the parameters), not read from the
  *                            parameter block
@@ -158,7 +163,15 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_ALPHA_MASK (1u << 13)
 #define GPU_OMIT_VERTEX_COLORS (1u << 14)
 #define GPU_OMIT_LIGHT_GROUPS (1u << 15)
-#define GPU_VARIANT_BITS 16
+#define GPU_OMIT_SPHERE_LIGHTS (1u << 16)
+#define GPU_OMIT_TRIANGLE_LIGHTS (1u << 17)
+#define GPU_OMIT_DELTA_LIGHTS (1u << 18)
+#define GPU_OMIT_ENVIRONMENT_LIGHT (1u << 19)
+#define GPU_OMIT_MANY_LIGHTS (1u << 20)
+#define GPU_OMIT_LAMBERTIAN (1u << 21)
+#define GPU_OMIT_METAL (1u << 22)
+#define GPU_OMIT_DIELECTRIC (1u << 23)
+#define GPU_VARIANT_BITS 24
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct
@@ -241,13 +254,16 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
  * (core/adaptive.h). */
 rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limits, rt_error *error);
 
-/* Makes the following passes run only the pixels of count rectangles (4 ints each: x0, y0,
- * x1, y1 of the image, rows from the top, x1/y1 exclusive; copied). A pixel outside is
- * not written, so the state set the pass writes keeps what it held two passes before:
- * leave a pixel out only once a pass has run it without changing it, so that both sets
- * hold its state (core/adaptive.h, "Tiles").
- * rectangles NULL: every pixel again (the default). */
-rt_status gpu_tracer_set_pass_rectangles(gpu_tracer *tracer, const int *rectangles, int count, rt_error *error);
+/* Makes the following passes run only the count pixels of pixels (indices y * width + x,
+ * rows from the top, each at most once; copied), packed densely (core/gpu_compact.c), so
+ * that the lanes of a SIMD vector are all pixels of the list: what adaptive sampling
+ * (core/adaptive.h) saves shows on the clock. Pixels left out keep their state; the
+ * image is the same to the bit as with every pixel traced. pixels NULL: every pixel again
+ * (the default). Costs two copies of the listed pixels' state (a pass's reading and
+ * writing of it), and the compact state: GPU_TRACER_STATE_BYTES_PER_PIXEL a pixel of the
+ * first list, kept until the tracer is destroyed. RT_ERROR_RUNTIME
+ * when the device runs out of memory. */
+rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels, int count, rt_error *error);
 
 /* Reads the accumulated result: rgba receives width*height*4 floats, rows top to bottom,
  * (sum of finished samples' radiance r, g, b, number of finished samples);

@@ -7,6 +7,7 @@
 #include <epoxy/gl.h>
 
 #include "gpu.h"
+#include "tracer_interface.h"
 
 /* Tracer variants kept per context: a render uses one (and the AOV pass one more); an
  * animation or sweep keeps using the same few. */
@@ -20,7 +21,7 @@ struct gpu_context {
     /* Kept between renders on this context (frames of an animation, a sweep): the
      * compiled tracer, and the last packed scene uploaded with its hash. */
     struct {                              /* compiled tracer variants, by variant key */
-        uint32_t key;
+        uint64_t key;
         GLuint program;
     } tracer_programs[GPU_PROGRAM_CACHE_SIZE];
     int tracer_program_count;
@@ -36,6 +37,57 @@ struct gpu_context {
 
 /* Texels per block of the packed scene's partial upload (16 KiB). */
 #define GPU_PACKED_BLOCK_TEXELS 1024u
+
+/* Compacted passes of a tracer (gpu.h gpu_tracer_set_pass_pixels; core/gpu_compact.c):
+ * the pixels still going, packed into two ping-pong sets of compact state textures. */
+typedef struct gpu_compact {
+    int count;                   /* pixels traced compactly; 0: passes draw the whole image */
+    int width, height;           /* of the compact textures (0: none made yet) */
+    GLuint state_textures[2][TRACER_STATE_COUNT];
+    GLuint framebuffers[2];
+    GLuint pixel_map;            /* R32UI, width x height (core/tracer_interface.h) */
+    GLuint gather_program, scatter_program;
+    int current;                 /* which compact set holds the latest pass */
+    bool unsaved;                /* the compact set is newer than the full state */
+} gpu_compact;
+
+struct gpu_tracer {
+    gpu_context *context;
+    int width, height;
+    GLuint program;
+    GLuint vertex_array;
+    GLuint packed_texture;
+    GLuint packed_buffer;
+    GLuint state_textures[2][TRACER_STATE_COUNT];
+    GLuint framebuffers[2];
+    GLuint counter_buffer;
+    GLuint parameter_buffer;     /* the parameter block (tracer_parameter_block) */
+    GLuint sample_limits;        /* R32UI per-pixel sample limits (TRACER_SAMPLE_LIMITS_UNIT) */
+    gpu_compact compact;         /* compacted passes (gpu_compact.c) */
+    GLuint light_group_texture;  /* the light group layers (2D array, rgba32f), or 0 when the
+                                  * program has no light group code */
+    int current;                 /* which state set holds the latest pass */
+    gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
+    bool reused_scene;           /* the packed scene was already on the device */
+    uint64_t uploaded_bytes;     /* of the packed scene, uploaded for this tracer */
+    bool compiled_program;       /* its program was compiled for it (not in the cache) */
+    gpu_tracer_timings timings;
+};
+
+/* Writes the compact state back to the full state textures of the current set when it is
+ * newer (gpu_compact.c): every read of the state calls it first. */
+rt_status gpu_compact_save(gpu_tracer *tracer, rt_error *error);
+
+/* Frees the tracer's compact state and programs. */
+void gpu_compact_destroy(gpu_tracer *tracer);
+
+/* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
+rt_status gpu_check_gl(const char *step, rt_error *error);
+
+/* Builds a program of the vertex shader vertex_source and the fragment program program
+ * (SHADER_PROGRAM_* of core/shader_sources.h), both after "#version 450 core" and defines.
+ * Returns the program or 0 with error set (the compiler's messages naming the modules). */
+GLuint gpu_build_program(const char *vertex_source, uintptr_t program, const char *defines, rt_error *error);
 
 /* Frees what the tracer keeps on the context (compiled programs, the packed scene);
  * gpu_destroy() calls it while the context is still current. In gpu_tracer.c. */

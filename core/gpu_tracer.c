@@ -11,32 +11,8 @@
 #include "hash.h"
 #include "shader_sources.h"
 
-struct gpu_tracer {
-    gpu_context *context;
-    int width, height;
-    GLuint program;
-    GLuint vertex_array;
-    GLuint packed_texture;
-    GLuint packed_buffer;
-    GLuint state_textures[2][TRACER_STATE_COUNT];
-    GLuint framebuffers[2];
-    GLuint counter_buffer;
-    GLuint parameter_buffer;     /* the parameter block (tracer_parameter_block) */
-    GLuint sample_limits;        /* R32UI per-pixel sample limits (TRACER_SAMPLE_LIMITS_UNIT) */
-    int *pass_rectangles;        /* 4 ints each (gpu_tracer_set_pass_rectangles); NULL: all */
-    int pass_rectangle_count;
-    GLuint light_group_texture;  /* the light group layers (2D array, rgba32f), or 0 when the
-                                  * program has no light group code */
-    int current;                 /* which state set holds the latest pass */
-    gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
-    bool reused_scene;           /* the packed scene was already on the device */
-    uint64_t uploaded_bytes;     /* of the packed scene, uploaded for this tracer */
-    bool compiled_program;       /* its program was compiled for it (not in the cache) */
-    gpu_tracer_timings timings;
-};
 
-/* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
-static rt_status check_gl(const char *step, rt_error *error)
+rt_status gpu_check_gl(const char *step, rt_error *error)
 {
     GLenum code = glGetError();
     if (code == GL_NO_ERROR)
@@ -168,12 +144,10 @@ static GLuint compile_fragment_program(uintptr_t program, const char *defines, r
     return shader;
 }
 
-/* Builds a program of the shared vertex shader and the fragment program (SHADER_PROGRAM_*)
- * with defines. Returns the program or 0 with error set. */
-static GLuint build_fragment_program(uintptr_t program, const char *defines, rt_error *error)
+GLuint gpu_build_program(const char *vertex_source, uintptr_t program, const char *defines, rt_error *error)
 {
-    const char *vertex_parts[] = {"#version 450 core\n", shader_source_fullscreen_vertex};
-    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 2, error);
+    const char *vertex_parts[] = {"#version 450 core\n", defines, vertex_source};
+    GLuint vertex = compile_stage(GL_VERTEX_SHADER, vertex_parts, 3, error);
     if (vertex == 0)
         return 0;
     GLuint fragment = compile_fragment_program(program, defines, error);
@@ -182,6 +156,13 @@ static GLuint build_fragment_program(uintptr_t program, const char *defines, rt_
         return 0;
     }
     return link_program(vertex, fragment, error);
+}
+
+/* Builds a program of the shared full-screen vertex shader and the fragment program
+ * (SHADER_PROGRAM_*) with defines. Returns the program or 0 with error set. */
+static GLuint build_fragment_program(uintptr_t program, const char *defines, rt_error *error)
+{
+    return gpu_build_program(shader_source_fullscreen_vertex, program, defines, error);
 }
 
 /* Writes the #defines of a tracer variant into defines (size bytes): every
@@ -211,6 +192,14 @@ static void variant_defines(uint32_t omitted, const tracer_parameter_block *sett
         {GPU_OMIT_LIGHT_CHOICE, "RTSPHERES_OMIT_LIGHT_CHOICE"},
         {GPU_OMIT_RECTANGLE_LIGHTS, "RTSPHERES_OMIT_RECTANGLE_LIGHTS"},
         {GPU_OMIT_LIGHT_GROUPS, "RTSPHERES_OMIT_LIGHT_GROUPS"},
+        {GPU_OMIT_SPHERE_LIGHTS, "RTSPHERES_OMIT_SPHERE_LIGHTS"},
+        {GPU_OMIT_TRIANGLE_LIGHTS, "RTSPHERES_OMIT_TRIANGLE_LIGHTS"},
+        {GPU_OMIT_DELTA_LIGHTS, "RTSPHERES_OMIT_DELTA_LIGHTS"},
+        {GPU_OMIT_ENVIRONMENT_LIGHT, "RTSPHERES_OMIT_ENVIRONMENT_LIGHT"},
+        {GPU_OMIT_MANY_LIGHTS, "RTSPHERES_OMIT_MANY_LIGHTS"},
+        {GPU_OMIT_LAMBERTIAN, "RTSPHERES_OMIT_LAMBERTIAN"},
+        {GPU_OMIT_METAL, "RTSPHERES_OMIT_METAL"},
+        {GPU_OMIT_DIELECTRIC, "RTSPHERES_OMIT_DIELECTRIC"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;
@@ -226,13 +215,13 @@ static void variant_defines(uint32_t omitted, const tracer_parameter_block *sett
 
 /* The key of a variant in the context's program cache: the bits, and the constants
  * compiled in with GPU_FIX_UNIFORMS. */
-static uint32_t variant_key(uint32_t omitted, const tracer_parameter_block *settings)
+static uint64_t variant_key(uint32_t omitted, const tracer_parameter_block *settings)
 {
-    omitted &= (1u << GPU_VARIANT_BITS) - 1u;
+    uint64_t key = omitted & ((1u << GPU_VARIANT_BITS) - 1u);
     if (omitted & GPU_FIX_UNIFORMS)
-        return omitted | (uint32_t)(settings->integrator & 3) << 16 | (uint32_t)(settings->sky_type & 15) << 20
-               | (uint32_t)(settings->sampler & 3) << 24;
-    return omitted;
+        return key | (uint64_t)(settings->integrator & 3) << 32 | (uint64_t)(settings->sky_type & 15) << 36
+               | (uint64_t)(settings->sampler & 3) << 40;
+    return key;
 }
 
 /* The context's tracer program for the variant of the parameters (omitted_features,
@@ -242,13 +231,13 @@ static rt_status build_program(gpu_tracer *tracer, const gpu_tracer_parameters *
 {
     gpu_context *context = tracer->context;
     uint32_t omitted = parameters->omitted_features;
-    uint32_t key = variant_key(omitted, &parameters->shader);
+    uint64_t key = variant_key(omitted, &parameters->shader);
     for (int i = 0; i < context->tracer_program_count; i++)
         if (context->tracer_programs[i].key == key) {
             tracer->program = context->tracer_programs[i].program;
             return RT_OK;
         }
-    char defines[1024];
+    char defines[2048];
     variant_defines(omitted, &parameters->shader, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
     if (program == 0)
@@ -310,7 +299,7 @@ static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels,
         return status;
     create_buffer_texture(GL_RGBA32UI, texels, (size_t)texel_count * 4 * sizeof(uint32_t), &tracer->packed_buffer,
                           &tracer->packed_texture);
-    return check_gl("uploading the packed scene", error);
+    return gpu_check_gl("uploading the packed scene", error);
 }
 
 /* The message of a device that could not hold a width x height image's state (bytes of
@@ -371,7 +360,7 @@ static rt_status update_packed_scene(gpu_tracer *tracer, const uint32_t *texels,
         tracer->uploaded_bytes += bytes;
     }
     glBindBuffer(GL_TEXTURE_BUFFER, 0);
-    return check_gl("updating the packed scene", error);
+    return gpu_check_gl("updating the packed scene", error);
 }
 
 /* Creates both sets of state textures (zeroed) and their framebuffers. */
@@ -435,7 +424,7 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32UI, tracer->width, tracer->height);
     const GLuint no_limit[4] = {UINT32_MAX, 0, 0, 0};
     glClearTexImage(tracer->sample_limits, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, no_limit);
-    rt_status status = check_gl("creating the state textures", error);
+    rt_status status = gpu_check_gl("creating the state textures", error);
     if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
         return state_out_of_memory(tracer, "GL_OUT_OF_MEMORY", error);
     return status;
@@ -456,7 +445,7 @@ static rt_status create_light_groups(gpu_tracer *tracer, rt_error *error)
     const GLfloat zero[4] = {0, 0, 0, 0};
     glClearTexImage(tracer->light_group_texture, 0, GL_RGBA, GL_FLOAT, zero);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
-    rt_status status = check_gl("creating the light group layers", error);
+    rt_status status = gpu_check_gl("creating the light group layers", error);
     if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
         return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for %u light group layers of %dx%d (%d MB)",
                             layers, width, height, (int)((double)width * height * 16 * layers / 1e6));
@@ -490,7 +479,7 @@ static rt_status load_resume_state(gpu_tracer *tracer, const float *resume, rt_e
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA_INTEGER, GL_UNSIGNED_INT, counters);
     free(sums);
     free(counters);
-    return check_gl("loading the partial render", error);
+    return gpu_check_gl("loading the partial render", error);
 }
 
 /* Returns budget within what the device's work bound allows (gpu.h). */
@@ -597,7 +586,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     upload_parameters(tracer);
     status = create_light_groups(tracer, error);
     if (status == RT_OK)
-        status = check_gl("setting up the tracer", error);
+        status = gpu_check_gl("setting up the tracer", error);
     if (status != RT_OK) {
         gpu_tracer_destroy(tracer);
         return status;
@@ -608,19 +597,33 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
 
 rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_error *error)
 {
-    int source = tracer->current, target = 1 - tracer->current;
+    /* A compacted pass reads and writes the compact sets (gpu_compact.c), the others the
+     * full ones. */
+    gpu_compact *compact = &tracer->compact;
+    bool compacted = compact->count > 0;
+    int source = compacted ? compact->current : tracer->current, target = 1 - source;
+    const GLuint *source_textures = compacted ? compact->state_textures[source] : tracer->state_textures[source];
+    if (tracer->parameters.shader.compact_pixels != (uint32_t)compacted) {
+        tracer->parameters.shader.compact_pixels = compacted;
+        update_parameter(tracer, offsetof(tracer_parameter_block, compact_pixels), compacted);
+    }
     const GLuint zero[2] = {0, 0};
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
     glBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof zero, zero);
-    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[target]);
-    glViewport(0, 0, tracer->width, tracer->height);
+    glBindFramebuffer(GL_FRAMEBUFFER, compacted ? compact->framebuffers[target] : tracer->framebuffers[target]);
+    if (compacted)
+        glViewport(0, 0, compact->width, compact->height);
+    else
+        glViewport(0, 0, tracer->width, tracer->height);
     glUseProgram(tracer->program);
     glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
     for (int state = 0; state < TRACER_STATE_COUNT; state++) {
         glActiveTexture(GL_TEXTURE0 + state);
-        glBindTexture(GL_TEXTURE_2D, tracer->state_textures[source][state]);
+        glBindTexture(GL_TEXTURE_2D, source_textures[state]);
     }
+    glActiveTexture(GL_TEXTURE0 + TRACER_PIXEL_MAP_UNIT);
+    glBindTexture(GL_TEXTURE_2D, compacted ? compact->pixel_map : 0);
     glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
     glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
     glActiveTexture(GL_TEXTURE0 + TRACER_SAMPLE_LIMITS_UNIT);
@@ -629,28 +632,22 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
         glBindImageTexture(TRACER_LIGHT_GROUP_IMAGE_UNIT, tracer->light_group_texture, 0, GL_TRUE, 0, GL_READ_WRITE,
                            GL_RGBA32F);
     glBindVertexArray(tracer->vertex_array);
-    if (tracer->pass_rectangles == NULL) {
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-    } else {
-        /* One scissored full-screen triangle per rectangle: only its pixels run. */
-        glEnable(GL_SCISSOR_TEST);
-        for (int i = 0; i < tracer->pass_rectangle_count; i++) {
-            const int *r = tracer->pass_rectangles + 4 * i;
-            glScissor(r[0], tracer->height - r[3], r[2] - r[0], r[3] - r[1]);
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-        }
-        glDisable(GL_SCISSOR_TEST);
-    }
+    glDrawArrays(GL_TRIANGLES, 0, 3);
     /* Image stores of this pass are read by the next pass and by the read-back. */
     glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT
                     | (tracer->light_group_texture != 0 ? GL_SHADER_IMAGE_ACCESS_BARRIER_BIT
                                                               | GL_TEXTURE_UPDATE_BARRIER_BIT : 0));
     GLuint counters[2] = {0, 0};
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof counters, counters);
-    tracer->current = target;
+    if (compacted) {
+        compact->current = target;
+        compact->unsaved = true;
+    } else {
+        tracer->current = target;
+    }
     report->unfinished_pixels = counters[0];
     report->samples_finished = counters[1];
-    return check_gl("a tracer pass", error);
+    return gpu_check_gl("a tracer pass", error);
 }
 
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
@@ -672,23 +669,9 @@ rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limit
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RED_INTEGER, GL_UNSIGNED_INT, bottom_up);
     free(bottom_up);
-    return check_gl("setting the sample limits", error);
+    return gpu_check_gl("setting the sample limits", error);
 }
 
-rt_status gpu_tracer_set_pass_rectangles(gpu_tracer *tracer, const int *rectangles, int count, rt_error *error)
-{
-    free(tracer->pass_rectangles);
-    tracer->pass_rectangles = NULL;
-    tracer->pass_rectangle_count = 0;
-    if (rectangles == NULL)
-        return RT_OK;
-    tracer->pass_rectangles = malloc((count > 0 ? (size_t)count : 1) * 4 * sizeof *rectangles);
-    if (tracer->pass_rectangles == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the pass rectangles");
-    memcpy(tracer->pass_rectangles, rectangles, (size_t)count * 4 * sizeof *rectangles);
-    tracer->pass_rectangle_count = count;
-    return RT_OK;
-}
 
 /* Reads one state texture of the latest set into rows top to bottom. */
 static void read_state(gpu_tracer *tracer, int state, float *rgba)
@@ -709,6 +692,9 @@ static void read_state(gpu_tracer *tracer, int state, float *rgba)
 rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
                           rt_error *error)
 {
+    rt_status saved = gpu_compact_save(tracer, error);
+    if (saved != RT_OK)
+        return saved;
     glActiveTexture(GL_TEXTURE0);
     read_state(tracer, TRACER_STATE_ACCUMULATED, rgba);
     if (totals != NULL || luminance_squares != NULL) {
@@ -728,7 +714,7 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
             *totals = sums;
         free(statistics);
     }
-    return check_gl("reading the result", error);
+    return gpu_check_gl("reading the result", error);
 }
 
 rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error)
@@ -751,21 +737,24 @@ rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_err
                    bottom_up + layer * layer_floats + (size_t)(tracer->height - 1 - row) * row_floats,
                    row_floats * sizeof(float));
     free(bottom_up);
-    return check_gl("reading the light groups", error);
+    return gpu_check_gl("reading the light groups", error);
 }
 
 rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error)
 {
+    rt_status saved = gpu_compact_save(tracer, error);
+    if (saved != RT_OK)
+        return saved;
     glActiveTexture(GL_TEXTURE0);
     read_state(tracer, TRACER_STATE_SQUARES, squares);
-    return check_gl("reading the sums of squares", error);
+    return gpu_check_gl("reading the sums of squares", error);
 }
 
 rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_depth, float *normal_coverage,
                                  rt_error *error)
 {
     /* The render's variant: the AOV pass reaches no more of the tracer than the render. */
-    char defines[1024];
+    char defines[2048];
     const gpu_tracer_parameters *p = &tracer->parameters;
     variant_defines(p->omitted_features, &p->shader, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_AOV, defines, error);
@@ -816,7 +805,7 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
     glUseProgram(tracer->program);
     if (status != RT_OK)
         return status;
-    return check_gl("the AOV pass", error);
+    return gpu_check_gl("the AOV pass", error);
 }
 
 bool gpu_tracer_reused_scene(const gpu_tracer *tracer)
@@ -857,7 +846,7 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
     glDeleteBuffers(1, &tracer->parameter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);
     glDeleteTextures(1, &tracer->sample_limits);
-    free(tracer->pass_rectangles);
+    gpu_compact_destroy(tracer);
     free(tracer);
 }
 
@@ -907,7 +896,7 @@ rt_status gpu_random_numbers(gpu_context *context, const gpu_random_request *req
     glDeleteProgram(program);
     if (bottom_up == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading random numbers");
-    return check_gl("drawing random numbers", error);
+    return gpu_check_gl("drawing random numbers", error);
 }
 
 /* Queries per draw of the material test (rows of MATERIAL_TEST_WIDTH). */
@@ -964,7 +953,7 @@ rt_status gpu_material_test(gpu_context *context, const uint32_t *packed_texels,
     rt_status status = check_packed_size(context, texel_count, error);
     if (status != RT_OK)
         return status;
-    char defines[1024];
+    char defines[2048];
     variant_defines(0, NULL, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_MATERIAL_TEST, defines, error);
     if (program == 0)
@@ -1023,7 +1012,7 @@ rt_status gpu_material_test(gpu_context *context, const uint32_t *packed_texels,
         }
         material_results(outputs, n, results + first);
     }
-    status = check_gl("the material test", error);
+    status = gpu_check_gl("the material test", error);
     glDeleteVertexArrays(1, &vertex_array);
     glDeleteFramebuffers(1, &framebuffer);
     glDeleteTextures(MATERIAL_TEST_OUTPUTS, images);
@@ -1040,7 +1029,7 @@ rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const cha
                                       int *block_size, rt_error *error)
 {
     (void)context;
-    char defines[1024];
+    char defines[2048];
     variant_defines(0, NULL, defines, sizeof defines);
     GLuint program = build_fragment_program(SHADER_PROGRAM_PASS, defines, error);
     if (program == 0)
@@ -1057,7 +1046,7 @@ rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const cha
     if (block != GL_INVALID_INDEX)
         glGetActiveUniformBlockiv(program, block, GL_UNIFORM_BLOCK_DATA_SIZE, block_size);
     glDeleteProgram(program);
-    return check_gl("reading the parameter block's layout", error);
+    return gpu_check_gl("reading the parameter block's layout", error);
 }
 
 void gpu_tracer_release(gpu_context *context)

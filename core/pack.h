@@ -69,6 +69,8 @@ typedef struct pack_summary {
     bool emitters;               /* an emissive material, whether a primitive uses it or not */
     bool textures;               /* a texture record, or a material naming a texture */
     bool normal_maps;            /* a material with a normal map */
+    uint32_t material_types;     /* MATERIAL_* tags of the material section (the default
+                                  * material included) */
     bool pbr;                    /* a MATERIAL_PBR material */
     bool alpha_mask;             /* a material with MATERIAL_FLAG_ALPHA_MASK */
     bool vertex_colors;          /* the vertex colour section (packed_layout.h "colours") */

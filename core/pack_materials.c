@@ -73,6 +73,7 @@ void pack_write_materials(packer *p)
         summary->textures |= m.albedo_texture >= 0 || m.emission_texture >= 0
                              || (pbr && m.metallic_roughness_texture >= 0);
         summary->normal_maps |= m.normal_map >= 0;
+        summary->material_types |= 1u << m.type;
         summary->pbr |= pbr;
         summary->alpha_mask |= (flags & MATERIAL_FLAG_ALPHA_MASK) != 0;
     }

@@ -39,8 +39,8 @@ uint64_t render_bytes_per_pixel(const render_options *options, int light_group_c
         bytes += 2 * 16 + 12 + 44;
     if (options->light_groups)   /* per group: the layer on the device, its read-back and copy, 3 channels twice */
         bytes += (uint64_t)light_group_count * (16 + 2 * 16 + 2 * 12);
-    if (options->noise_threshold > 0)   /* the checks' read-back, limits, the sampler's arrays */
-        bytes += 16 + 4 + 4 + 16;
+    if (options->noise_threshold > 0)   /* the checks' read-back, limits, the sampler's arrays, */
+        bytes += 16 + 4 + 4 + 16 + GPU_TRACER_STATE_BYTES_PER_PIXEL;   /* compacted passes' state */
     return bytes;
 }
 
@@ -106,7 +106,8 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
  * sampling in path tracing without lights (or with it switched off), no volumes when there
  * is none and the camera is in none, no textures when there is none and no material has a
  * normal map; primitive types, emitters, the pbr material, alpha masks and vertex colours
- * as the packed records (every BVH level) hold them. The --full-tracer option asks for 0:
+ * as the packed records (every BVH level) hold them; light and material kinds as the light
+ * and material sections hold them. The --full-tracer option asks for 0:
  * everything, read from uniforms. */
 static uint32_t omitted_features(const packed_scene *packed, const render_options *options, uint32_t camera_media)
 {
@@ -145,6 +146,24 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_VERTEX_COLORS;
     if (!options->light_groups)
         omitted |= GPU_OMIT_LIGHT_GROUPS;
+    uint32_t lights = contents->light_types;
+    if (!(lights & 1u << LIGHT_SPHERE))
+        omitted |= GPU_OMIT_SPHERE_LIGHTS;
+    if (!(lights & 1u << LIGHT_TRIANGLE))
+        omitted |= GPU_OMIT_TRIANGLE_LIGHTS;
+    if (!(lights & (1u << LIGHT_POINT | 1u << LIGHT_SPOT | 1u << LIGHT_SUN)))
+        omitted |= GPU_OMIT_DELTA_LIGHTS;
+    if (!(lights & 1u << LIGHT_ENVIRONMENT))
+        omitted |= GPU_OMIT_ENVIRONMENT_LIGHT;
+    if (packed->light_count <= 1)
+        omitted |= GPU_OMIT_MANY_LIGHTS;
+    uint32_t materials = contents->material_types;
+    if (!(materials & 1u << MATERIAL_LAMBERTIAN))
+        omitted |= GPU_OMIT_LAMBERTIAN;
+    if (!(materials & 1u << MATERIAL_METAL))
+        omitted |= GPU_OMIT_METAL;
+    if (!(materials & 1u << MATERIAL_DIELECTRIC))
+        omitted |= GPU_OMIT_DIELECTRIC;
     return omitted;
 }
 
@@ -532,8 +551,7 @@ static rt_status crop_to_region(rt_image *image, const int traced[4], const int 
 typedef struct adaptive_run {
     adaptive_sampler *sampler;
     float *rgba, *luminance_squares;
-    int *rectangles;
-    bool settle;                 /* the next pass is the first after a check (adaptive.h) */
+    uint32_t *pixels;            /* the pixels still going (adaptive_going_pixels) */
 } adaptive_run;
 
 static void end_adaptive(adaptive_run *run)
@@ -541,7 +559,7 @@ static void end_adaptive(adaptive_run *run)
     adaptive_free(run->sampler);
     free(run->rgba);
     free(run->luminance_squares);
-    free(run->rectangles);
+    free(run->pixels);
     memset(run, 0, sizeof *run);
 }
 
@@ -560,8 +578,8 @@ static rt_status start_adaptive(gpu_tracer *tracer, const render_options *option
     size_t pixels = (size_t)width * height;
     run->rgba = malloc(pixels * 4 * sizeof *run->rgba);
     run->luminance_squares = malloc(pixels * sizeof *run->luminance_squares);
-    run->rectangles = malloc((size_t)adaptive_rectangle_capacity(run->sampler) * 4 * sizeof *run->rectangles);
-    status = run->rgba && run->luminance_squares && run->rectangles
+    run->pixels = malloc(pixels * sizeof *run->pixels);
+    status = run->rgba && run->luminance_squares && run->pixels
                  ? gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error)
                  : rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for adaptive sampling");
     if (status != RT_OK)
@@ -569,8 +587,9 @@ static rt_status start_adaptive(gpu_tracer *tracer, const render_options *option
     return status;
 }
 
-/* The check once every pixel going has reached its limit: new limits and pass rectangles
- * on the tracer; *done when no pixel goes on. */
+/* The check once every pixel going has reached its limit: new limits on the tracer, and
+ * the pixels still going as the pixels its passes trace (compacted: gpu.h); *done when no
+ * pixel goes on. */
 static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, bool *done, rt_error *error)
 {
     rt_status status = gpu_tracer_read(tracer, run->rgba, run->luminance_squares, NULL, error);
@@ -582,9 +601,12 @@ static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, bool *don
     status = gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error);
     if (status != RT_OK)
         return status;
-    run->settle = true;
-    return gpu_tracer_set_pass_rectangles(tracer, run->rectangles,
-                                          adaptive_pass_rectangles(run->sampler, true, run->rectangles), error);
+    /* RTSPHERES_TEST_FULL_PASSES=1: every pass over the whole image, as before compacted
+     * passes, so that a test can show both give the same image (tests/render/test-adaptive.sh). */
+    const char *full = getenv("RTSPHERES_TEST_FULL_PASSES");
+    if (full != NULL && strcmp(full, "1") == 0)
+        return RT_OK;
+    return gpu_tracer_set_pass_pixels(tracer, run->pixels, adaptive_going_pixels(run->sampler, run->pixels), error);
 }
 
 /* Before a pass: whether it may run under options->deadline, predicting its time from
@@ -682,12 +704,6 @@ static rt_status run_passes(gpu_context *context, gpu_tracer *tracer, const rend
         }
         if (options->progress != NULL)
             options->progress(options->progress_context, progress);
-        if (adaptive.settle) {
-            adaptive.settle = false;
-            status = gpu_tracer_set_pass_rectangles(
-                tracer, adaptive.rectangles, adaptive_pass_rectangles(adaptive.sampler, false, adaptive.rectangles),
-                error);
-        }
         if (status == RT_OK && report.unfinished_pixels == 0) {
             done = true;
             if (adaptive.sampler != NULL) {

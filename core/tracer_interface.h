@@ -79,6 +79,17 @@
 /* image unit of the light group layers (glsl/light_groups.glsl): an rgba32f 2D array */
 #define TRACER_LIGHT_GROUP_IMAGE_UNIT 0
 
+/* ---- compacted passes (core/gpu_compact.c; gpu.h gpu_tracer_set_pass_pixels): the pixels
+ * still taking samples packed densely into compact state textures, so that no lane of a
+ * SIMD vector idles on a pixel that is done. The pixel map (R32UI, on unit
+ * TRACER_PIXEL_MAP_UNIT) gives each compact slot its pixel of the full state textures as
+ * x | y << TRACER_PIXEL_MAP_SHIFT (framebuffer rows, bottom up), or TRACER_NO_PIXEL for a
+ * slot that holds none. The parameter compact_pixels is nonzero while a pass traces the
+ * compact textures. */
+#define TRACER_PIXEL_MAP_UNIT 10
+#define TRACER_PIXEL_MAP_SHIFT 16
+#define TRACER_NO_PIXEL 4294967295u
+
 /* ---- the parameter block. Vectors are world space; pixels count from the top left. */
 #define TRACER_PARAMETERS(P) \
     P(ivec2, image_size)             /* the region rendered: the whole image or a crop */ \
@@ -118,6 +129,7 @@
     P(int, pass_work_budget)         /* work units a pixel may start in one pass (core/gpu_tracer.c */ \
                                      /* clamps it to what the device allows) */ \
     P(int, work_cap)                 /* no invocation does more (core/gpu_tracer.c, from the device) */ \
-    P(int, aov_samples)              /* the AOV pass: jittered camera rays per pixel */
+    P(int, aov_samples)              /* the AOV pass: jittered camera rays per pixel */ \
+    P(uint, compact_pixels)          /* nonzero: the pass traces the compact state (above) */
 
 #endif

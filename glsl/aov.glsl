@@ -10,6 +10,7 @@ void main()
 {
     read_header();
     light_count = 0u;
+    frame_pixel = ivec2(gl_FragCoord.xy);
     begin_pixel();
     vec3 albedo_sum = vec3(0.0), normal_sum = vec3(0.0);
     float depth_sum = 0.0, hits = 0.0, taken = 0.0;

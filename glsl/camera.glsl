@@ -2,13 +2,15 @@
 // core/camera.h).
 
 vec2 film_pixel;     // the pixel's bottom-left corner on the film (row 0 at the bottom)
+ivec2 frame_pixel;   // the pixel in the traced region's framebuffer (row 0 at the bottom):
+                     // gl_FragCoord, or in compacted passes what the pixel map says (main.glsl)
 
-// Sets the pixel's film position and random stream from gl_FragCoord: a crop or tile
+// Sets the pixel's film position and random stream from frame_pixel: a crop or tile
 // renders exactly the pixels (and random numbers) of the full render, so both use
 // full-image pixels, rows counted from the top.
 void begin_pixel()
 {
-    ivec2 frag_pixel = ivec2(gl_FragCoord.xy);
+    ivec2 frag_pixel = frame_pixel;
     ivec2 image_pixel = ivec2(region_origin.x + frag_pixel.x, region_origin.y + (image_size.y - 1 - frag_pixel.y));
     film_pixel = vec2(float(image_pixel.x), float(full_size.y - 1 - image_pixel.y));
     rng_pixel = uvec2(image_pixel);

@@ -26,7 +26,7 @@ void add_to_light_group(uint group, vec3 value)
 {
     if (!collects_light_groups())
         return;
-    ivec3 at = ivec3(ivec2(gl_FragCoord.xy), int(min(group, light_group_count - 1u)));
+    ivec3 at = ivec3(frame_pixel, int(min(group, light_group_count - 1u)));
     imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(value, 0.0));
 }
 

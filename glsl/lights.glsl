@@ -21,6 +21,8 @@ const vec3 LUMINANCE = vec3(0.2126, 0.7152, 0.0722);   // Rec. 709, as the packe
 // The probability that choose_light() picks light.
 float light_power_probability(uint light)
 {
+    if (!HAS_MANY_LIGHTS)
+        return 1.0;
     float cdf = packed_vec4(light_offset + light * uint(PACKED_LIGHT_STRIDE) + 1u).w;
     float before = light > 0u ? packed_vec4(light_offset + (light - 1u) * uint(PACKED_LIGHT_STRIDE) + 1u).w : 0.0;
     return cdf - before;
@@ -37,17 +39,17 @@ float light_importance(uint light, vec3 p)
     uvec4 head = packed_texel(base);
     vec4 where = packed_vec4(base + 1u);
     vec4 colour = packed_vec4(base + 2u);
-    if (head.x == uint(LIGHT_ENVIRONMENT))
+    if (HAS_ENVIRONMENT_LIGHT && head.x == uint(LIGHT_ENVIRONMENT))
         return colour.w;
-    if (head.x == uint(LIGHT_SUN))
+    if (HAS_DELTA_LIGHTS && head.x == uint(LIGHT_SUN))
         return dot(colour.rgb, LUMINANCE);
     vec3 to_light = where.xyz - p;
     float distance_squared = max(dot(to_light, to_light), 1e-20);
-    if (head.x <= uint(LIGHT_TRIANGLE)) {
+    if (!HAS_DELTA_LIGHTS || head.x <= uint(LIGHT_TRIANGLE)) {
         // Radiance x the solid angle it covers (at most a hemisphere): the projected area
         // over the squared distance; a sphere's projected area is a quarter of its area.
         float area = max(packed_vec4(base + 3u).x, 1e-30);
-        float facing = head.x == uint(LIGHT_SPHERE) ? 0.25 : abs(dot(colour.xyz, to_light)) * inversesqrt(distance_squared);
+        float facing = HAS_SPHERE_LIGHTS && head.x == uint(LIGHT_SPHERE) ? 0.25 : abs(dot(colour.xyz, to_light)) * inversesqrt(distance_squared);
         return colour.w / area * min(area * facing / distance_squared, 2.0 * PI);
     }
     vec3 attenuation = uintBitsToFloat(head.yzw);
@@ -55,7 +57,7 @@ float light_importance(uint light, vec3 p)
     float falloff = attenuation == vec3(0.0) ? distance_squared
                   : attenuation.x + attenuation.y * distance + attenuation.z * distance_squared;
     float importance = dot(colour.rgb, LUMINANCE) / max(falloff, 1e-12);
-    if (head.x == uint(LIGHT_SPOT)) {
+    if (HAS_DELTA_LIGHTS && head.x == uint(LIGHT_SPOT)) {
         vec4 spot = packed_vec4(base + 3u);
         importance *= smoothstep(colour.w, max(spot.w, colour.w + 1e-6), dot(-to_light / distance, spot.xyz));
     }
@@ -120,6 +122,8 @@ uint choose_light_at(float u, vec3 p, out float probability, out float total)
 
 uint choose_light(float u)
 {
+    if (!HAS_MANY_LIGHTS)
+        return 0u;
     uint low = 0u, high = light_count - 1u;
     while (low < high) {
         work++;
@@ -147,6 +151,8 @@ void area_light_geometry(uint light, out uvec4 head, out vec4 a, out vec4 b, out
 // come first in the light list, in primitive order (packed_layout.h), so a binary search.
 uint area_light_of(uint slot)
 {
+    if (!HAS_MANY_LIGHTS)
+        return area_light_count > 0u && packed_texel(light_offset).y == slot ? 0u : NONE;
     uint low = 0u, high = area_light_count;
     while (low < high) {
         work++;
@@ -242,13 +248,15 @@ float area_light_pdf(uvec4 head, vec4 a, vec4 edge1, vec4 edge2, vec3 p, vec3 x,
     SphericalRectangle rectangle;
     if (head.x == uint(LIGHT_QUAD) && spherical_rectangle(a.xyz, edge1.xyz, edge2.xyz, p, rectangle))
         return 1.0 / rectangle.solid_angle;
-    if (head.x == uint(LIGHT_SPHERE)) {
+    if (HAS_SPHERE_LIGHTS && head.x == uint(LIGHT_SPHERE)) {
         float distance_squared = dot(a.xyz - p, a.xyz - p);
         if (distance_squared <= a.w * a.w)
             return 0.0;
         float cos_max = sqrt(max(0.0, 1.0 - a.w * a.w / distance_squared));
         return 1.0 / (2.0 * PI * max(1.0 - cos_max, 1e-12));
     }
+    if (!HAS_FLAT_LIGHTS)
+        return 0.0;
     float area = length(cross(edge1.xyz, edge2.xyz)) * (head.x == uint(LIGHT_QUAD) ? 1.0 : 0.5);
     vec3 to_light = x - p;
     float distance_squared = dot(to_light, to_light);
@@ -280,7 +288,7 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
     distance = 0.0;
     pdf = 0.0;
     emitted = vec3(0.0);
-    if (head.x == uint(LIGHT_SPHERE)) {
+    if (HAS_SPHERE_LIGHTS && head.x == uint(LIGHT_SPHERE)) {
         vec3 axis = a.xyz - p;
         float distance_squared = dot(axis, axis);
         if (distance_squared <= a.w * a.w)
@@ -297,7 +305,7 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
         n = normalize(x - a.xyz);
         uv = vec2(0.5 + atan(-n.z, n.x) / (2.0 * PI), acos(clamp(-n.y, -1.0, 1.0)) / PI);
         pdf = 1.0 / (2.0 * PI * max(1.0 - cos_max, 1e-12));
-    } else {
+    } else if (HAS_FLAT_LIGHTS) {
         SphericalRectangle rectangle;
         bool by_solid_angle = head.x == uint(LIGHT_QUAD) && spherical_rectangle(a.xyz, edge1.xyz, edge2.xyz, p,
                                                                                    rectangle);
@@ -305,7 +313,7 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
             vec2 local = spherical_rectangle_point(rectangle, u);
             uv = vec2((local.x - rectangle.x0) / (rectangle.x1 - rectangle.x0),
                       (local.y - rectangle.y0) / (rectangle.y1 - rectangle.y0));
-        } else if (head.x == uint(LIGHT_TRIANGLE) && u.x + u.y > 1.0) {
+        } else if (HAS_TRIANGLE_LIGHTS && head.x == uint(LIGHT_TRIANGLE) && u.x + u.y > 1.0) {
             uv = vec2(1.0) - u;   // fold the square onto the triangle: still uniform
         }
         x = a.xyz + uv.x * edge1.xyz + uv.y * edge2.xyz;
@@ -318,6 +326,8 @@ bool sample_light(uint light, vec3 p, vec2 u, out vec3 direction, out float dist
         pdf = area_light_pdf(head, a, edge1, edge2, p, x, n);   // the geometry is at hand
         if (pdf == 0.0)
             return false;
+    } else {
+        return false;
     }
     Material material = material_record(primitive_info(head.y) & uint(PRIMITIVE_INFO_MATERIAL_MASK));
     emitted = emissive_emitted(material, x, uv) * emitted_side(material, direction, n);
@@ -385,16 +395,21 @@ bool sample_light_from(uint light, vec3 p, vec2 u, out LightSample s)
     s.delta = false;
     uvec4 head = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE));
     bool found;
-    if (head.x == uint(LIGHT_ENVIRONMENT)) {
+    if (HAS_ENVIRONMENT_LIGHT && head.x == uint(LIGHT_ENVIRONMENT)) {
         found = sample_environment(light, u, s.direction, s.emitted, s.pdf);
         s.distance = INFINITY;
-    } else if (head.x >= uint(LIGHT_POINT)) {
+    } else if (HAS_DELTA_LIGHTS && head.x >= uint(LIGHT_POINT)) {
         found = sample_delta_light(light, p, u, s.direction, s.distance, s.emitted);
         s.delta = true;
-    } else {
+    } else if (HAS_AREA_LIGHTS) {
         found = sample_light(light, p, u, s.direction, s.distance, s.emitted, s.pdf) && !(s.pdf <= 0.0);
+    } else {
+        found = false;
+        s.direction = vec3(0.0, 1.0, 0.0);
+        s.distance = 0.0;
+        s.emitted = vec3(0.0);
     }
-    s.slot = s.delta || head.x == uint(LIGHT_ENVIRONMENT) ? NONE : head.y;
+    s.slot = s.delta || (HAS_ENVIRONMENT_LIGHT && head.x == uint(LIGHT_ENVIRONMENT)) ? NONE : head.y;
     return found;
 }
 
@@ -418,7 +433,7 @@ float emitter_mis_weight(Hit hit, float previous_pdf, float light_total, vec3 ve
 // the last light).
 float environment_mis_weight(float previous_pdf, float light_total, vec3 vertex, vec3 direction)
 {
-    if (previous_pdf > 0.0 && sky_kind() == SKY_ENVIRONMENT && light_count > 0u) {
+    if (HAS_ENVIRONMENT_LIGHT && previous_pdf > 0.0 && sky_kind() == SKY_ENVIRONMENT && light_count > 0u) {
         uint last = light_count - 1u;
         if (packed_texel(light_offset + last * uint(PACKED_LIGHT_STRIDE)).x == uint(LIGHT_ENVIRONMENT))
             return power_heuristic(previous_pdf,

@@ -1,27 +1,6 @@
 // main.glsl: one pass of the tracer: one invocation per pixel reads the pixel's state
 // from the previous pass, lets the integrator continue it, and writes it for the next
-// (core/gpu_tracer.c ping-pongs two sets of state textures, TRACER_STATE_* of
-// core/tracer_interface.h).
-
-layout(binding = TRACER_STATE_ORIGIN) uniform sampler2D state_origin;
-layout(binding = TRACER_STATE_DIRECTION) uniform sampler2D state_direction;
-layout(binding = TRACER_STATE_THROUGHPUT) uniform sampler2D state_throughput;
-layout(binding = TRACER_STATE_RADIANCE) uniform sampler2D state_radiance;
-layout(binding = TRACER_STATE_COUNTERS) uniform usampler2D state_counters;
-layout(binding = TRACER_STATE_ACCUMULATED) uniform sampler2D state_accumulated;
-layout(binding = TRACER_STATE_STATISTICS) uniform sampler2D state_statistics;
-layout(binding = TRACER_STATE_SQUARES) uniform sampler2D state_squares;
-// The pixel's sample limit (core/adaptive.h; all at most samples_per_pixel without it).
-layout(binding = TRACER_SAMPLE_LIMITS_UNIT) uniform usampler2D sample_limits;
-
-layout(location = TRACER_STATE_ORIGIN) out vec4 out_origin;            // xyz: origin, w: since_vertex
-layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction, w: light_total
-layout(location = TRACER_STATE_THROUGHPUT) out vec4 out_throughput;    // rgb: throughput, a: previous_pdf
-layout(location = TRACER_STATE_RADIANCE) out vec4 out_radiance;        // rgb: radiance
-layout(location = TRACER_STATE_COUNTERS) out uvec4 out_counters;       // samples_started, bounce, media
-layout(location = TRACER_STATE_ACCUMULATED) out vec4 out_accumulated;
-layout(location = TRACER_STATE_STATISTICS) out vec4 out_statistics;
-layout(location = TRACER_STATE_SQUARES) out vec4 out_squares;          // rgb: sums of squared radiance
+// (core/gpu_tracer.c ping-pongs two sets of state textures, glsl/pass_state.glsl).
 
 // Pixels with samples left, and samples finished in this pass (read by core/gpu_tracer.c).
 layout(binding = TRACER_COUNTER_BINDING, offset = 0) uniform atomic_uint unfinished_pixels;
@@ -65,8 +44,16 @@ void write_state(PixelState s)
 
 void main()
 {
-    PixelState s = read_state(ivec2(gl_FragCoord.xy));
-    sample_limit = min(samples_per_pixel, texelFetch(sample_limits, ivec2(gl_FragCoord.xy), 0).x);
+    // The state lives where this invocation draws: the pixel itself, or its compact slot.
+    ivec2 slot = ivec2(gl_FragCoord.xy);
+    frame_pixel = slot;
+    if (compact_pixels != 0u) {
+        frame_pixel = mapped_pixel(texelFetch(pixel_map, slot, 0).x);
+        if (frame_pixel.x < 0)
+            discard;
+    }
+    PixelState s = read_state(slot);
+    sample_limit = min(samples_per_pixel, texelFetch(sample_limits, frame_pixel, 0).x);
     read_header();
     begin_pixel();
     rng_sample = sample_start + s.samples_started - 1u;   // the sample of the path in flight

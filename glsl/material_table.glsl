@@ -2,14 +2,14 @@
 // interface (glsl/material.glsl) of the record's type. A new material adds one line to
 // each (glsl/material.glsl lists the other steps). llvmpipe runs every line for every
 // pixel (docs/performance.md), so a material costs its code here whether a scene has it
-// or not; HAS_EMITTERS and HAS_PBR (glsl/variant.glsl) leave the emitter and the pbr
-// material out where there is none.
+// or not; the HAS_ constants of the kinds (glsl/variant.glsl) leave out each kind no
+// material of the scene has.
 
 BsdfSample material_sample(Material m, ShadingFrame frame, vec3 direction, vec4 u)
 {
-    if (m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_sample(m, frame, direction, u);
-    if (m.type == uint(MATERIAL_METAL)) return metal_sample(m, frame, direction, u);
-    if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_sample(m, frame, direction, u);
+    if (HAS_LAMBERTIAN && m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_sample(m, frame, direction, u);
+    if (HAS_METAL && m.type == uint(MATERIAL_METAL)) return metal_sample(m, frame, direction, u);
+    if (HAS_DIELECTRIC && m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_sample(m, frame, direction, u);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_sample(m, frame, direction, u);
     if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_sample(m, frame, direction, u);
     return absorbed_sample(direction);
@@ -17,9 +17,9 @@ BsdfSample material_sample(Material m, ShadingFrame frame, vec3 direction, vec4 
 
 vec3 material_evaluate(Material m, ShadingFrame frame, vec3 view, vec3 to_light)
 {
-    if (m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_evaluate(m, frame, view, to_light);
-    if (m.type == uint(MATERIAL_METAL)) return metal_evaluate(m, frame, view, to_light);
-    if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_evaluate(m, frame, view, to_light);
+    if (HAS_LAMBERTIAN && m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_evaluate(m, frame, view, to_light);
+    if (HAS_METAL && m.type == uint(MATERIAL_METAL)) return metal_evaluate(m, frame, view, to_light);
+    if (HAS_DIELECTRIC && m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_evaluate(m, frame, view, to_light);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_evaluate(m, frame, view, to_light);
     if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_evaluate(m, frame, view, to_light);
     return vec3(0.0);
@@ -27,9 +27,9 @@ vec3 material_evaluate(Material m, ShadingFrame frame, vec3 view, vec3 to_light)
 
 float material_pdf(Material m, ShadingFrame frame, vec3 view, vec3 to_light)
 {
-    if (m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_pdf(m, frame, view, to_light);
-    if (m.type == uint(MATERIAL_METAL)) return metal_pdf(m, frame, view, to_light);
-    if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_pdf(m, frame, view, to_light);
+    if (HAS_LAMBERTIAN && m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_pdf(m, frame, view, to_light);
+    if (HAS_METAL && m.type == uint(MATERIAL_METAL)) return metal_pdf(m, frame, view, to_light);
+    if (HAS_DIELECTRIC && m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_pdf(m, frame, view, to_light);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_pdf(m, frame, view, to_light);
     if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_pdf(m, frame, view, to_light);
     return 0.0;
@@ -37,9 +37,9 @@ float material_pdf(Material m, ShadingFrame frame, vec3 view, vec3 to_light)
 
 vec3 material_guide_albedo(Material m)
 {
-    if (m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_guide_albedo(m);
-    if (m.type == uint(MATERIAL_METAL)) return metal_guide_albedo(m);
-    if (m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_guide_albedo(m);
+    if (HAS_LAMBERTIAN && m.type == uint(MATERIAL_LAMBERTIAN)) return lambertian_guide_albedo(m);
+    if (HAS_METAL && m.type == uint(MATERIAL_METAL)) return metal_guide_albedo(m);
+    if (HAS_DIELECTRIC && m.type == uint(MATERIAL_DIELECTRIC)) return dielectric_guide_albedo(m);
     if (HAS_EMITTERS && m.type == uint(MATERIAL_EMISSIVE)) return emissive_guide_albedo(m);
     if (HAS_PBR && m.type == uint(MATERIAL_PBR)) return pbr_guide_albedo(m);
     return m.albedo;

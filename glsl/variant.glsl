@@ -16,15 +16,25 @@ const bool HAS_QUADS = RTSPHERES_OMIT_QUADS == 0;
 const bool HAS_INSTANCES = RTSPHERES_OMIT_INSTANCES == 0;         // a second BVH level
 const bool HAS_EMITTERS = RTSPHERES_OMIT_EMITTERS == 0;           // emissive materials
 const bool HAS_LIGHT_CHOICE = RTSPHERES_OMIT_LIGHT_CHOICE == 0;   // lights chosen by the point
-const bool HAS_RECTANGLE_LIGHTS = RTSPHERES_OMIT_RECTANGLE_LIGHTS == 0;   // quad lights
+const bool HAS_RECTANGLE_LIGHTS = RTSPHERES_OMIT_RECTANGLE_LIGHTS == 0;   // quad lights (rectangles by solid angle)
 const bool HAS_PBR = RTSPHERES_OMIT_PBR == 0;                     // the pbr material
 const bool HAS_ALPHA_MASK = RTSPHERES_OMIT_ALPHA_MASK == 0;       // alpha-masked materials
 const bool HAS_VERTEX_COLORS = RTSPHERES_OMIT_VERTEX_COLORS == 0; // the vertex colour section
 const bool HAS_LIGHT_GROUPS = RTSPHERES_OMIT_LIGHT_GROUPS == 0;   // light group layers
+const bool HAS_SPHERE_LIGHTS = RTSPHERES_OMIT_SPHERE_LIGHTS == 0;     // emissive spheres
+const bool HAS_TRIANGLE_LIGHTS = RTSPHERES_OMIT_TRIANGLE_LIGHTS == 0; // emissive triangles
+const bool HAS_DELTA_LIGHTS = RTSPHERES_OMIT_DELTA_LIGHTS == 0;       // point, spot and sun lights
+const bool HAS_ENVIRONMENT_LIGHT = RTSPHERES_OMIT_ENVIRONMENT_LIGHT == 0;   // the sky sampled as a light
+const bool HAS_MANY_LIGHTS = RTSPHERES_OMIT_MANY_LIGHTS == 0;         // more than one light to choose from
+const bool HAS_LAMBERTIAN = RTSPHERES_OMIT_LAMBERTIAN == 0;           // material kinds
+const bool HAS_METAL = RTSPHERES_OMIT_METAL == 0;
+const bool HAS_DIELECTRIC = RTSPHERES_OMIT_DIELECTRIC == 0;
 
 // Derived: flat primitives (triangles, quads), and scenes of a single primitive kind, whose
 // records need no type test.
 const bool HAS_FLAT = HAS_TRIANGLES || HAS_QUADS;
+const bool HAS_FLAT_LIGHTS = HAS_RECTANGLE_LIGHTS || HAS_TRIANGLE_LIGHTS;   // quad and triangle lights
+const bool HAS_AREA_LIGHTS = HAS_SPHERE_LIGHTS || HAS_FLAT_LIGHTS;
 const bool ONLY_SPHERES = !HAS_TRIANGLES && !HAS_QUADS && !HAS_MOVING_SPHERES && !HAS_INSTANCES;
 const bool ONLY_TRIANGLES = !HAS_SPHERES && !HAS_QUADS && !HAS_INSTANCES;
 

@@ -99,6 +99,33 @@ else
     fail "adaptive crop" "render failed"
 fi
 
+# ---- compacted passes (core/gpu_compact.c: only the pixels still going, packed densely)
+# give the image, bit for bit, that passes over the whole image give; with light group
+# layers too (written at the pixel, not the compact slot), and the Cornell box's
+# scattered pixels
+compact=$scratch/compact.exr
+full=$scratch/full-passes.exr
+if render "$compact" --noise-threshold 0.02 --light-groups &&
+        RTSPHERES_TEST_FULL_PASSES=1 render "$full" --noise-threshold 0.02 --light-groups &&
+        "$program" render scenes/cornell.txt -o "$scratch/cornell-compact.exr" --size 48x48 --spp 256 \
+            --noise-threshold 0.1 --quiet &&
+        RTSPHERES_TEST_FULL_PASSES=1 "$program" render scenes/cornell.txt -o "$scratch/cornell-full.exr" \
+            --size 48x48 --spp 256 --noise-threshold 0.1 --quiet; then
+    for pair in "$compact $full" "$scratch/cornell-compact.exr $scratch/cornell-full.exr"; do
+        a=${pair%% *} b=${pair#* }
+        # RGB bit for bit; every other channel (samples, the light group layers) by its
+        # statistics
+        "$program" stats "$a" | grep "^channel" >"$scratch/compact.stats"
+        "$program" stats "$b" | grep "^channel" >"$scratch/full.stats"
+        if "$program" diff "$a" "$b" --fail 0 --failpercent 0 >"$scratch/compact.diff" 2>&1 &&
+                grep -q "^max error: 0 " "$scratch/compact.diff" &&
+                cmp -s "$scratch/compact.stats" "$scratch/full.stats"; then
+            pass "compacted passes give the image of full passes bit for bit ($(basename "$a"), $(wc -l <"$scratch/full.stats") channels)"
+        else fail "compacted passes give the image of full passes ($(basename "$a"))" \
+            "$(tr '\n' ' ' <"$scratch/compact.diff") $(diff "$scratch/compact.stats" "$scratch/full.stats" | tr '\n' ' ')"; fi
+    done
+else fail "compacted passes" "a render failed"; fi
+
 # ---- AOVs come with adaptive sampling as without it
 if render "$scratch/aovs.exr" --noise-threshold 0.05 --aovs && stats_of "$scratch/aovs.exr" &&
         [ -n "$(stat_mean variance.Y)" ] && [ -n "$(stat_mean depth.Z)" ]; then

@@ -43,6 +43,11 @@ check lights-without-sampling scenes/lights.txt --light-sampling off
 check lights scenes/lights.txt
 # Lights and a volume (the smoke boxes are instances), quads, no textures, no spheres.
 check cornell-smoke scenes/cornell-smoke.txt
+# One quad light (rectangles by solid angle, no light to choose), lambertian and emissive
+# materials only; one sphere light with metal and glass; triangle lights (a mesh).
+check cornell scenes/cornell.txt
+check three-balls scenes/three-balls.txt
+check mesh-light tests/render/scenes/mesh-light.txt
 # Textures (image, checker, noise, normal maps) and an image sky.
 check textures scenes/textures.txt
 # Moving spheres, instances, a volume, fog, textures, emitters, a black sky.

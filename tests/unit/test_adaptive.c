@@ -109,18 +109,18 @@ static void dark_pixels_and_max(void **state)
     adaptive_free(sampler);
 }
 
-/* The tiles a pass draws: those going, and for the first pass after a check also those
- * that check stopped; runs along a row are joined; edges are cut to the image. */
-static void pass_rectangles(void **state)
+/* The pixels the next passes trace: every pixel at first, then those a check left going
+ * (the noisy one and its 3x3 neighbourhood, cut at the image's corner), rows from the top,
+ * in raster order. */
+static void going_pixels(void **state)
 {
     (void)state;
     adaptive_sampler *sampler = NULL;
     assert_int_equal(adaptive_create(20, 10, 0.05f, 16, 256, &sampler, NULL), RT_OK);
-    int rectangles[4 * 6];
-    assert_int_equal(adaptive_rectangle_capacity(sampler), 6);
-    assert_int_equal(adaptive_pass_rectangles(sampler, false, rectangles), 2);
-    int all[8] = {0, 0, 20, 8, 0, 8, 20, 10};
-    assert_memory_equal(rectangles, all, sizeof all);
+    uint32_t pixels[200];
+    assert_int_equal(adaptive_going_pixels(sampler, pixels), 200);
+    for (uint32_t i = 0; i < 200; i++)
+        assert_int_equal(pixels[i], i);
     float rgba[200 * 4], squares[200];
     for (int i = 0; i < 200; i++) {
         for (int c = 0; c < 3; c++)
@@ -128,13 +128,11 @@ static void pass_rectangles(void **state)
         rgba[4 * i + 3] = 16;
         squares[i] = 16 * 0.25f;
     }
-    squares[9 * 20 + 19] = 8 * 1.0f;   /* pixel (19, 9): noisy, in the last tile */
+    squares[9 * 20 + 19] = 8 * 1.0f;   /* pixel (19, 9): noisy, in the bottom-right corner */
     assert_int_equal(adaptive_check(sampler, rgba, squares), 4);
-    assert_int_equal(adaptive_pass_rectangles(sampler, true, rectangles), 2);
-    assert_memory_equal(rectangles, all, sizeof all);
-    assert_int_equal(adaptive_pass_rectangles(sampler, false, rectangles), 1);
-    int last[4] = {16, 8, 20, 10};
-    assert_memory_equal(rectangles, last, sizeof last);
+    assert_int_equal(adaptive_going_pixels(sampler, pixels), 4);
+    const uint32_t expected[4] = {8 * 20 + 18, 8 * 20 + 19, 9 * 20 + 18, 9 * 20 + 19};
+    assert_memory_equal(pixels, expected, sizeof expected);
     adaptive_free(sampler);
 }
 
@@ -145,7 +143,7 @@ int main(void)
         cmocka_unit_test(schedule),
         cmocka_unit_test(neighbourhood),
         cmocka_unit_test(dark_pixels_and_max),
-        cmocka_unit_test(pass_rectangles),
+        cmocka_unit_test(going_pixels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -33,6 +33,7 @@ static void assert_summary_matches_texels(const packed_scene *packed)
         light_types |= BIT(packed_uint(packed, packed->light_offset + light * PACKED_LIGHT_STRIDE, 0));
     bool emitters = false, textures = packed->texture_count > 0, normal_maps = false, volumes = false;
     bool pbr = false, alpha_mask = false;
+    uint32_t material_types = 0;
     for (uint32_t m = 0; m < packed->material_count; m++) {
         uint32_t base = packed->material_offset + m * PACKED_MATERIAL_STRIDE;
         uint32_t type = packed_uint(packed, base, 0) & MATERIAL_TYPE_MASK;
@@ -44,6 +45,7 @@ static void assert_summary_matches_texels(const packed_scene *packed)
                     || (is_pbr && packed_uint(packed, base + 4, 3) != PACKED_NONE);
         normal_maps |= packed_uint(packed, base + 2, 3) != PACKED_NONE;
         pbr |= is_pbr;
+        material_types |= BIT(type);
         alpha_mask |= (packed_uint(packed, base, 0) & MATERIAL_FLAG_ALPHA_MASK) != 0;
     }
     for (uint32_t i = 0; i < packed->instance_count; i++)
@@ -55,6 +57,7 @@ static void assert_summary_matches_texels(const packed_scene *packed)
     assert_int_equal(packed->summary.normal_maps, normal_maps);
     assert_int_equal(packed->summary.volumes, volumes);
     assert_int_equal(packed->summary.pbr, pbr);
+    assert_int_equal(packed->summary.material_types, material_types);
     assert_int_equal(packed->summary.alpha_mask, alpha_mask);
     assert_int_equal(packed->summary.vertex_colors, packed_uint(packed, PACKED_HEADER_COLOR_OFFSET / 4,
                                                                 PACKED_HEADER_COLOR_OFFSET % 4) != PACKED_NONE);
