@@ -34,7 +34,9 @@
 #   BENCH_QUALITY_REFERENCE_SPP  the references' spp (default 2048)
 #   BENCH_QUALITY_REFRESH        1: render the references again
 #   BENCH_NOISE_THRESHOLDS       the adaptive ladder of --noise-threshold values (default
-#                                "0.4 0.2 0.1 0.05 0.025", at most 1024 spp each), run
+#                                "0.4 0.3 0.2 0.15 0.1 0.05 0.025", at most 1024 spp
+#                                each: the steps near 64 spp's RMSE (T 0.15 to 0.2) are what
+#                                the interpolation of the adaptive target reads), run
 #                                only when `rtspheres render --help` lists the option
 #   BENCH_PEER_THREADS           threads of Cycles and POV-Ray (default: the cores,
 #                                as llvmpipe uses)
@@ -44,7 +46,7 @@ peers=${BENCH_PEERS-cycles povray}
 quality_spp=$(for s in ${BENCH_QUALITY_SPP:-8 16 32 64 128 256}; do scaled "$s"; done | sort -n -u | tr '\n' ' ' | sed 's/ $//')
 quality_point=$(scaled "${BENCH_QUALITY_POINT:-64}")
 quality_reference_spp=$(scaled "${BENCH_QUALITY_REFERENCE_SPP:-2048}")
-noise_thresholds=${BENCH_NOISE_THRESHOLDS:-0.4 0.2 0.1 0.05 0.025}
+noise_thresholds=${BENCH_NOISE_THRESHOLDS:-0.4 0.3 0.2 0.15 0.1 0.05 0.025}
 adaptive_max_spp=$(scaled 1024)
 peer_threads=${BENCH_PEER_THREADS:-$(nproc 2>/dev/null || echo 2)}
 quality=$work/quality.tsv      # this run's time-to-quality results: label, key, value
