@@ -108,30 +108,11 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
             node_entry = -INFINITY;
             continue;
         } else if (node_entry < hit.t) {
-            if (count > 0u) {
-                for (uint slot = first; slot < first + count && !stop && count_work(); slot++) {
-                    uvec4 record = packed_texel(primitive_offset + slot);
-                    uint type = record_type(record);
-                    if (HAS_INSTANCES && type == uint(PRIMITIVE_INSTANCE)) {
-                        if (stack_size + 2 <= STACK_SIZE) {
-                            stack_node[stack_size] = stack_word(0u, LEAVE_INSTANCE_MARK);
-                            stack_entry[stack_size] = -INFINITY;
-                            stack_node[stack_size + 1] = stack_word(record.x, ENTER_INSTANCE_MARK);
-                            stack_entry[stack_size + 1] = -INFINITY;
-                            stack_size += 2;
-                        } else {
-                            overflow = true;   // reported as an error, never skipped silently
-                        }
-                    } else {
-                        float before = hit.t;
-                        intersect_primitive(slot, record, type, ray, time, instance, hit);
-                        // A shadow ray's blocker: anything but its light and volume boundaries.
-                        bool passable = instance == NONE ? slot == shadow.light_slot : HAS_VOLUMES && volume_instance;
-                        if (shadow_phase && hit.t < before && !passable)
-                            stop = true;
-                    }
-                }
-            } else {
+            // An interior node: its children's boxes, the farther hit one pushed, the
+            // nearer one next. When that one is a leaf it is tested in this same iteration
+            // (below): llvmpipe runs the primitive loop's body in every iteration anyway.
+            bool descend = false;
+            if (count == 0u) {
                 float left_entry = intersect_box(packed_xyz(texel0), packed_xyz(texel1), ray.origin,
                                                  ray.inverse_direction, hit.t);
                 float right_entry = intersect_box(packed_xyz(texel2), packed_xyz(texel3), ray.origin,
@@ -153,7 +134,33 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
                     first = near_node.x;
                     count = near_node.y;
                     node_entry = near_entry;
-                    continue;
+                    descend = count == 0u;
+                }
+            }
+            if (descend)
+                continue;
+            // A leaf: popped, or the nearer child just found (a node whose children both
+            // missed still has count 0 here, and goes on to the pop).
+            for (uint slot = first; slot < first + count && !stop && count_work(); slot++) {
+                uvec4 record = packed_texel(primitive_offset + slot);
+                uint type = record_type(record);
+                if (HAS_INSTANCES && type == uint(PRIMITIVE_INSTANCE)) {
+                    if (stack_size + 2 <= STACK_SIZE) {
+                        stack_node[stack_size] = stack_word(0u, LEAVE_INSTANCE_MARK);
+                        stack_entry[stack_size] = -INFINITY;
+                        stack_node[stack_size + 1] = stack_word(record.x, ENTER_INSTANCE_MARK);
+                        stack_entry[stack_size + 1] = -INFINITY;
+                        stack_size += 2;
+                    } else {
+                        overflow = true;   // reported as an error, never skipped silently
+                    }
+                } else {
+                    float before = hit.t;
+                    intersect_primitive(slot, record, type, ray, time, instance, hit);
+                    // A shadow ray's blocker: anything but its light and volume boundaries.
+                    bool passable = instance == NONE ? slot == shadow.light_slot : HAS_VOLUMES && volume_instance;
+                    if (shadow_phase && hit.t < before && !passable)
+                        stop = true;
                 }
             }
         }
