@@ -148,6 +148,16 @@ rt_status gpu_compact_save(gpu_tracer *tracer, rt_error *error)
     return gpu_check_gl("writing the compacted state back", error);
 }
 
+void gpu_compact_scissor(gpu_tracer *tracer, bool on)
+{
+    if (!on) {
+        glDisable(GL_SCISSOR_TEST);
+        return;
+    }
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, 0, tracer->compact.used_width, tracer->compact.used_height);
+}
+
 rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels, int count, rt_error *error)
 {
     gpu_compact *c = &tracer->compact;
@@ -178,15 +188,25 @@ rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels,
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, c->width, c->height, GL_RED_INTEGER, GL_UNSIGNED_INT, map);
     free(map);
+    /* The region the list's slots take (whole 4 x 4 blocks): draws are cut to it, since a
+     * vector of empty slots is not free on llvmpipe (its loops run once, masked), and a
+     * list shorter than the one the textures were made for leaves most of them empty. */
+    int blocks = (count + 7) / 8, blocks_per_row = c->width / 4;
+    int block_rows = (blocks + blocks_per_row - 1) / blocks_per_row;
+    c->used_width = block_rows > 1 ? c->width : 4 * blocks;
+    c->used_height = (2 * block_rows + 3) & ~3;
+    c->used_height = c->used_height > c->height ? c->height : c->used_height;
     /* The gather: the full state of the current set into compact set 0. */
     glBindFramebuffer(GL_FRAMEBUFFER, c->framebuffers[0]);
     glViewport(0, 0, c->width, c->height);
+    gpu_compact_scissor(tracer, true);
     glUseProgram(c->gather_program);
     bind_state(tracer->state_textures[tracer->current]);
     glActiveTexture(GL_TEXTURE0 + TRACER_PIXEL_MAP_UNIT);
     glBindTexture(GL_TEXTURE_2D, c->pixel_map);
     glBindVertexArray(tracer->vertex_array);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    gpu_compact_scissor(tracer, false);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
     c->current = 0;
     c->count = count;

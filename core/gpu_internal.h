@@ -43,6 +43,7 @@ struct gpu_context {
 typedef struct gpu_compact {
     int count;                   /* pixels traced compactly; 0: passes draw the whole image */
     int width, height;           /* of the compact textures (0: none made yet) */
+    int used_width, used_height; /* the slots of the list: drawn (a scissor), the rest not */
     GLuint state_textures[2][TRACER_STATE_COUNT];
     GLuint framebuffers[2];
     GLuint pixel_map;            /* R32UI, width x height (core/tracer_interface.h) */
@@ -77,6 +78,10 @@ struct gpu_tracer {
 /* Writes the compact state back to the full state textures of the current set when it is
  * newer (gpu_compact.c): every read of the state calls it first. */
 rt_status gpu_compact_save(gpu_tracer *tracer, rt_error *error);
+
+/* Cuts the draws that follow to the compact slots the list takes (on), or lets them cover
+ * their whole framebuffer again (off). */
+void gpu_compact_scissor(gpu_tracer *tracer, bool on);
 
 /* Frees the tracer's compact state and programs. */
 void gpu_compact_destroy(gpu_tracer *tracer);

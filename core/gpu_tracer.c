@@ -632,7 +632,11 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
         glBindImageTexture(TRACER_LIGHT_GROUP_IMAGE_UNIT, tracer->light_group_texture, 0, GL_TRUE, 0, GL_READ_WRITE,
                            GL_RGBA32F);
     glBindVertexArray(tracer->vertex_array);
+    if (compacted)
+        gpu_compact_scissor(tracer, true);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (compacted)
+        gpu_compact_scissor(tracer, false);
     /* Image stores of this pass are read by the next pass and by the read-back. */
     glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT
                     | (tracer->light_group_texture != 0 ? GL_SHADER_IMAGE_ACCESS_BARRIER_BIT
