@@ -88,22 +88,9 @@ static rt_status create_compact(gpu_tracer *tracer, int count, rt_error *error)
         }
         glDeleteTextures(1, &c->pixel_map);
     }
-    GLenum draw_buffers[TRACER_STATE_COUNT];
     for (int set = 0; set < 2; set++) {
-        glGenTextures(TRACER_STATE_COUNT, c->state_textures[set]);
-        glGenFramebuffers(1, &c->framebuffers[set]);
-        glBindFramebuffer(GL_FRAMEBUFFER, c->framebuffers[set]);
-        for (int target = 0; target < TRACER_STATE_COUNT; target++) {
-            glBindTexture(GL_TEXTURE_2D, c->state_textures[set][target]);
-            nearest_filtering();
-            glTexStorage2D(GL_TEXTURE_2D, 1, target == TRACER_STATE_COUNTERS ? GL_RGBA32UI : GL_RGBA32F, width,
-                           height);
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + target, GL_TEXTURE_2D,
-                                   c->state_textures[set][target], 0);
-            draw_buffers[target] = GL_COLOR_ATTACHMENT0 + target;
-        }
-        glDrawBuffers(TRACER_STATE_COUNT, draw_buffers);
-        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        if (gpu_create_state_set(c->state_textures[set], &c->framebuffers[set], width, height)
+            != GL_FRAMEBUFFER_COMPLETE) {
             while (glGetError() != GL_NO_ERROR) {
             }
             return rt_error_set(error, RT_ERROR_RUNTIME,

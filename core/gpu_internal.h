@@ -86,6 +86,13 @@ void gpu_compact_scissor(gpu_tracer *tracer, bool on);
 /* Frees the tracer's compact state and programs. */
 void gpu_compact_destroy(gpu_tracer *tracer);
 
+/* Creates one set of pass-state textures (TRACER_STATE_COUNT of width x height, nearest
+ * filtering; RGBA32F, the counters RGBA32UI) and a framebuffer drawing to them
+ * (attachment TRACER_STATE_* for each) into textures and *framebuffer, left bound. Returns
+ * the framebuffer's status: GL_FRAMEBUFFER_COMPLETE, or incomplete where the device could
+ * not allocate a texture. In gpu_tracer.c; the caller deletes them. */
+GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], GLuint *framebuffer, int width, int height);
+
 /* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
 rt_status gpu_check_gl(const char *step, rt_error *error);
 

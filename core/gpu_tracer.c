@@ -363,6 +363,26 @@ static rt_status update_packed_scene(gpu_tracer *tracer, const uint32_t *texels,
     return gpu_check_gl("updating the packed scene", error);
 }
 
+GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], GLuint *framebuffer, int width, int height)
+{
+    GLenum draw_buffers[TRACER_STATE_COUNT];
+    glGenTextures(TRACER_STATE_COUNT, textures);
+    glGenFramebuffers(1, framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, *framebuffer);
+    for (int target = 0; target < TRACER_STATE_COUNT; target++) {
+        /* Nearest filtering: an integer texture with the default (mipmapped, linear) filter
+         * is incomplete, and texelFetch reads zeros from it. */
+        glBindTexture(GL_TEXTURE_2D, textures[target]);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexStorage2D(GL_TEXTURE_2D, 1, target == TRACER_STATE_COUNTERS ? GL_RGBA32UI : GL_RGBA32F, width, height);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + target, GL_TEXTURE_2D, textures[target], 0);
+        draw_buffers[target] = GL_COLOR_ATTACHMENT0 + target;
+    }
+    glDrawBuffers(TRACER_STATE_COUNT, draw_buffers);
+    return glCheckFramebufferStatus(GL_FRAMEBUFFER);
+}
+
 /* Creates both sets of state textures (zeroed) and their framebuffers. */
 static rt_status create_state(gpu_tracer *tracer, rt_error *error)
 {
@@ -379,23 +399,9 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     const char *forced = getenv("RTSPHERES_TEST_GPU_FAILURE");
     if (forced != NULL && strcmp(forced, "memory") == 0)
         return state_out_of_memory(tracer, "GL_OUT_OF_MEMORY", error);
-    GLenum draw_buffers[TRACER_STATE_COUNT];
     for (int set = 0; set < 2; set++) {
-        glGenTextures(TRACER_STATE_COUNT, tracer->state_textures[set]);
-        glGenFramebuffers(1, &tracer->framebuffers[set]);
-        glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[set]);
-        for (int target = 0; target < TRACER_STATE_COUNT; target++) {
-            bool integer = target == TRACER_STATE_COUNTERS;
-            glBindTexture(GL_TEXTURE_2D, tracer->state_textures[set][target]);
-            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-            glTexStorage2D(GL_TEXTURE_2D, 1, integer ? GL_RGBA32UI : GL_RGBA32F, tracer->width, tracer->height);
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + target, GL_TEXTURE_2D,
-                                   tracer->state_textures[set][target], 0);
-            draw_buffers[target] = GL_COLOR_ATTACHMENT0 + target;
-        }
-        glDrawBuffers(TRACER_STATE_COUNT, draw_buffers);
-        GLenum complete = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+        GLenum complete = gpu_create_state_set(tracer->state_textures[set], &tracer->framebuffers[set], tracer->width,
+                                               tracer->height);
         if (forced != NULL && strcmp(forced, "framebuffer") == 0)
             complete = GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT;
         /* A texture the driver could not allocate leaves its attachment incomplete
