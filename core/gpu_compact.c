@@ -88,6 +88,13 @@ static rt_status create_compact(gpu_tracer *tracer, int count, rt_error *error)
         }
         glDeleteTextures(1, &c->pixel_map);
     }
+    /* Names of 0 until made, and the size set now, so that gpu_compact_destroy frees what
+     * a failure below leaves (GL ignores the name 0). */
+    memset(c->state_textures, 0, sizeof c->state_textures);
+    memset(c->framebuffers, 0, sizeof c->framebuffers);
+    c->pixel_map = 0;
+    c->width = width;
+    c->height = height;
     for (int set = 0; set < 2; set++) {
         if (gpu_create_state_set(c->state_textures[set], &c->framebuffers[set], width, height)
             != GL_FRAMEBUFFER_COMPLETE) {
@@ -102,8 +109,6 @@ static rt_status create_compact(gpu_tracer *tracer, int count, rt_error *error)
     glBindTexture(GL_TEXTURE_2D, c->pixel_map);
     nearest_filtering();
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32UI, width, height);
-    c->width = width;
-    c->height = height;
     return gpu_check_gl("creating the compacted state", error);
 }
 
