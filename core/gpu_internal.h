@@ -1,5 +1,6 @@
-/* gpu_internal.h: what core/gpu.c (the EGL context) and core/gpu_tracer.c (the tracer on
- * it) share; no other file includes it. */
+/* gpu_internal.h: what core/gpu.c (the EGL context), core/gpu_tracer.c (the tracer on it),
+ * core/gpu_compact.c (its compacted passes) and core/gpu_test_programs.c (the programs
+ * only tests use) share; no other file includes it. */
 #ifndef RT_GPU_INTERNAL_H
 #define RT_GPU_INTERNAL_H
 
@@ -92,6 +93,22 @@ void gpu_compact_destroy(gpu_tracer *tracer);
  * the framebuffer's status: GL_FRAMEBUFFER_COMPLETE, or incomplete where the device could
  * not allocate a texture. In gpu_tracer.c; the caller deletes them. */
 GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], GLuint *framebuffer, int width, int height);
+
+/* Shared by gpu_tracer.c (where they are) and gpu_test_programs.c: */
+/* Writes the #defines of a tracer variant into defines (size bytes): every
+ * RTSPHERES_OMIT_* as 1 when its GPU_OMIT_* bit is in omitted, else 0 (glsl/variant.glsl
+ * reads them), and RTSPHERES_FIX_UNIFORMS with the integrator, sky type and sampler of
+ * settings it compiles in (0 when not fixed, so the source does not vary with the
+ * parameters; settings may then be NULL). */
+void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *settings, char *defines, size_t size);
+
+/* Creates a buffer object holding bytes bytes of data (at least 16, so that an empty one
+ * is still a valid texture store) and a buffer texture of format over it. */
+void gpu_create_buffer_texture(GLenum format, const void *data, size_t bytes, GLuint *buffer, GLuint *texture);
+
+/* The error for a packed scene of texel_count texels on a device whose buffer textures
+ * hold fewer, or RT_OK. */
+rt_status gpu_check_packed_size(const gpu_context *context, uint32_t texel_count, rt_error *error);
 
 /* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
 rt_status gpu_check_gl(const char *step, rt_error *error);
