@@ -1,6 +1,6 @@
 /* adaptive.h: adaptive sampling's decisions (render_options.noise_threshold): which pixels
- * go on taking samples, how far, and which tiles of the image a pass must draw. Plain C on
- * the sums the tracer accumulates; core/render.c runs it between passes, the GPU never
+ * go on taking samples, how far, and which pixels a pass must trace. Plain C on the sums
+ * the tracer accumulates; core/render_passes.c runs it between passes, the GPU never
  * sees it. docs/sampling.md ("Adaptive sampling") says the same for users.
  *
  * ## The estimator

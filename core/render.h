@@ -13,9 +13,11 @@
  *
  * Defaults of render_options (zero means default):
  *   pass_work_budget: adaptive: starts at 64 work units per pixel per pass (a unit is
- *     one BVH node visit or one primitive test) and is scaled after each pass so that a
- *     pass takes about target_pass_seconds, between 16 and 16384 units (the shader's
- *     hard cap per traversal is 60,000, under llvmpipe's 65,535). A non-zero value is
+ *     one loop iteration of the tracer, a path segment counts 64: glsl/work.glsl) and is
+ *     scaled after each pass so that a pass takes about target_pass_seconds, between 16
+ *     and 16384 units and at most the device's gpu_info.max_pass_work_budget (on
+ *     llvmpipe half its work cap, which keeps a SIMD vector under the 65,535-iteration
+ *     loop cap: 3,128 units at 8 lanes; core/gpu.c set_work_limits). A non-zero value is
  *     used for every pass. The image does not depend on it, only the time per pass.
  *   target_pass_seconds 0.25 on a GPU (short passes keep progress, Ctrl-C and watchdogs
  *     happy), 1 on a CPU rasteriser (where each pass costs a share of its time),
@@ -29,9 +31,9 @@
  *   min_spp ADAPTIVE_DEFAULT_MIN_SPP (16, core/adaptive.h) with a threshold,
  *   deadline 0: none, no BVH cache.
  *
- * Adaptive sampling (noise_threshold > 0): pixels stop as core/adaptive.h says, each
- * pass runs only the tiles with pixels still going, and the samples channel holds each
- * pixel's count. With a region, the tracer renders the pixels within adaptive_reach() of
+ * Adaptive sampling (noise_threshold > 0): pixels stop as core/adaptive.h says, after
+ * each check the passes trace only the pixels still going (compacted: gpu.h
+ * gpu_tracer_set_pass_pixels), and the samples channel holds each pixel's count. With a region, the tracer renders the pixels within adaptive_reach() of
  * it too (and drops them), so a region's decisions, and so its pixels, are exactly the
  * full render's. resume is refused with a threshold (the partial keeps no squares).
  *

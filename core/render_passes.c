@@ -1,0 +1,217 @@
+/* render_passes.c: the pass loop of a render (render_internal.h render_run_passes): the
+ * pass budget, adaptive sampling's checks (core/adaptive.h), the deadline, checkpoints and
+ * previews between passes. Plain C: the GL work is the GPU module's. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "adaptive.h"
+#include "clock.h"
+#include "render_internal.h"
+
+/* Passes of about a second on a CPU rasteriser, a quarter on a GPU (under any watchdog):
+ * on llvmpipe every pass costs a share of its time whatever it does (docs/performance.md,
+ * the log: longer passes), and nothing kills a long draw there. */
+#define DEFAULT_TARGET_PASS_SECONDS 0.25
+#define SOFTWARE_TARGET_PASS_SECONDS 1.0
+
+/* Moves the adaptive pass budget *budget towards a pass of target_seconds after a pass of
+ * pass_seconds, within [MINIMUM_ADAPTIVE_BUDGET, most_budget], and gives it to the tracer. */
+static void adapt_pass_budget(gpu_tracer *tracer, double pass_seconds, double target_seconds, double most_budget,
+                              double *budget)
+{
+    /* Pass time grows roughly linearly with the budget; move towards the target by at
+     * most a factor of 4 per pass so one odd pass cannot swing it far. */
+    double scale = pass_seconds > 0 ? target_seconds / pass_seconds : 4.0;
+    scale = scale < 0.5 ? 0.5 : scale > 4.0 ? 4.0 : scale;
+    *budget *= scale;
+    *budget = *budget < MINIMUM_ADAPTIVE_BUDGET ? MINIMUM_ADAPTIVE_BUDGET : *budget > most_budget ? most_budget : *budget;
+    gpu_tracer_set_pass_work_budget(tracer, (uint32_t)*budget);
+}
+
+/* Adaptive sampling in the pass loop: the sampler (NULL: none) and what its checks read. */
+typedef struct adaptive_run {
+    adaptive_sampler *sampler;
+    float *rgba, *luminance_squares;
+    uint32_t *pixels;            /* the pixels still going (adaptive_going_pixels) */
+} adaptive_run;
+
+static void end_adaptive(adaptive_run *run)
+{
+    adaptive_free(run->sampler);
+    free(run->rgba);
+    free(run->luminance_squares);
+    free(run->pixels);
+    memset(run, 0, sizeof *run);
+}
+
+/* Starts adaptive sampling for a width x height tracer when the options ask for it: the
+ * sampler, its buffers and the first limits on the tracer. Nothing to free on failure. */
+static rt_status start_adaptive(gpu_tracer *tracer, const render_options *options, uint32_t samples_per_pixel,
+                                int width, int height, adaptive_run *run, rt_error *error)
+{
+    memset(run, 0, sizeof *run);
+    if (!(options->noise_threshold > 0))
+        return RT_OK;
+    rt_status status = adaptive_create(width, height, options->noise_threshold, options->min_spp, samples_per_pixel,
+                                       &run->sampler, error);
+    if (status != RT_OK)
+        return status;
+    size_t pixels = (size_t)width * height;
+    run->rgba = malloc(pixels * 4 * sizeof *run->rgba);
+    run->luminance_squares = malloc(pixels * sizeof *run->luminance_squares);
+    run->pixels = malloc(pixels * sizeof *run->pixels);
+    status = run->rgba && run->luminance_squares && run->pixels
+                 ? gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error)
+                 : rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for adaptive sampling");
+    if (status != RT_OK)
+        end_adaptive(run);
+    return status;
+}
+
+/* The check once every pixel going has reached its limit: new limits on the tracer, and
+ * the pixels still going as the pixels its passes trace (compacted: gpu.h); *done when no
+ * pixel goes on. */
+static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, bool *done, rt_error *error)
+{
+    rt_status status = gpu_tracer_read(tracer, run->rgba, run->luminance_squares, NULL, error);
+    if (status != RT_OK)
+        return status;
+    *done = adaptive_check(run->sampler, run->rgba, run->luminance_squares) == 0;
+    if (*done)
+        return RT_OK;
+    status = gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error);
+    if (status != RT_OK)
+        return status;
+    /* RTSPHERES_TEST_FULL_PASSES=1: every pass over the whole image, as before compacted
+     * passes, so that a test can show both give the same image (tests/render/test-adaptive.sh). */
+    const char *full = getenv("RTSPHERES_TEST_FULL_PASSES");
+    if (full != NULL && strcmp(full, "1") == 0)
+        return RT_OK;
+    return gpu_tracer_set_pass_pixels(tracer, run->pixels, adaptive_going_pixels(run->sampler, run->pixels), error);
+}
+
+/* Before a pass: whether it may run under options->deadline, predicting its time from
+ * the last pass (last_pass_seconds 0: the first pass, which always runs). With an adaptive
+ * budget a pass that would end late is shortened to fit (*budget, on the tracer), if it
+ * can be, within the smallest budget. */
+static bool pass_fits_deadline(gpu_tracer *tracer, const render_options *options, double last_pass_seconds,
+                               bool adaptive_budget, double *budget)
+{
+    if (options->deadline <= 0 || last_pass_seconds <= 0)
+        return true;
+    double remaining = options->deadline - clock_seconds();
+    if (remaining >= last_pass_seconds)
+        return true;
+    double shortened = *budget * remaining / last_pass_seconds;
+    if (!adaptive_budget || !(shortened >= MINIMUM_ADAPTIVE_BUDGET))
+        return false;
+    *budget = shortened;
+    gpu_tracer_set_pass_work_budget(tracer, (uint32_t)shortened);
+    return true;
+}
+
+/* Reads the image so far once (cut to region) and hands it to options->checkpoint when
+ * checkpoint_due and to options->preview (--display) when preview_due. */
+static rt_status write_partial(gpu_tracer *tracer, const render_options *options, const int traced[4],
+                               const int region[4], uint64_t scene_hash, bool checkpoint_due, bool preview_due,
+                               rt_error *error)
+{
+    rt_image partial;
+    uint64_t partial_samples;
+    rt_status status = render_read_image(tracer, traced[2] - traced[0], traced[3] - traced[1], &partial, NULL,
+                                         NULL, &partial_samples, error);
+    if (status != RT_OK)
+        return status;
+    if (memcmp(traced, region, 4 * sizeof *traced) != 0) {
+        status = render_crop_to_region(&partial, traced, region, error);
+        partial_samples = status == RT_OK ? render_sample_total(&partial) : 0;
+    }
+    if (status == RT_OK && checkpoint_due)
+        status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, scene_hash, error);
+    if (status == RT_OK && preview_due)
+        options->preview(options->preview_context, &partial);
+    image_free(&partial);
+    return status;
+}
+
+rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const render_options *options,
+                            uint32_t samples_per_pixel, const int traced[4], const int region[4],
+                            uint32_t initial_budget, double start, render_progress *progress,
+                            render_stop_reason *stop, render_result *result, rt_error *error)
+{
+    double last_checkpoint = clock_seconds(), last_preview = clock_seconds();
+    double first_pass_end = 0, last_pass_seconds = 0;
+    bool adaptive_budget = options->pass_work_budget == 0;
+    gpu_info device;
+    gpu_get_info(context, &device);
+    double target_seconds = options->target_pass_seconds > 0 ? options->target_pass_seconds
+                            : device.software                ? SOFTWARE_TARGET_PASS_SECONDS
+                                                             : DEFAULT_TARGET_PASS_SECONDS;
+    double budget = initial_budget;
+    double most_budget = device.max_pass_work_budget < MAXIMUM_ADAPTIVE_BUDGET ? device.max_pass_work_budget
+                                                                               : MAXIMUM_ADAPTIVE_BUDGET;
+    adaptive_run adaptive;
+    rt_status status = start_adaptive(tracer, options, samples_per_pixel, traced[2] - traced[0],
+                                      traced[3] - traced[1], &adaptive, error);
+    *stop = RENDER_STOP_SAMPLES;
+    for (bool done = false; status == RT_OK && !done;) {
+        if (!pass_fits_deadline(tracer, options, last_pass_seconds, adaptive_budget, &budget)) {
+            *stop = RENDER_STOP_TIME;
+            break;
+        }
+        gpu_pass_report report;
+        double pass_start = clock_seconds();
+        status = gpu_tracer_run_pass(tracer, &report, error);
+        if (status != RT_OK)
+            break;
+        last_pass_seconds = clock_seconds() - pass_start;
+        if (adaptive_budget)
+            adapt_pass_budget(tracer, last_pass_seconds, target_seconds, most_budget, &budget);
+        progress->passes++;
+        progress->samples_done += report.samples_finished;
+        progress->elapsed_seconds = clock_seconds() - start;
+        if (progress->passes == 1) {
+            result->first_pass_seconds = progress->elapsed_seconds;
+            first_pass_end = clock_seconds();
+        } else {
+            result->steady_samples += report.samples_finished;
+            result->steady_seconds = clock_seconds() - first_pass_end;
+        }
+        if (options->progress != NULL)
+            options->progress(options->progress_context, progress);
+        if (status == RT_OK && report.unfinished_pixels == 0) {
+            done = true;
+            if (adaptive.sampler != NULL) {
+                status = check_adaptive(tracer, &adaptive, &done, error);
+                adaptive_noise noise;
+                adaptive_get_noise(adaptive.sampler, &noise);
+                progress->noise_checks = noise.checks;
+                progress->noisy_pixels = noise.unconverged_pixels;
+                progress->going_pixels = noise.going_pixels;
+                progress->noise_error = noise.mean_error;
+            }
+            if (done && adaptive.sampler != NULL && adaptive_stopped_early(adaptive.sampler))
+                *stop = RENDER_STOP_NOISE;
+            continue;
+        }
+        if (options->stop_requested != NULL && *options->stop_requested) {
+            *stop = RENDER_STOP_INTERRUPTED;
+            break;
+        }
+        /* Checkpoints and previews (--display) share one read-back when both are due. */
+        bool checkpoint_due = options->checkpoint != NULL && options->checkpoint_seconds > 0
+                              && clock_seconds() - last_checkpoint >= options->checkpoint_seconds;
+        bool preview_due = options->preview != NULL && options->preview_seconds > 0
+                           && clock_seconds() - last_preview >= options->preview_seconds;
+        if (status == RT_OK && (checkpoint_due || preview_due)) {
+            status = write_partial(tracer, options, traced, region, result->scene_hash, checkpoint_due, preview_due,
+                                   error);
+            if (checkpoint_due)
+                last_checkpoint = clock_seconds();
+            if (preview_due)
+                last_preview = clock_seconds();
+        }
+    }
+    end_adaptive(&adaptive);
+    return status;
+}
