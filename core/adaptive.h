@@ -8,11 +8,11 @@
  * (Y = 0.2126 R + 0.7152 G + 0.0722 B, as glsl/path_state.glsl finish_sample squares it):
  *     s^2   = (sum Y^2 - n * mean^2) / (n - 1)          (the sample variance)
  *     error = sqrt(s^2 / n) / max(mean, ADAPTIVE_LUMINANCE_FLOOR)
- * so above the floor the threshold is relative (LuxCore's and Cycles' halt thresholds are
- * relative too), below it absolute: a nearly black pixel need not reach a relative error
- * that no display shows. The Sobol samples of one pixel are stratified, so s^2 / n
- * overestimates the variance of their mean: pixels stop later than they could, never
- * earlier. A pixel with fewer than 2 samples has an infinite error.
+ * so above the floor the threshold is relative (LuxCore's halt threshold is, and Cycles'
+ * above an intensity of 1), below it absolute: a nearly black pixel need not reach a
+ * relative error that no display shows. The Sobol samples of one pixel are stratified,
+ * so s^2 / n overestimates the variance of their mean: pixels stop later than they
+ * could, never earlier. A pixel with fewer than 2 samples has an infinite error.
  *
  * ## The schedule (checks happen at fixed sample counts, so the result is a pure function
  * of the samples: the pass budget and the machine's speed decide nothing)
