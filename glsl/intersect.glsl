@@ -133,14 +133,15 @@ bool alpha_masked(uint slot, uvec4 record, uint type, vec4 sphere, vec3 origin, 
     return alpha < uintBitsToFloat(mask.y);
 }
 
-// Tests one primitive (by slot, its record already read) of the current level; on a
-// nearer hit updates hit (a hit where an alpha mask has no surface is none).
-void intersect_primitive(uint slot, uvec4 record, uint type, TraversalRay ray, float time, uint instance,
-                         inout Hit hit)
+// Tests one primitive (by slot, its record and the texels behind it already read:
+// glsl/scene_access.glsl primitive_geometry_addresses) of the current level; on a nearer
+// hit updates hit (a hit where an alpha mask has no surface is none).
+void intersect_primitive(uint slot, uvec4 record, uint type, uvec4 g0, uvec4 g1, uvec4 g2, TraversalRay ray,
+                         float time, uint instance, inout Hit hit)
 {
     vec4 a, b, c;
     uvec3 normal_words;
-    primitive_geometry(record, type, a, b, c, normal_words);
+    primitive_geometry_of(record, type, g0, g1, g2, a, b, c, normal_words);
     float t = INFINITY;
     vec2 coordinates = vec2(0.0);
     if (ONLY_SPHERES) {

@@ -77,12 +77,22 @@ uint record_type(uvec4 record)
     return ONLY_SPHERES ? uint(PRIMITIVE_SPHERE) : ONLY_TRIANGLES ? uint(PRIMITIVE_TRIANGLE) : tagged;
 }
 
-// A primitive's geometry: sphere (centre, radius) in a; moving sphere (centre at time 0,
-// radius) in a, (centre at time 1) in b; triangle and quad: corner in a, edges in b and c;
-// for a triangle, normal_words are its vertices' encoded normals. The texels behind the
-// record are fetched in one place for every type (a triangle's vertices, a shape record):
-// llvmpipe runs every branch, so per-type fetches would all be paid.
-void primitive_geometry(uvec4 record, uint type, out vec4 a, out vec4 b, out vec4 c, out uvec3 normal_words)
+// The texels behind a primitive's record (a triangle's three vertices; a quad's or moving
+// sphere's shape record): texel 0 (unused) for spheres and instances.
+uvec3 primitive_geometry_addresses(uvec4 record, uint type)
+{
+    bool triangle = type == uint(PRIMITIVE_TRIANGLE);
+    bool behind = type != uint(PRIMITIVE_SPHERE) && type != uint(PRIMITIVE_INSTANCE);
+    uvec3 address = triangle ? uvec3(vertex_offset) + record.xyz : uvec3(record.x, record.x + 1u, record.x + 2u);
+    return behind ? address : uvec3(0u);
+}
+
+// A primitive's geometry from its record and the texels behind it (g0..g2, fetched from
+// primitive_geometry_addresses): sphere (centre, radius) in a; moving sphere (centre at
+// time 0, radius) in a, (centre at time 1) in b; triangle and quad: corner in a, edges in
+// b and c; for a triangle, normal_words are its vertices' encoded normals.
+void primitive_geometry_of(uvec4 record, uint type, uvec4 g0, uvec4 g1, uvec4 g2, out vec4 a, out vec4 b,
+                           out vec4 c, out uvec3 normal_words)
 {
     a = uintBitsToFloat(record);
     b = vec4(0.0);
@@ -91,10 +101,6 @@ void primitive_geometry(uvec4 record, uint type, out vec4 a, out vec4 b, out vec
     if (!ONLY_SPHERES) {
         bool triangle = type == uint(PRIMITIVE_TRIANGLE);
         bool behind = type != uint(PRIMITIVE_SPHERE) && type != uint(PRIMITIVE_INSTANCE);
-        uvec3 address = triangle ? uvec3(vertex_offset) + record.xyz : uvec3(record.x, record.x + 1u, record.x + 2u);
-        address = behind ? address : uvec3(0u);
-        uvec4 g0 = packed_texel(address.x), g1 = packed_texel(address.y);
-        uvec4 g2 = HAS_FLAT ? packed_texel(address.z) : uvec4(0u);   // moving spheres have 2 texels
         if (behind) {
             vec4 f0 = uintBitsToFloat(g0), f1 = uintBitsToFloat(g1), f2 = uintBitsToFloat(g2);
             a = triangle ? vec4(f0.xyz, 0.0) : f0;
@@ -104,6 +110,21 @@ void primitive_geometry(uvec4 record, uint type, out vec4 a, out vec4 b, out vec
                 normal_words = uvec3(g0.w, g1.w, g2.w);
         }
     }
+}
+
+// A primitive's geometry (primitive_geometry_of) with the texels behind its record
+// fetched here, in one place for every type: llvmpipe runs every branch, so per-type
+// fetches would all be paid.
+void primitive_geometry(uvec4 record, uint type, out vec4 a, out vec4 b, out vec4 c, out uvec3 normal_words)
+{
+    uvec4 g0 = uvec4(0u), g1 = uvec4(0u), g2 = uvec4(0u);
+    if (!ONLY_SPHERES) {
+        uvec3 address = primitive_geometry_addresses(record, type);
+        g0 = packed_texel(address.x);
+        g1 = packed_texel(address.y);
+        g2 = HAS_FLAT ? packed_texel(address.z) : uvec4(0u);   // moving spheres have 2 texels
+    }
+    primitive_geometry_of(record, type, g0, g1, g2, a, b, c, normal_words);
 }
 
 // The vertex normals of a triangle whose vertex texels' w are bits (false when a vertex

@@ -27,6 +27,16 @@ const uint LEAVE_INSTANCE_MARK = 7u;
 
 uint stack_word(uint first, uint count) { return first | (count << STACK_FIRST_BITS); }
 
+// With triangles, a leaf primitive is read by the loop's four node fetches, in an
+// iteration of its own (a leaf found going down is tested in the next iteration), rather
+// than by fetches of its own in every iteration: an iteration then makes 4 fetches (the
+// record and the three vertices, or a node pair) instead of 8. Measured
+// (docs/performance.md, the log): meshes of 82k and 1.3M triangles 10 and 20% faster, but
+// the Cornell box (quads) no faster and lights.txt (quads and spheres) 5% slower, where
+// the extra iteration per leaf costs more than the fetches save; a sphere is its record
+// alone. So only the variants with triangles do it.
+const bool LEAF_TEXELS = HAS_TRIANGLES;
+
 // A shadow ray: from origin towards a light, which it reaches at t_max (just short of
 // the light, so that the light itself is not in the way).
 struct ShadowRay {
@@ -87,10 +97,18 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
         if (!count_work())
             break;
         bool entering = HAS_INSTANCES && count == ENTER_INSTANCE_MARK;
+        // The iteration's four texels: an interior node's pair of children, an instance's
+        // head and matrix, or (LEAF_TEXELS) a leaf primitive's record and the three texels
+        // behind it, all by the same four fetch calls.
+        bool at_leaf = LEAF_TEXELS && count != 0u && !entering && !(HAS_INSTANCES && count == LEAVE_INSTANCE_MARK);
         uint base = entering ? instance_offset + first * uint(PACKED_INSTANCE_STRIDE)
+                  : at_leaf  ? primitive_offset + first
                              : node_offset + first * uint(PACKED_NODE_STRIDE);
-        uvec4 texel0 = packed_texel(base), texel1 = packed_texel(base + 1u);
-        uvec4 texel2 = packed_texel(base + 2u), texel3 = packed_texel(base + 3u);
+        uvec4 texel0 = packed_texel(base);
+        uvec3 behind = uvec3(base + 1u, base + 2u, base + 3u);
+        if (at_leaf)
+            behind = primitive_geometry_addresses(texel0, record_type(texel0));
+        uvec4 texel1 = packed_texel(behind.x), texel2 = packed_texel(behind.y), texel3 = packed_texel(behind.z);
         if (HAS_INSTANCES && count == LEAVE_INSTANCE_MARK) {
             ray = world;
             instance = NONE;
@@ -111,7 +129,8 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
             // An interior node: its children's boxes, the farther hit one pushed, the
             // nearer one next. When that one is a leaf its first primitive is tested in
             // this same iteration (below): llvmpipe runs the primitive test's code in
-            // every iteration anyway.
+            // every iteration anyway (with LEAF_TEXELS, in the next: its texels come
+            // through the node fetches).
             bool descend = false;
             if (count == 0u) {
                 float left_entry = intersect_box(packed_xyz(texel0), packed_xyz(texel1), ray.origin,
@@ -135,7 +154,7 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
                     first = near_node.x;
                     count = near_node.y;
                     node_entry = near_entry;
-                    descend = count == 0u;
+                    descend = LEAF_TEXELS || count == 0u;
                 }
             }
             if (descend)
@@ -149,7 +168,7 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
             // meshes). The count stays below the instance marks (BVH_MAX_LEAF_SIZE 4).
             if (count > 0u) {
                 uint slot = first;
-                uvec4 record = packed_texel(primitive_offset + slot);
+                uvec4 record = LEAF_TEXELS ? texel0 : packed_texel(primitive_offset + slot);
                 uint type = record_type(record);
                 if (HAS_INSTANCES && type == uint(PRIMITIVE_INSTANCE)) {
                     if (stack_size + 2 <= STACK_SIZE) {
@@ -163,7 +182,14 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
                     }
                 } else {
                     float before = hit.t;
-                    intersect_primitive(slot, record, type, ray, time, instance, hit);
+                    uvec4 g0 = texel1, g1 = texel2, g2 = texel3;
+                    if (!LEAF_TEXELS && !ONLY_SPHERES) {
+                        uvec3 address = primitive_geometry_addresses(record, type);
+                        g0 = packed_texel(address.x);
+                        g1 = packed_texel(address.y);
+                        g2 = HAS_FLAT ? packed_texel(address.z) : uvec4(0u);
+                    }
+                    intersect_primitive(slot, record, type, g0, g1, g2, ray, time, instance, hit);
                     // A shadow ray's blocker: anything but its light and volume boundaries.
                     bool passable = instance == NONE ? slot == shadow.light_slot : HAS_VOLUMES && volume_instance;
                     if (shadow_phase && hit.t < before && !passable)
