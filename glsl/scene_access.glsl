@@ -112,18 +112,27 @@ void primitive_geometry_of(uvec4 record, uint type, uvec4 g0, uvec4 g1, uvec4 g2
     }
 }
 
-// A primitive's geometry (primitive_geometry_of) with the texels behind its record
-// fetched here, in one place for every type: llvmpipe runs every branch, so per-type
-// fetches would all be paid.
-void primitive_geometry(uvec4 record, uint type, out vec4 a, out vec4 b, out vec4 c, out uvec3 normal_words)
+// Fetches the texels behind a primitive's record (primitive_geometry_addresses), in one
+// place for every type: llvmpipe runs every branch, so per-type fetches would all be paid.
+void primitive_geometry_texels(uvec4 record, uint type, out uvec4 g0, out uvec4 g1, out uvec4 g2)
 {
-    uvec4 g0 = uvec4(0u), g1 = uvec4(0u), g2 = uvec4(0u);
+    g0 = uvec4(0u);
+    g1 = uvec4(0u);
+    g2 = uvec4(0u);
     if (!ONLY_SPHERES) {
         uvec3 address = primitive_geometry_addresses(record, type);
         g0 = packed_texel(address.x);
         g1 = packed_texel(address.y);
         g2 = HAS_FLAT ? packed_texel(address.z) : uvec4(0u);   // moving spheres have 2 texels
     }
+}
+
+// A primitive's geometry (primitive_geometry_of) with the texels behind its record
+// fetched here.
+void primitive_geometry(uvec4 record, uint type, out vec4 a, out vec4 b, out vec4 c, out uvec3 normal_words)
+{
+    uvec4 g0, g1, g2;
+    primitive_geometry_texels(record, type, g0, g1, g2);
     primitive_geometry_of(record, type, g0, g1, g2, a, b, c, normal_words);
 }
 

@@ -183,12 +183,8 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
                 } else {
                     float before = hit.t;
                     uvec4 g0 = texel1, g1 = texel2, g2 = texel3;
-                    if (!LEAF_TEXELS && !ONLY_SPHERES) {
-                        uvec3 address = primitive_geometry_addresses(record, type);
-                        g0 = packed_texel(address.x);
-                        g1 = packed_texel(address.y);
-                        g2 = HAS_FLAT ? packed_texel(address.z) : uvec4(0u);
-                    }
+                    if (!LEAF_TEXELS)
+                        primitive_geometry_texels(record, type, g0, g1, g2);
                     intersect_primitive(slot, record, type, g0, g1, g2, ray, time, instance, hit);
                     // A shadow ray's blocker: anything but its light and volume boundaries.
                     bool passable = instance == NONE ? slot == shadow.light_slot : HAS_VOLUMES && volume_instance;
