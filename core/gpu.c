@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "gpu_internal.h"
 
@@ -261,6 +263,28 @@ static int count_software_threads(void)
     return count;
 }
 
+/* Counts the rasteriser threads once they have all named themselves: llvmpipe starts
+ * them as its screen is made and each sets its name when it first runs, which on a loaded
+ * machine can come after the context exists (a likely cause of one failure of
+ * tests/render/test-farm.sh's --threads check under `make test`, not reproduced since).
+ * So the count is read again, every 10 ms for at most half a second, while it is below
+ * expected (the threads asked for, or LP_NUM_THREADS; by default at least one on a
+ * machine of several CPUs, where llvmpipe runs one per CPU). */
+static int settled_software_threads(int asked)
+{
+    int expected = asked;
+    const char *environment = getenv("LP_NUM_THREADS");
+    if (expected <= 0)
+        expected = environment != NULL ? atoi(environment) : sysconf(_SC_NPROCESSORS_ONLN) > 1 ? 1 : 0;
+    int count = count_software_threads();
+    for (int tries = 0; tries < 50 && count >= 0 && count < expected; tries++) {
+        struct timespec pause = {0, 10 * 1000 * 1000};
+        nanosleep(&pause, NULL);
+        count = count_software_threads();
+    }
+    return count;
+}
+
 /* The environment's LP_NUM_THREADS before gpu_create() changed it, to put back. */
 typedef struct thread_setting {
     bool changed;
@@ -318,7 +342,8 @@ rt_status gpu_create(const gpu_options *options, gpu_context **out, rt_error *er
         return status;
     }
     read_gl_info(context);
-    context->info.software_threads = count_software_threads();
+    context->info.software_threads =
+        context->info.software ? settled_software_threads(threads) : count_software_threads();
     context->info.threads_ignored = threads > 0 && !context->info.software;
     if (context->options.debug_output && epoxy_has_gl_extension("GL_KHR_debug")) {
         glEnable(GL_DEBUG_OUTPUT);
