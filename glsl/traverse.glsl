@@ -13,8 +13,13 @@ const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 // their w components are those pairs, so a node is never fetched twice (4 fetches per
 // interior node instead of 6). A stack entry is such a pair in one word, count in the top
 // bits (a leaf holds at most BVH_MAX_LEAF_SIZE primitives; the packer keeps first below
-// 2^PACKED_FIRST_BITS), and the entry distance: two arrays, not three, since llvmpipe
-// writes and reads a per-lane array index one lane at a time. Two counts mark instances:
+// 2^PACKED_FIRST_BITS), and nothing else: llvmpipe writes and reads a per-lane array index
+// one lane at a time, and a store as a read, a per-lane branch on the lane's mask and a
+// write, so the stack is one array, written in one place (the loop's top level, see
+// trace_rays). A popped entry carries no entry distance to cull it by: its children's
+// boxes (or a leaf's primitives) are tested against the nearest hit in its own iteration,
+// which costs less than the second array did (docs/performance.md, the log).
+// Two counts mark instances:
 // ENTER_INSTANCE (first = the instance) moves the ray into the instance's object and
 // goes on at its root, LEAVE_INSTANCE restores the world ray. Entering is an iteration of
 // its own whose four texels (the instance's head and matrix) are fetched by the same
@@ -88,10 +93,10 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
     bool volume_instance = false;
     // The root's box is not tested: its children's are, in the first iteration.
     uint first = root_low.w, count = root_high.w;
-    float node_entry = -INFINITY;
     bool stop = false;   // the shadow ray is blocked
-    uint stack_node[STACK_SIZE];
-    float stack_entry[STACK_SIZE];
+    // One slot more than the stack can hold: every iteration writes the free slot above
+    // the top (below), also when the stack is full.
+    uint stack[STACK_SIZE + 1];
     int stack_size = 0;
     for (;;) {
         if (!count_work())
@@ -109,6 +114,21 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
         if (at_leaf)
             behind = primitive_geometry_addresses(texel0, record_type(texel0));
         uvec4 texel1 = packed_texel(behind.x), texel2 = packed_texel(behind.y), texel3 = packed_texel(behind.z);
+        // An interior node's children's boxes, the nearer one to go on with and the farther
+        // one written to the free slot above the stack's top, in every iteration whatever
+        // its item (llvmpipe would run this code in every iteration anyway). A push is then
+        // only stack_size++. Here, outside every condition, the store's per-lane branch
+        // follows whether the lane is still walking; inside the push's condition it went
+        // either way at random (docs/performance.md, the log).
+        float left_entry = intersect_box(packed_xyz(texel0), packed_xyz(texel1), ray.origin, ray.inverse_direction,
+                                         hit.t);
+        float right_entry = intersect_box(packed_xyz(texel2), packed_xyz(texel3), ray.origin, ray.inverse_direction,
+                                          hit.t);
+        bool right_nearer = right_entry < left_entry;
+        uvec2 near_node = right_nearer ? uvec2(texel2.w, texel3.w) : uvec2(texel0.w, texel1.w);
+        uvec2 far_node = right_nearer ? uvec2(texel0.w, texel1.w) : uvec2(texel2.w, texel3.w);
+        bool near_hit = min(left_entry, right_entry) < INFINITY, far_hit = max(left_entry, right_entry) < INFINITY;
+        stack[stack_size] = stack_word(far_node.x, far_node.y);
         if (HAS_INSTANCES && count == LEAVE_INSTANCE_MARK) {
             ray = world;
             instance = NONE;
@@ -123,39 +143,24 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
             ray = traversal_ray(object_origin, object_direction);
             first = texel0.x;
             count = texel0.w;
-            node_entry = -INFINITY;
             continue;
-        } else if (node_entry < hit.t) {
-            // An interior node: its children's boxes, the farther hit one pushed, the
-            // nearer one next. When that one is a leaf its first primitive is tested in
-            // this same iteration (below): llvmpipe runs the primitive test's code in
-            // every iteration anyway (with LEAF_TEXELS, in the next: its texels come
-            // through the node fetches).
+        } else {
+            // An interior node: the farther child hit is pushed (written above), the nearer
+            // one goes next. When that one is a leaf its first primitive is tested in this
+            // same iteration (below): llvmpipe runs the primitive test's code in every
+            // iteration anyway (with LEAF_TEXELS, in the next: its texels come through the
+            // node fetches).
             bool descend = false;
-            if (count == 0u) {
-                float left_entry = intersect_box(packed_xyz(texel0), packed_xyz(texel1), ray.origin,
-                                                 ray.inverse_direction, hit.t);
-                float right_entry = intersect_box(packed_xyz(texel2), packed_xyz(texel3), ray.origin,
-                                                  ray.inverse_direction, hit.t);
-                bool right_nearer = right_entry < left_entry;
-                uvec2 near_node = right_nearer ? uvec2(texel2.w, texel3.w) : uvec2(texel0.w, texel1.w);
-                uvec2 far_node = right_nearer ? uvec2(texel0.w, texel1.w) : uvec2(texel2.w, texel3.w);
-                float near_entry = min(left_entry, right_entry), far_entry = max(left_entry, right_entry);
-                if (near_entry < INFINITY) {
-                    if (far_entry < INFINITY) {
-                        if (stack_size < STACK_SIZE) {
-                            stack_node[stack_size] = stack_word(far_node.x, far_node.y);
-                            stack_entry[stack_size] = far_entry;
-                            stack_size++;
-                        } else {
-                            overflow = true;
-                        }
-                    }
-                    first = near_node.x;
-                    count = near_node.y;
-                    node_entry = near_entry;
-                    descend = LEAF_TEXELS || count == 0u;
+            if (count == 0u && near_hit) {
+                if (far_hit) {
+                    if (stack_size < STACK_SIZE)
+                        stack_size++;
+                    else
+                        overflow = true;
                 }
+                first = near_node.x;
+                count = near_node.y;
+                descend = LEAF_TEXELS || count == 0u;
             }
             if (descend)
                 continue;
@@ -172,10 +177,8 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
                 uint type = record_type(record);
                 if (HAS_INSTANCES && type == uint(PRIMITIVE_INSTANCE)) {
                     if (stack_size + 2 <= STACK_SIZE) {
-                        stack_node[stack_size] = stack_word(0u, LEAVE_INSTANCE_MARK);
-                        stack_entry[stack_size] = -INFINITY;
-                        stack_node[stack_size + 1] = stack_word(record.x, ENTER_INSTANCE_MARK);
-                        stack_entry[stack_size + 1] = -INFINITY;
+                        stack[stack_size] = stack_word(0u, LEAVE_INSTANCE_MARK);
+                        stack[stack_size + 1] = stack_word(record.x, ENTER_INSTANCE_MARK);
                         stack_size += 2;
                     } else {
                         overflow = true;   // reported as an error, never skipped silently
@@ -193,7 +196,6 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
                 }
                 first++;
                 count--;
-                node_entry = -INFINITY;   // the leaf's box is not tested again
                 if (count > 0u && !stop)
                     continue;
             }
@@ -218,15 +220,13 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
             stop = false;
             first = root_low.w;
             count = root_high.w;
-            node_entry = -INFINITY;
             stack_size = 0;
             continue;
         }
         stack_size--;
-        uint word = stack_node[stack_size];
+        uint word = stack[stack_size];
         first = word & STACK_FIRST_MASK;
         count = word >> STACK_FIRST_BITS;
-        node_entry = stack_entry[stack_size];
     }
 }
 
