@@ -15,8 +15,9 @@ const int STACK_SIZE = 2 * BVH_MAX_DEPTH + 2 * BVH_MAX_LEAF_SIZE;
 // bits (a leaf holds at most BVH_MAX_LEAF_SIZE primitives; the packer keeps first below
 // 2^PACKED_FIRST_BITS), and nothing else: llvmpipe writes and reads a per-lane array index
 // one lane at a time, and a store as a read, a per-lane branch on the lane's mask and a
-// write, so the stack is one array, written in one place (the loop's top level, see
-// trace_rays). A popped entry carries no entry distance to cull it by: its children's
+// write, so the stack is one array, written at the loop's top level (see trace_rays;
+// only an instance's two marks are pushed inside a condition, and only by variants with
+// instances). A popped entry carries no entry distance to cull it by: its children's
 // boxes (or a leaf's primitives) are tested against the nearest hit in its own iteration,
 // which costs less than the second array did (docs/performance.md, the log).
 // Two counts mark instances:
