@@ -108,7 +108,11 @@
  *                   (centre at time 0 .xyz, radius), (centre at time 1 .xyz, 0)
  *   triangle:       (vertex 0, vertex 1, vertex 2, tag): indices into the vertex section
  *   quad:           (first texel of its shape record, 0, 0, tag); the record is 3 texels:
- *                   (corner Q.xyz, 0), (edge u.xyz, 0), (edge v.xyz, 0)
+ *                   (corner Q.xyz, 0), (edge u.xyz, 0), (edge v.xyz, 0). Shape records
+ *                   follow one another in slot order from the shape section's start, so
+ *                   in a scene of quads alone (one BVH level) quad k's is at
+ *                   shape_offset + 3k: the tracer's quad-only variant reads it from there
+ *                   without the record (glsl/traverse.glsl leaf_record)
  *   instance:       (instance index, 0, 0, tag)   (only in top-level leaves)
  * tag = PRIMITIVE_RECORD_TAG + type tag: no sphere's w (a positive float's bits, below
  * 2139095040) is that large, so a ray test reads the type from the record itself.

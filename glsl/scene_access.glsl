@@ -16,6 +16,7 @@ uint node_offset;
 uint node_count;
 uint instance_offset;
 uint info_offset;
+uint shape_offset;
 uint vertex_offset;
 uint uv_offset;
 uint area_light_count;
@@ -45,6 +46,7 @@ void read_header()
     light_count = header4.y;
     environment_offset = header4.z;
     area_light_count = header4.w;
+    shape_offset = header5.x;
     vertex_offset = header5.y;
     uv_offset = header5.z;
     color_offset = HAS_VERTEX_COLORS ? packed_texel(6u).x : NONE;

@@ -37,6 +37,7 @@ const bool HAS_FLAT_LIGHTS = HAS_RECTANGLE_LIGHTS || HAS_TRIANGLE_LIGHTS;   // q
 const bool HAS_AREA_LIGHTS = HAS_SPHERE_LIGHTS || HAS_FLAT_LIGHTS;
 const bool ONLY_SPHERES = !HAS_TRIANGLES && !HAS_QUADS && !HAS_MOVING_SPHERES && !HAS_INSTANCES;
 const bool ONLY_TRIANGLES = !HAS_SPHERES && !HAS_QUADS && !HAS_INSTANCES;
+const bool ONLY_QUADS = !HAS_SPHERES && !HAS_TRIANGLES && !HAS_INSTANCES;
 
 // The integrator, the sky kind and the sampler: compiled in as constants (RTSPHERES_FIX_UNIFORMS 1,
 // gpu.h GPU_FIX_UNIFORMS), or read from the parameter block (the full tracer).

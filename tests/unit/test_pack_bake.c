@@ -295,10 +295,46 @@ static void the_default_budget(void **state)
     }
 }
 
+/* In a scene of quads alone (boxes and quads, their placements baked: one BVH level),
+ * quad k's shape record is at shape_offset + 3k, which the tracer's quad-only variant
+ * relies on instead of reading the record (glsl/traverse.glsl leaf_record). */
+static void quads_alone_keep_their_shapes_in_slot_order(void **state)
+{
+    (void)state;
+    scene s;
+    load_text("material grey lambertian 0.5 0.5 0.5\n"
+              "material lamp emissive 4 4 4\n"
+              "quad -1 0 -1  2 0 0  0 0 2 grey\n"
+              "quad 0 2 0  0.5 0 0  0 0 0.5 lamp\n"
+              "group material grey {\n"
+              "    rotate 0 1 0 15\n"
+              "    translate 0.3 0 0.2\n"
+              "    box 0 0 0  0.5 1 0.5\n"
+              "}\n"
+              "group material grey {\n"
+              "    translate -0.4 0 -0.3\n"
+              "    box 0 0 0  0.3 0.6 0.3\n"
+              "}\n",
+              &s);
+    packed_scene packed;
+    pack(&s, NULL, &packed);
+    assert_int_equal(packed.instance_count, 0);
+    assert_int_equal(packed.primitive_count, 14);   /* two quads, two boxes of six */
+    assert_int_equal(packed.shape_texels, 3 * 14);
+    for (uint32_t slot = 0; slot < packed.primitive_count; slot++) {
+        const uint32_t *record = &packed.texels[4 * (packed.primitive_offset + slot)];
+        assert_int_equal(record[3], PRIMITIVE_RECORD_TAG + PRIMITIVE_QUAD);
+        assert_int_equal(record[0], packed.shape_offset + PACKED_QUAD_TEXELS * slot);
+    }
+    packed_scene_free(&packed);
+    scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(baked_records_are_the_moved_shapes),
+        cmocka_unit_test(quads_alone_keep_their_shapes_in_slot_order),
         cmocka_unit_test(the_rule_keeps_instances_where_it_says),
         cmocka_unit_test(the_default_budget),
     };
