@@ -12,6 +12,7 @@ struct adaptive_sampler {
     uint32_t *limits;            /* per pixel, rows top to bottom */
     uint8_t *going;              /* 1: the pixel still takes samples */
     uint8_t *unconverged;        /* scratch of adaptive_check */
+    uint32_t checked_at, next_check;   /* the sample counts of the last check and the next */
     bool stopped_early;
     adaptive_noise noise;        /* of the last check */
 };
@@ -76,6 +77,7 @@ rt_status adaptive_create(int width, int height, float threshold, uint32_t min_s
     uint32_t first = adaptive_next_check(0, sampler->min_spp, max_spp);
     for (size_t i = 0; i < pixels; i++)
         sampler->limits[i] = first;
+    sampler->next_check = first;
     memset(sampler->going, 1, pixels);
     *out = sampler;
     return RT_OK;
@@ -124,6 +126,8 @@ int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *lu
         unconverged += sampler->unconverged[i];
     }
     sampler->noise.checks++;
+    sampler->checked_at = sampler->next_check;
+    sampler->next_check = adaptive_next_check(sampler->checked_at, sampler->min_spp, sampler->max_spp);
     sampler->noise.unconverged_pixels = unconverged;
     sampler->noise.mean_error = checked > 0 ? (float)(error_sum / checked) : 0.0f;
     int going = 0;
@@ -148,6 +152,12 @@ int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *lu
         }
     sampler->noise.going_pixels = going;
     return going;
+}
+
+int adaptive_runs(const adaptive_sampler *sampler)
+{
+    uint32_t runs = (sampler->next_check - sampler->checked_at) / ADAPTIVE_RUN_SAMPLES;
+    return runs < 1 ? 1 : runs > ADAPTIVE_MAX_RUNS ? ADAPTIVE_MAX_RUNS : (int)runs;
 }
 
 void adaptive_get_noise(const adaptive_sampler *sampler, adaptive_noise *noise)

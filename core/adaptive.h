@@ -33,7 +33,10 @@
  * ## The passes
  * After a check, passes trace only the pixels still going (adaptive_going_pixels), packed
  * densely by the tracer (gpu.h gpu_tracer_set_pass_pixels, core/gpu_compact.c), so that
- * no SIMD lane idles on a pixel that has stopped.
+ * no SIMD lane idles on a pixel that has stopped, each pixel's samples up to the next
+ * check split into adaptive_runs() runs traced side by side: a pass may give a slot only
+ * so many samples (glsl/work.glsl), and the few pixels of the last checks would otherwise
+ * take many short passes, each with its fixed cost (docs/performance.md).
  */
 #ifndef RT_ADAPTIVE_H
 #define RT_ADAPTIVE_H
@@ -45,6 +48,10 @@
 
 #define ADAPTIVE_DEFAULT_MIN_SPP 16
 #define ADAPTIVE_LUMINANCE_FLOOR 0.2f
+/* adaptive_runs(): about this many samples a run (a Cornell box slot takes 10 to 20 in a
+ * pass on llvmpipe), at most ADAPTIVE_MAX_RUNS runs a pixel. */
+#define ADAPTIVE_RUN_SAMPLES 8
+#define ADAPTIVE_MAX_RUNS 16
 
 typedef struct adaptive_sampler adaptive_sampler;
 
@@ -78,6 +85,12 @@ const uint32_t *adaptive_limits(const adaptive_sampler *sampler);
  * bottom. Stops the pixels the decision above stops and raises the others' limit to the
  * next check. Returns the pixels still going (0: the render is done). */
 int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *luminance_squares);
+
+/* The runs (gpu.h gpu_tracer_set_pass_pixels) a pixel going on takes from the last check
+ * to the next: (next - last) / ADAPTIVE_RUN_SAMPLES, within [1, ADAPTIVE_MAX_RUNS]. A
+ * function of the checks' sample counts alone, never of how many pixels go on, so that a
+ * tile's pixels get the same runs, and so the same sums, as in the whole image. */
+int adaptive_runs(const adaptive_sampler *sampler);
 
 /* How noisy the image was at the last check (all zero before the first): for progress
  * reports. */

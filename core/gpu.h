@@ -254,16 +254,25 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget);
  * (core/adaptive.h). */
 rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limits, rt_error *error);
 
-/* Makes the following passes run only the count pixels of pixels (indices y * width + x,
- * rows from the top, each at most once; copied), packed densely (core/gpu_compact.c), so
- * that the lanes of a SIMD vector are all pixels of the list: what adaptive sampling
- * (core/adaptive.h) saves shows on the clock. Pixels left out keep their state; the
- * image is the same to the bit as with every pixel traced. pixels NULL: every pixel again
- * (the default). Costs two copies of the listed pixels' state (a pass's reading and
- * writing of it), and the compact state: GPU_TRACER_STATE_BYTES_PER_PIXEL a pixel of the
- * first list, kept until the tracer is destroyed. RT_ERROR_RUNTIME
- * when the device runs out of memory. */
-rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels, int count, rt_error *error);
+/* Makes the following passes run only the count (> 0) pixels of pixels (indices y * width
+ * + x, rows from the top, each at most once; copied), packed densely (core/gpu_compact.c),
+ * so that the lanes of a SIMD vector are all pixels of the list: what adaptive sampling
+ * (core/adaptive.h) saves shows on the clock. Call it after a pass that reported no
+ * unfinished pixel and then gpu_tracer_set_sample_limits: each listed pixel goes on from
+ * its limit before those (the samples it has started) to its new limit in runs (at least 1):
+ * its samples split into that many ranges of consecutive indices, traced side by side in
+ * slots of their own, each summed from zero and added to the pixel's sums in order. So a
+ * pixel's sums depend on its samples and runs alone, not on the list (a tile renders its
+ * pixels as the whole image does); they differ from one run's (or uncompacted passes') by
+ * float rounding. With light group layers a pixel takes 1 run. Pixels left out keep their
+ * sums; from the first list on, passes never return to the whole image. Costs one
+ * read-back of the full state (the first list), one of the slots' sums a list (and a read
+ * of them at every read of the state), and the compact state: GPU_TRACER_STATE_BYTES_PER_PIXEL
+ * a slot, at most as many slots as the image has pixels (more runs go in rounds, one after
+ * another), kept until the tracer is destroyed. RT_ERROR_RUNTIME when the device or the
+ * host runs out of memory. */
+rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels, int count, int runs,
+                                     rt_error *error);
 
 /* Reads the accumulated result: rgba receives width*height*4 floats, rows top to bottom,
  * (sum of finished samples' radiance r, g, b, number of finished samples);

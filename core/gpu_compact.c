@@ -5,47 +5,42 @@
  * (docs/performance.md). Under adaptive sampling the pixels still going are scattered over
  * the image, so a vector of the full image often holds one busy pixel and seven that are
  * done, and costs as much as eight busy ones. Here the pixels still going are packed
- * densely into compact state textures, so that every lane of a vector has work.
+ * densely into compact state textures, so that every lane of a vector has work. And since
+ * a pass may give a pixel only so many samples (the loop cap, glsl/work.glsl), a short
+ * list would take many short passes, each with its fixed cost: so each pixel's samples
+ * are split into runs, one slot each, traced side by side.
  *
- * How: the compact textures are two ping-pong sets like the full ones (gpu_tracer.c), of
- * width x height slots; the pixel map (R32UI, core/tracer_interface.h) names each slot's
- * pixel. Eight consecutive pixels of the list take a 4 x 2 block of slots, which is what
- * llvmpipe shades as one vector (and a quarter of a GPU's 8 x 4 warp), so the lanes of a
- * vector are pixels near one another in the image. A change of pixel list first writes the
- * compact state back to the full textures (the scatter program: a point per slot, placed
- * on its pixel), then copies the new list's pixels into the compact set (the gather
- * program: a full-screen draw over the slots). Passes trace the compact set
- * (glsl/main.glsl reads its pixel from the map: random numbers, film position, sample
- * limit and light group layers are the pixel's, so the image is the same to the bit).
- * Every read of the state first writes the compact state back (gpu_compact_save), so the
- * full textures of the current set always hold every pixel when they are read. */
+ * How: after the first list the host keeps every pixel's sums (sums[]: the state's sums
+ * read back once, when the first list is set), so the state textures' texels are free to
+ * be slots: the pixel map (RGBA32UI, core/tracer_interface.h) gives each slot its pixel
+ * and its run of sample indices. Slot k + r * count holds run r of the list's pixel k;
+ * eight consecutive slots take a 4 x 2 block, which is what llvmpipe shades as one vector
+ * (and a quarter of a GPU's 8 x 4 warp). Every run starts with no path in flight and sums
+ * of zero (the map's round number, glsl/main.glsl read_state), and the host adds the
+ * runs' sums to the pixel's, run after run in order: so a pixel's result depends on its
+ * samples and runs, never on how many pixels the list has or where their slots are, and
+ * a tile of a render equals the render's pixels to the bit (core/render.h). Reads of the
+ * state are served from the host's sums plus the current slots (gpu_compact_read). When
+ * the runs of all pixels need more slots than the textures have, they go in rounds, each
+ * added to the host's sums before the next starts. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "gpu_internal.h"
-#include "shader_sources.h"
 
-/* The 64 x 64 tiles of llvmpipe's rasteriser the compact slots are spread over: enough
- * for its threads to share a pass evenly. */
-#define COMPACT_TILES 16
-
-/* The slot (x, y) of the pixel at index k of a list, in compact textures width slots wide:
- * blocks of 8 pixels fill 4 x 2 slots, block after block along the rows. */
-static void slot_of(int k, int width, int *x, int *y)
+/* The slot (x, y) of slot index k in the state textures (width x height): in 4 x 2 blocks
+ * of 8 slots, block after block along the rows (blocks), which is what llvmpipe shades as
+ * one vector (and a quarter of a GPU's 8 x 4 warp); else row by row. */
+static void slot_of(int k, int width, bool blocks, int *x, int *y)
 {
+    if (!blocks) {
+        *x = k % width;
+        *y = k / width;
+        return;
+    }
     int block = k >> 3, lane = k & 7, blocks_per_row = width / 4;
     *x = (block % blocks_per_row) * 4 + (lane & 3);
     *y = (block / blocks_per_row) * 2 + (lane >> 2);
-}
-
-/* The tracer interface's text (core/tracer_interface.h), the defines both stages of the
- * compact programs need (the vertex shader is not made of modules). */
-static const char *interface_source(void)
-{
-    for (int i = 0; shader_modules[i].path != NULL; i++)
-        if (strcmp(shader_modules[i].path, "core/tracer_interface.h") == 0)
-            return shader_modules[i].source;
-    return "";
 }
 
 /* Gives the bound 2D texture nearest filtering: an integer texture with the default
@@ -56,88 +51,205 @@ static void nearest_filtering(void)
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
 }
 
-/* Creates the compact textures for at least count slots (none may be larger than the
- * device's side), their framebuffers, the pixel map and the two copy programs. */
-static rt_status create_compact(gpu_tracer *tracer, int count, rt_error *error)
+/* The state index of sums[] for TRACER_STATE_ACCUMULATED, _STATISTICS, _SQUARES; -1 for
+ * the others. */
+static int sums_index(int state)
+{
+    return state == TRACER_STATE_ACCUMULATED ? 0 : state == TRACER_STATE_STATISTICS ? 1
+         : state == TRACER_STATE_SQUARES     ? 2 : -1;
+}
+
+/* Reads the round's slots of one (float) state texture of the latest set (used_width x
+ * used_height texels, rows from the bottom) into out (4 floats a texel). */
+static void read_slots(gpu_tracer *tracer, int state, float *out)
 {
     gpu_compact *c = &tracer->compact;
-    /* Wide and short: llvmpipe shares a draw among its threads by 64 x 64 tiles, so the
-     * slots are spread over about COMPACT_TILES tiles (or fill them), not packed into one. */
-    int max_side = tracer->context->info.max_tile_side;
-    int height = (count + COMPACT_TILES * 64 - 1) / (COMPACT_TILES * 64);
-    height = height < 4 ? 4 : height > 64 ? 64 : (height + 3) & ~3;   /* whole 4 x 4 blocks */
-    int width = ((count + height - 1) / height + 3) & ~3;
-    if (width > max_side) {
-        width = max_side & ~3;
-        height = ((count + width - 1) / width + 3) & ~3;
+    size_t bytes = (size_t)c->used_width * c->used_height * 16;
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTextureSubImage(tracer->state_textures[tracer->current][state], 0, 0, 0, 0, c->used_width, c->used_height,
+                         1, GL_RGBA, GL_FLOAT, (GLsizei)bytes, out);
+}
+
+/* Adds the round's sums of state (sums_index) to target (4 floats a pixel, rows from the
+ * top), run after run. RT_ERROR_RUNTIME when memory runs out. */
+static rt_status add_round(gpu_tracer *tracer, int state, float *target, rt_error *error)
+{
+    gpu_compact *c = &tracer->compact;
+    size_t texels = (size_t)c->used_width * c->used_height;
+    float *slots = malloc(texels * 16);
+    if (slots == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the compacted state");
+    read_slots(tracer, state, slots);
+    /* Slot k + r * count is run first_run + r of pixel k: in slot order, each pixel's runs
+     * are added in run order. */
+    int slot_count = c->round_runs * c->count;
+    for (int k = 0; k < slot_count; k++) {
+        int x, y;
+        slot_of(k, tracer->width, c->blocks, &x, &y);
+        if (c->slot_map[((size_t)y * tracer->width + x) * 4] == TRACER_NO_PIXEL)
+            continue;
+        size_t texel = (size_t)y * c->used_width + x, pixel = c->pixels[k % c->count];
+        for (int i = 0; i < 4; i++)
+            target[pixel * 4 + i] += slots[texel * 4 + i];
     }
-    if (c->gather_program == 0) {
-        c->gather_program = gpu_build_program(shader_source_fullscreen_vertex, SHADER_PROGRAM_COMPACT_GATHER,
-                                              interface_source(), error);
-        if (c->gather_program == 0)
-            return RT_ERROR_RUNTIME;
-        c->scatter_program = gpu_build_program(shader_source_compact_scatter_vertex, SHADER_PROGRAM_COMPACT_SCATTER,
-                                               interface_source(), error);
-        if (c->scatter_program == 0)
-            return RT_ERROR_RUNTIME;
+    free(slots);
+    return RT_OK;
+}
+
+/* Adds the finished round to the host's sums. */
+static rt_status commit_round(gpu_tracer *tracer, rt_error *error)
+{
+    gpu_compact *c = &tracer->compact;
+    rt_status status = RT_OK;
+    for (int state = 0; state < TRACER_STATE_COUNT && status == RT_OK; state++) {
+        int index = sums_index(state);
+        if (index >= 0)
+            status = add_round(tracer, state, c->sums[index], error);
     }
-    if (c->width != 0) {
-        for (int set = 0; set < 2; set++) {
-            glDeleteTextures(TRACER_STATE_COUNT, c->state_textures[set]);
-            glDeleteFramebuffers(1, &c->framebuffers[set]);
+    return status == RT_OK ? gpu_check_gl("reading the compacted state", error) : status;
+}
+
+/* Lays out the runs first_run and on of the list in the slots (as many as fit) and
+ * uploads the pixel map. */
+static rt_status start_round(gpu_tracer *tracer, int first_run, rt_error *error)
+{
+    gpu_compact *c = &tracer->compact;
+    int width = tracer->width, height = tracer->height;
+    /* The slots are the state textures' texels, which the host's sums have made free: in
+     * 4 x 2 blocks when the round fits in the whole blocks they hold. */
+    size_t capacity = (size_t)width * height, block_capacity = (size_t)(width & ~3) * (height & ~1);
+    /* For the test that rounds add up as one round does (tests/render/test-adaptive.sh):
+     * RTSPHERES_TEST_COMPACT_SLOTS lowers, never raises, the slots a round may use. */
+    const char *test_slots = getenv("RTSPHERES_TEST_COMPACT_SLOTS");
+    if (test_slots != NULL && atoi(test_slots) > 0 && (size_t)atoi(test_slots) < block_capacity)
+        capacity = block_capacity = (size_t)atoi(test_slots);
+    c->blocks = block_capacity >= (size_t)c->count;
+    size_t fit = (c->blocks ? block_capacity : capacity) / (size_t)c->count;
+    int round_runs = c->runs - first_run;
+    round_runs = fit < 1 ? 1 : (size_t)round_runs > fit ? (int)fit : round_runs;
+    int slot_count = round_runs * c->count;
+    c->first_run = first_run;
+    c->round_runs = round_runs;
+    /* A new round number tells the slots' old state from the round's (glsl/main.glsl
+     * read_state): cheaper than clearing them (8 textures: about 8 ms on llvmpipe). */
+    c->round = c->round == UINT32_MAX ? 1 : c->round + 1;
+    for (size_t i = 0; i < (size_t)width * height; i++) {
+        c->slot_map[i * 4] = TRACER_NO_PIXEL;
+        c->slot_map[i * 4 + 1] = c->slot_map[i * 4 + 2] = c->slot_map[i * 4 + 3] = 0;
+    }
+    int used_x = 0, used_y = 0;
+    for (int k = 0; k < slot_count; k++) {
+        int sx, sy;
+        slot_of(k, width, c->blocks, &sx, &sy);
+        used_x = sx + 1 > used_x ? sx + 1 : used_x;
+        used_y = sy + 1 > used_y ? sy + 1 : used_y;
+        uint64_t run = (uint64_t)(first_run + k / c->count);
+        uint64_t start = c->list_start[k % c->count], limit = c->list_limit[k % c->count];
+        if (limit <= start)
+            continue;
+        /* Run r of R covers samples start + (limit - start) r / R up to the next one's. */
+        uint32_t first = (uint32_t)(start + (limit - start) * run / (uint64_t)c->runs);
+        uint32_t end = (uint32_t)(start + (limit - start) * (run + 1) / (uint64_t)c->runs);
+        if (first == end)
+            continue;
+        /* Rows from the top in the list, from the bottom in the framebuffer. */
+        uint32_t pixel = c->pixels[k % c->count];
+        uint32_t x = pixel % (uint32_t)width, y = pixel / (uint32_t)width;
+        uint32_t *texel = c->slot_map + ((size_t)sy * width + sx) * 4;
+        texel[0] = x | ((uint32_t)(height - 1) - y) << TRACER_PIXEL_MAP_SHIFT;
+        texel[1] = first;
+        texel[2] = end;
+        texel[3] = c->round;
+    }
+    /* Draws are cut to the rows the round's slots take, since a vector of empty slots is
+     * not free on llvmpipe (its loops run once, masked). */
+    c->used_width = used_x;
+    c->used_height = used_y;
+    glBindTexture(GL_TEXTURE_2D, c->pixel_map);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, used_y, GL_RGBA_INTEGER, GL_UNSIGNED_INT, c->slot_map);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    return gpu_check_gl("compacting the pass state", error);
+}
+
+void gpu_compact_note_full_read(gpu_tracer *tracer, int state, const float *sums)
+{
+    gpu_compact *c = &tracer->compact;
+    int index = sums_index(state);
+    if (c->limits == NULL || c->sums[0] != NULL || index < 0)
+        return;
+    size_t bytes = (size_t)tracer->width * tracer->height * 4 * sizeof(float);
+    if (c->full_copies[index] == NULL)
+        c->full_copies[index] = malloc(bytes);
+    if (c->full_copies[index] != NULL) {
+        memcpy(c->full_copies[index], sums, bytes);
+        c->full_copy_passes[index] = tracer->passes;
+    }
+}
+
+bool gpu_compact_read(gpu_tracer *tracer, int state, float *out)
+{
+    gpu_compact *c = &tracer->compact;
+    int index = sums_index(state);
+    if (c->sums[0] == NULL || index < 0)
+        return false;
+    memcpy(out, c->sums[index], (size_t)tracer->width * tracer->height * 4 * sizeof *out);
+    if (c->count > 0) {
+        rt_error ignored;
+        add_round(tracer, state, out, &ignored);
+    }
+    return true;
+}
+
+rt_status gpu_compact_next_round(gpu_tracer *tracer, bool *next, rt_error *error)
+{
+    gpu_compact *c = &tracer->compact;
+    *next = c->count > 0 && c->first_run + c->round_runs < c->runs;
+    if (!*next)
+        return RT_OK;
+    rt_status status = commit_round(tracer, error);
+    return status == RT_OK ? start_round(tracer, c->first_run + c->round_runs, error) : status;
+}
+
+/* Makes the host's sums from the full state textures (the first list). */
+static rt_status start_host_sums(gpu_tracer *tracer, rt_error *error)
+{
+    gpu_compact *c = &tracer->compact;
+    size_t pixels = (size_t)tracer->width * tracer->height;
+    /* What a read since the last pass took from the full state (the check's, before this
+     * list) is not read again: a read-back costs llvmpipe about 4 ms a 640 KB texture. */
+    for (int state = 0; state < TRACER_STATE_COUNT; state++) {
+        int index = sums_index(state);
+        if (index < 0)
+            continue;
+        if (c->full_copies[index] != NULL && c->full_copy_passes[index] == tracer->passes) {
+            c->sums[index] = c->full_copies[index];
+            c->full_copies[index] = NULL;
+        } else {
+            c->sums[index] = malloc(pixels * 4 * sizeof(float));
+            if (c->sums[index] != NULL)
+                gpu_read_full_state(tracer, state, c->sums[index]);
         }
-        glDeleteTextures(1, &c->pixel_map);
     }
-    /* Names of 0 until made, and the size set now, so that gpu_compact_destroy frees what
-     * a failure below leaves (GL ignores the name 0). */
-    memset(c->state_textures, 0, sizeof c->state_textures);
-    memset(c->framebuffers, 0, sizeof c->framebuffers);
-    c->pixel_map = 0;
-    c->width = width;
-    c->height = height;
-    for (int set = 0; set < 2; set++) {
-        if (gpu_create_state_set(c->state_textures[set], &c->framebuffers[set], width, height)
-            != GL_FRAMEBUFFER_COMPLETE) {
-            while (glGetError() != GL_NO_ERROR) {
-            }
-            return rt_error_set(error, RT_ERROR_RUNTIME,
-                                "GPU: out of memory for the compacted state of %d pixels (%.1f MiB)", count,
-                                (double)width * height * TRACER_STATE_COUNT * 16 * 2 / (1 << 20));
+    for (int i = 0; i < 3; i++) {
+        free(c->full_copies[i]);
+        c->full_copies[i] = NULL;
+    }
+    if (c->sums[0] == NULL || c->sums[1] == NULL || c->sums[2] == NULL) {
+        for (int i = 0; i < 3; i++) {
+            free(c->sums[i]);
+            c->sums[i] = NULL;
         }
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the compacted passes' sums");
     }
+    c->slot_map = malloc(pixels * 4 * sizeof *c->slot_map);
+    if (c->slot_map == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the pixel map");
     glGenTextures(1, &c->pixel_map);
     glBindTexture(GL_TEXTURE_2D, c->pixel_map);
     nearest_filtering();
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32UI, width, height);
-    return gpu_check_gl("creating the compacted state", error);
-}
-
-/* Binds the state textures of one set (units TRACER_STATE_*). */
-static void bind_state(const GLuint textures[TRACER_STATE_COUNT])
-{
-    for (int state = 0; state < TRACER_STATE_COUNT; state++) {
-        glActiveTexture(GL_TEXTURE0 + state);
-        glBindTexture(GL_TEXTURE_2D, textures[state]);
-    }
-}
-
-rt_status gpu_compact_save(gpu_tracer *tracer, rt_error *error)
-{
-    gpu_compact *c = &tracer->compact;
-    if (c->count == 0 || !c->unsaved)
-        return RT_OK;
-    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[tracer->current]);
-    glViewport(0, 0, tracer->width, tracer->height);
-    glUseProgram(c->scatter_program);
-    glUniform2f(glGetUniformLocation(c->scatter_program, "frame_size"), (float)tracer->width, (float)tracer->height);
-    bind_state(c->state_textures[c->current]);
-    glActiveTexture(GL_TEXTURE0 + TRACER_PIXEL_MAP_UNIT);
-    glBindTexture(GL_TEXTURE_2D, c->pixel_map);
-    glBindVertexArray(tracer->vertex_array);
-    glDrawArrays(GL_POINTS, 0, c->width * c->height);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
-    c->unsaved = false;
-    return gpu_check_gl("writing the compacted state back", error);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32UI, tracer->width, tracer->height);
+    return gpu_check_gl("reading the state for compacted passes", error);
 }
 
 void gpu_compact_scissor(gpu_tracer *tracer, bool on)
@@ -150,73 +262,83 @@ void gpu_compact_scissor(gpu_tracer *tracer, bool on)
     glScissor(0, 0, tracer->compact.used_width, tracer->compact.used_height);
 }
 
-rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels, int count, rt_error *error)
+rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limits, rt_error *error)
 {
     gpu_compact *c = &tracer->compact;
-    rt_status status = gpu_compact_save(tracer, error);
+    size_t row = (size_t)tracer->width, pixels = row * tracer->height;
+    /* The limits so far are the samples every pixel has started once a pass reports none
+     * unfinished, which is when new ones are set (gpu.h): where compacted runs begin.
+     * Before any limits: none, or samples_per_pixel once passes have run. */
+    uint32_t most = tracer->parameters.shader.samples_per_pixel;
+    bool first = c->limits == NULL;
+    if (first) {
+        c->limits = malloc(pixels * sizeof *c->limits);
+        c->started = malloc(pixels * sizeof *c->started);
+    }
+    uint32_t *bottom_up = malloc(pixels * sizeof *bottom_up);
+    if (bottom_up == NULL || c->limits == NULL || c->started == NULL) {
+        free(bottom_up);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the sample limits");
+    }
+    for (size_t i = 0; i < pixels; i++)
+        c->started[i] = first ? (tracer->passes == 0 ? 0 : most) : c->limits[i] > most ? most : c->limits[i];
+    memcpy(c->limits, limits, pixels * sizeof *limits);
+    for (int y = 0; y < tracer->height; y++)
+        memcpy(bottom_up + (size_t)y * row, limits + (size_t)(tracer->height - 1 - y) * row, row * sizeof *limits);
+    glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RED_INTEGER, GL_UNSIGNED_INT, bottom_up);
+    free(bottom_up);
+    return gpu_check_gl("setting the sample limits", error);
+}
+
+rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels, int count, int runs,
+                                     rt_error *error)
+{
+    gpu_compact *c = &tracer->compact;
+    if (count <= 0 || pixels == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: a compacted pass needs at least one pixel");
+    rt_status status = c->sums[0] == NULL ? start_host_sums(tracer, error)
+                       : c->count > 0    ? commit_round(tracer, error)
+                                         : RT_OK;
+    c->count = 0;
     if (status != RT_OK)
         return status;
-    c->count = 0;
-    if (pixels == NULL)
-        return RT_OK;
-    if (c->width == 0 || (size_t)c->width * c->height < (size_t)count) {
-        status = create_compact(tracer, count > 0 ? count : 1, error);
-        if (status != RT_OK)
-            return status;
-    }
-    uint32_t *map = malloc((size_t)c->width * c->height * sizeof *map);
-    if (map == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the pixel map of %d pixels", count);
-    for (size_t i = 0; i < (size_t)c->width * c->height; i++)
-        map[i] = TRACER_NO_PIXEL;
+    uint32_t *list = realloc(c->pixels, (size_t)count * 3 * sizeof *list);
+    if (list == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the pixel list of %d pixels", count);
+    c->pixels = list;
+    c->list_start = list + count;
+    c->list_limit = list + 2 * (size_t)count;
+    /* Each pixel's samples from here to its limit: fixed for the list's rounds. */
+    uint32_t most = tracer->parameters.shader.samples_per_pixel;
     for (int k = 0; k < count; k++) {
-        /* Rows from the top in the list, from the bottom in the framebuffer. */
-        uint32_t x = pixels[k] % (uint32_t)tracer->width, y = pixels[k] / (uint32_t)tracer->width;
-        int sx, sy;
-        slot_of(k, c->width, &sx, &sy);
-        map[(size_t)sy * c->width + sx] = x | ((uint32_t)(tracer->height - 1) - y) << TRACER_PIXEL_MAP_SHIFT;
+        list[k] = pixels[k];
+        c->list_start[k] = c->started[pixels[k]];
+        uint32_t limit = c->limits != NULL ? c->limits[pixels[k]] : most;
+        c->list_limit[k] = limit > most ? most : limit;
     }
-    glBindTexture(GL_TEXTURE_2D, c->pixel_map);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, c->width, c->height, GL_RED_INTEGER, GL_UNSIGNED_INT, map);
-    free(map);
-    /* The region the list's slots take (whole 4 x 4 blocks): draws are cut to it, since a
-     * vector of empty slots is not free on llvmpipe (its loops run once, masked), and a
-     * list shorter than the one the textures were made for leaves most of them empty. */
-    int blocks = (count + 7) / 8, blocks_per_row = c->width / 4;
-    int block_rows = (blocks + blocks_per_row - 1) / blocks_per_row;
-    c->used_width = block_rows > 1 ? c->width : 4 * blocks;
-    c->used_height = (2 * block_rows + 3) & ~3;
-    c->used_height = c->used_height > c->height ? c->height : c->used_height;
-    /* The gather: the full state of the current set into compact set 0. */
-    glBindFramebuffer(GL_FRAMEBUFFER, c->framebuffers[0]);
-    glViewport(0, 0, c->width, c->height);
-    gpu_compact_scissor(tracer, true);
-    glUseProgram(c->gather_program);
-    bind_state(tracer->state_textures[tracer->current]);
-    glActiveTexture(GL_TEXTURE0 + TRACER_PIXEL_MAP_UNIT);
-    glBindTexture(GL_TEXTURE_2D, c->pixel_map);
-    glBindVertexArray(tracer->vertex_array);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    gpu_compact_scissor(tracer, false);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
-    c->current = 0;
+    /* Light group layers are added to at the pixel itself (glsl/light_groups.glsl): two
+     * slots of one pixel in one pass would lose each other's additions. */
+    c->runs = runs < 1 || tracer->light_group_texture != 0 ? 1 : runs;
     c->count = count;
-    c->unsaved = false;
-    return gpu_check_gl("compacting the pass state", error);
+    status = start_round(tracer, 0, error);
+    if (status != RT_OK)
+        c->count = 0;
+    return status;
 }
 
 void gpu_compact_destroy(gpu_tracer *tracer)
 {
     gpu_compact *c = &tracer->compact;
-    if (c->width != 0) {
-        for (int set = 0; set < 2; set++) {
-            glDeleteTextures(TRACER_STATE_COUNT, c->state_textures[set]);
-            glDeleteFramebuffers(1, &c->framebuffers[set]);
-        }
-        glDeleteTextures(1, &c->pixel_map);
+    glDeleteTextures(1, &c->pixel_map);
+    free(c->pixels);
+    free(c->slot_map);
+    for (int i = 0; i < 3; i++) {
+        free(c->sums[i]);
+        free(c->full_copies[i]);
     }
-    glDeleteProgram(c->gather_program);
-    glDeleteProgram(c->scatter_program);
+    free(c->started);
+    free(c->limits);
     memset(c, 0, sizeof *c);
 }

@@ -40,17 +40,31 @@ struct gpu_context {
 #define GPU_PACKED_BLOCK_TEXELS 1024u
 
 /* Compacted passes of a tracer (gpu.h gpu_tracer_set_pass_pixels; core/gpu_compact.c):
- * the pixels still going, packed into two ping-pong sets of compact state textures. */
+ * the pixels still going, each in one or more slots (runs) of the state textures, and the
+ * host's copy of every pixel's sums that the runs add to. */
 typedef struct gpu_compact {
     int count;                   /* pixels traced compactly; 0: passes draw the whole image */
-    int width, height;           /* of the compact textures (0: none made yet) */
-    int used_width, used_height; /* the slots of the list: drawn (a scissor), the rest not */
-    GLuint state_textures[2][TRACER_STATE_COUNT];
-    GLuint framebuffers[2];
-    GLuint pixel_map;            /* R32UI, width x height (core/tracer_interface.h) */
-    GLuint gather_program, scatter_program;
-    int current;                 /* which compact set holds the latest pass */
-    bool unsaved;                /* the compact set is newer than the full state */
+    uint32_t *pixels;            /* the list (indices y * width + x, rows from the top) */
+    uint32_t *list_start, *list_limit;   /* each listed pixel's samples started when the list
+                                          * was set, and its limit (in the pixels block) */
+    int runs;                    /* runs a pixel's samples are split into */
+    int first_run, round_runs;   /* the runs the slots trace now: a round (when all runs at
+                                  * once would not fit, rounds follow one another) */
+    uint32_t round;              /* the round's number (core/tracer_interface.h), from 1 */
+    bool blocks;                 /* the round's slots go in 4 x 2 blocks (else row by row) */
+    int used_width, used_height; /* the slots of the round: drawn (a scissor), the rest not */
+    GLuint pixel_map;            /* RGBA32UI, the state textures' size (core/tracer_interface.h) */
+    uint32_t *slot_map;          /* the pixel map's texels as uploaded, rows from the bottom */
+    /* The host's sums of every pixel (from the first list on; NULL before): the full
+     * state's sums when the first list was set, plus every finished round's, rows top to
+     * bottom, 4 floats a pixel each: TRACER_STATE_ACCUMULATED, _STATISTICS, _SQUARES. */
+    float *sums[3];
+    uint32_t *started;           /* samples started per pixel: the limits before the last ones */
+    /* Copies of the full state's sums as a read took them before the first list, and the
+     * tracer's passes then (under sample limits only: adaptive sampling's first check). */
+    float *full_copies[3];
+    uint64_t full_copy_passes[3];
+    uint32_t *limits;            /* per pixel, rows from the top: gpu_tracer_set_sample_limits */
 } gpu_compact;
 
 struct gpu_tracer {
@@ -69,6 +83,7 @@ struct gpu_tracer {
     GLuint light_group_texture;  /* the light group layers (2D array, rgba32f), or 0 when the
                                   * program has no light group code */
     int current;                 /* which state set holds the latest pass */
+    uint64_t passes;             /* passes run */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
     bool reused_scene;           /* the packed scene was already on the device */
     uint64_t uploaded_bytes;     /* of the packed scene, uploaded for this tracer */
@@ -76,15 +91,31 @@ struct gpu_tracer {
     gpu_tracer_timings timings;
 };
 
-/* Writes the compact state back to the full state textures of the current set when it is
- * newer (gpu_compact.c): every read of the state calls it first. */
-rt_status gpu_compact_save(gpu_tracer *tracer, rt_error *error);
+/* Reads the sums of state TRACER_STATE_ACCUMULATED, _STATISTICS or _SQUARES of every
+ * pixel into out (4 floats a pixel, rows top to bottom) when passes have been compacted:
+ * the host's sums plus the current round's slots (gpu_compact.c). Returns false, reading
+ * nothing, when they have not (the full state textures hold every pixel). */
+bool gpu_compact_read(gpu_tracer *tracer, int state, float *out);
+
+/* Keeps a copy of sums, just read from the full state textures' state (TRACER_STATE_*), for
+ * the first list to start from (gpu_compact.c): when sample limits are set and no list
+ * has been. */
+void gpu_compact_note_full_read(gpu_tracer *tracer, int state, const float *sums);
+
+/* After a compacted pass that left no slot unfinished: when runs of the list remain, adds
+ * the round's sums to the host's and starts the next round, and sets *next (the pass loop
+ * goes on); else clears it. RT_ERROR_RUNTIME when memory runs out. */
+rt_status gpu_compact_next_round(gpu_tracer *tracer, bool *next, rt_error *error);
 
 /* Cuts the draws that follow to the compact slots the list takes (on), or lets them cover
  * their whole framebuffer again (off). */
 void gpu_compact_scissor(gpu_tracer *tracer, bool on);
 
-/* Frees the tracer's compact state and programs. */
+/* Reads float state texture state (TRACER_STATE_*) of the latest set into out, rows top
+ * to bottom, 4 floats a texel (nothing when memory runs out). In gpu_tracer.c. */
+void gpu_read_full_state(gpu_tracer *tracer, int state, float *out);
+
+/* Frees the tracer's compact state. */
 void gpu_compact_destroy(gpu_tracer *tracer);
 
 /* Creates one set of pass-state textures (TRACER_STATE_COUNT of width x height, nearest

@@ -594,12 +594,12 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
 
 rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_error *error)
 {
-    /* A compacted pass reads and writes the compact sets (gpu_compact.c), the others the
-     * full ones. */
+    /* A compacted pass traces the slots of the pixel map (gpu_compact.c), which live in the
+     * same state textures. */
     gpu_compact *compact = &tracer->compact;
     bool compacted = compact->count > 0;
-    int source = compacted ? compact->current : tracer->current, target = 1 - source;
-    const GLuint *source_textures = compacted ? compact->state_textures[source] : tracer->state_textures[source];
+    int source = tracer->current, target = 1 - source;
+    const GLuint *source_textures = tracer->state_textures[source];
     if (tracer->parameters.shader.compact_pixels != (uint32_t)compacted) {
         tracer->parameters.shader.compact_pixels = compacted;
         update_parameter(tracer, offsetof(tracer_parameter_block, compact_pixels), compacted);
@@ -607,11 +607,8 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     const GLuint zero[2] = {0, 0};
     glBindBuffer(GL_ATOMIC_COUNTER_BUFFER, tracer->counter_buffer);
     glBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof zero, zero);
-    glBindFramebuffer(GL_FRAMEBUFFER, compacted ? compact->framebuffers[target] : tracer->framebuffers[target]);
-    if (compacted)
-        glViewport(0, 0, compact->width, compact->height);
-    else
-        glViewport(0, 0, tracer->width, tracer->height);
+    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[target]);
+    glViewport(0, 0, tracer->width, tracer->height);
     glUseProgram(tracer->program);
     glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
@@ -640,15 +637,18 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
                                                               | GL_TEXTURE_UPDATE_BARRIER_BIT : 0));
     GLuint counters[2] = {0, 0};
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof counters, counters);
-    if (compacted) {
-        compact->current = target;
-        compact->unsaved = true;
-    } else {
-        tracer->current = target;
-    }
+    tracer->current = target;
+    tracer->passes++;
     report->unfinished_pixels = counters[0];
     report->samples_finished = counters[1];
-    return gpu_check_gl("a tracer pass", error);
+    rt_status status = gpu_check_gl("a tracer pass", error);
+    /* A compacted list whose runs go in rounds goes on with the next round. */
+    bool next_round = false;
+    if (status == RT_OK && compacted && counters[0] == 0)
+        status = gpu_compact_next_round(tracer, &next_round, error);
+    if (next_round)
+        report->unfinished_pixels = (uint32_t)compact->count;
+    return status;
 }
 
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
@@ -658,44 +658,34 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
                      tracer->parameters.shader.pass_work_budget);
 }
 
-rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limits, rt_error *error)
+void gpu_read_full_state(gpu_tracer *tracer, int state, float *out)
 {
-    size_t row = (size_t)tracer->width;
-    uint32_t *bottom_up = malloc(row * tracer->height * sizeof *bottom_up);
-    if (bottom_up == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the sample limits");
-    for (int y = 0; y < tracer->height; y++)
-        memcpy(bottom_up + (size_t)y * row, limits + (size_t)(tracer->height - 1 - y) * row, row * sizeof *limits);
-    glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RED_INTEGER, GL_UNSIGNED_INT, bottom_up);
-    free(bottom_up);
-    return gpu_check_gl("setting the sample limits", error);
-}
-
-
-/* Reads one state texture of the latest set into rows top to bottom. */
-static void read_state(gpu_tracer *tracer, int state, float *rgba)
-{
-    size_t row_floats = (size_t)tracer->width * 4;
-    float *bottom_up = malloc(row_floats * tracer->height * sizeof(float));
+    size_t row_bytes = (size_t)tracer->width * 16;
+    char *bottom_up = malloc(row_bytes * tracer->height), *rows = (char *)out;
     if (bottom_up == NULL)
         return;
     glBindTexture(GL_TEXTURE_2D, tracer->state_textures[tracer->current][state]);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, bottom_up);
     for (int row = 0; row < tracer->height; row++)
-        memcpy(rgba + (size_t)row * row_floats, bottom_up + (size_t)(tracer->height - 1 - row) * row_floats,
-               row_floats * sizeof(float));
+        memcpy(rows + (size_t)row * row_bytes, bottom_up + (size_t)(tracer->height - 1 - row) * row_bytes, row_bytes);
     free(bottom_up);
+}
+
+/* Reads the sums of one state (accumulated, statistics or squares) of every pixel into
+ * rows top to bottom: from the compacted passes' sums once there are some, else from the
+ * full state textures. */
+static void read_state(gpu_tracer *tracer, int state, float *rgba)
+{
+    if (gpu_compact_read(tracer, state, rgba))
+        return;
+    gpu_read_full_state(tracer, state, rgba);
+    gpu_compact_note_full_read(tracer, state, rgba);
 }
 
 rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
                           rt_error *error)
 {
-    rt_status saved = gpu_compact_save(tracer, error);
-    if (saved != RT_OK)
-        return saved;
     glActiveTexture(GL_TEXTURE0);
     read_state(tracer, TRACER_STATE_ACCUMULATED, rgba);
     if (totals != NULL || luminance_squares != NULL) {
@@ -743,9 +733,6 @@ rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_err
 
 rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error)
 {
-    rt_status saved = gpu_compact_save(tracer, error);
-    if (saved != RT_OK)
-        return saved;
     glActiveTexture(GL_TEXTURE0);
     read_state(tracer, TRACER_STATE_SQUARES, squares);
     return gpu_check_gl("reading the sums of squares", error);

@@ -32,8 +32,10 @@ uint64_t render_bytes_per_pixel(const render_options *options, int light_group_c
         bytes += 2 * 16 + 12 + 44;
     if (options->light_groups)   /* per group: the layer on the device, its read-back and copy, 3 channels twice */
         bytes += (uint64_t)light_group_count * (16 + 2 * 16 + 2 * 12);
-    if (options->noise_threshold > 0)   /* the checks' read-back, limits, the sampler's arrays, */
-        bytes += 16 + 4 + 4 + 16 + GPU_TRACER_STATE_BYTES_PER_PIXEL;   /* compacted passes' state */
+    if (options->noise_threshold > 0)   /* the checks' read-back, limits, the sampler's arrays; */
+        bytes += 16 + 4 + 4 + 16        /* compacted passes (core/gpu_compact.c): the host's sums, */
+                 + 3 * 16 + 4 + 4 + 2 * 16;   /* started, limits, the pixel map on the device and
+                                               * the host */
     return bytes;
 }
 

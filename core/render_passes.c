@@ -87,7 +87,8 @@ static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, bool *don
     const char *full = getenv("RTSPHERES_TEST_FULL_PASSES");
     if (full != NULL && strcmp(full, "1") == 0)
         return RT_OK;
-    return gpu_tracer_set_pass_pixels(tracer, run->pixels, adaptive_going_pixels(run->sampler, run->pixels), error);
+    return gpu_tracer_set_pass_pixels(tracer, run->pixels, adaptive_going_pixels(run->sampler, run->pixels),
+                                      adaptive_runs(run->sampler), error);
 }
 
 /* Before a pass: whether it may run under options->deadline, predicting its time from

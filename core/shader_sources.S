@@ -26,7 +26,7 @@
     .balign 16
     .global shader_modules
 shader_modules:
-    module "core/tracer_interface.h", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST|SHADER_PROGRAM_COMPACT /* ids, parameters */
+    module "core/tracer_interface.h", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST /* ids, parameters */
     module "core/packed_layout.h", SHADER_PROGRAM_SHADING           /* the packed scene's records */
     module "glsl/random.glsl", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST
     module "glsl/random_test.frag", SHADER_PROGRAM_RANDOM_TEST
@@ -59,9 +59,7 @@ shader_modules:
     module "glsl/integrator_path.glsl", SHADER_PROGRAM_PASS
     module "glsl/integrator_whitted.glsl", SHADER_PROGRAM_PASS
     module "glsl/integrators.glsl", SHADER_PROGRAM_PASS             /* the table of integrators */
-    module "glsl/pass_state.glsl", SHADER_PROGRAM_STATE
-    module "glsl/compact_gather.frag", SHADER_PROGRAM_COMPACT_GATHER
-    module "glsl/compact_scatter.frag", SHADER_PROGRAM_COMPACT_SCATTER
+    module "glsl/pass_state.glsl", SHADER_PROGRAM_PASS
     module "glsl/main.glsl", SHADER_PROGRAM_PASS
     module "glsl/aov.glsl", SHADER_PROGRAM_AOV
     .dc.a 0, 0, 0
@@ -70,10 +68,6 @@ shader_modules:
     .global shader_source_fullscreen_vertex
 shader_source_fullscreen_vertex:
     .incbin "glsl/fullscreen.vert"
-    .byte 0
-    .global shader_source_compact_scatter_vertex
-shader_source_compact_scatter_vertex:
-    .incbin "glsl/compact_scatter.vert"
     .byte 0
 
     .section .note.GNU-stack,"",@progbits

@@ -3,8 +3,7 @@
  * The fragment programs are made of modules: core/gpu_tracer.c (compile_fragment_program) joins
  * "#version 450 core", the program's defines and, in the order of the module table of
  * shader_sources.S, every module whose programs include that program. The vertex shader
- * (one triangle over the viewport) is shared by all programs but the scatter of
- * compacted passes, which has its own.
+ * (one triangle over the viewport) is shared by all programs.
  *
  * This header is also read by the assembler (for the SHADER_PROGRAM_* bits), so
  * everything but the #defines is hidden from it. */
@@ -16,11 +15,6 @@
 #define SHADER_PROGRAM_AOV 2            /* the AOV pass (glsl/aov.glsl) */
 #define SHADER_PROGRAM_RANDOM_TEST 4    /* the random-number test (glsl/random_test.frag) */
 #define SHADER_PROGRAM_MATERIAL_TEST 8  /* the material test (glsl/material_test.frag) */
-#define SHADER_PROGRAM_COMPACT_GATHER 16   /* compacted passes' gather (glsl/compact_gather.frag) */
-#define SHADER_PROGRAM_COMPACT_SCATTER 32  /* and scatter (glsl/compact_scatter.frag) */
-#define SHADER_PROGRAM_COMPACT (SHADER_PROGRAM_COMPACT_GATHER|SHADER_PROGRAM_COMPACT_SCATTER)
-/* The programs that read and write the pass state (glsl/pass_state.glsl). */
-#define SHADER_PROGRAM_STATE (SHADER_PROGRAM_PASS|SHADER_PROGRAM_COMPACT)
 #define SHADER_PROGRAM_TRACER (SHADER_PROGRAM_PASS|SHADER_PROGRAM_AOV)   /* no spaces: an assembler macro argument */
 /* The modules up to the materials: the tracer's, and the material test's. */
 #define SHADER_PROGRAM_SHADING (SHADER_PROGRAM_PASS|SHADER_PROGRAM_AOV|SHADER_PROGRAM_MATERIAL_TEST)
@@ -37,7 +31,6 @@ typedef struct shader_module {
 /* The module table, ended by an entry whose path is NULL. */
 extern const shader_module shader_modules[];
 extern const char shader_source_fullscreen_vertex[];
-extern const char shader_source_compact_scatter_vertex[];   /* glsl/compact_scatter.vert */
 #endif
 
 #endif

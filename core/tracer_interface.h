@@ -81,11 +81,17 @@
 
 /* ---- compacted passes (core/gpu_compact.c; gpu.h gpu_tracer_set_pass_pixels): the pixels
  * still taking samples packed densely into compact state textures, so that no lane of a
- * SIMD vector idles on a pixel that is done. The pixel map (R32UI, on unit
- * TRACER_PIXEL_MAP_UNIT) gives each compact slot its pixel of the full state textures as
- * x | y << TRACER_PIXEL_MAP_SHIFT (framebuffer rows, bottom up), or TRACER_NO_PIXEL for a
- * slot that holds none. The parameter compact_pixels is nonzero while a pass traces the
- * compact textures. */
+ * SIMD vector idles on a pixel that is done, each pixel in one or more slots (runs), each
+ * run tracing its own range of the pixel's sample indices from sums of zero. The pixel
+ * map (RGBA32UI, on unit TRACER_PIXEL_MAP_UNIT) gives each compact slot
+ *   x: its pixel as x | y << TRACER_PIXEL_MAP_SHIFT (framebuffer rows, bottom up), or
+ *      TRACER_NO_PIXEL for a slot that holds none;
+ *   y: the first sample index of its run (relative to sample_start);
+ *   z: the end of its run (the run is samples y to z - 1);
+ *   w: the round (never 0): a slot whose state's counters.w differs holds another round's
+ *      run, and the pass starts the slot's run from no path and sums of zero.
+ * The slot's samples_started counts from its run's first sample. The parameter
+ * compact_pixels is nonzero while a pass traces the compact textures. */
 #define TRACER_PIXEL_MAP_UNIT 10
 #define TRACER_PIXEL_MAP_SHIFT 16
 #define TRACER_NO_PIXEL 4294967295u

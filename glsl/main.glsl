@@ -6,7 +6,11 @@
 layout(binding = TRACER_COUNTER_BINDING, offset = 0) uniform atomic_uint unfinished_pixels;
 layout(binding = TRACER_COUNTER_BINDING, offset = 4) uniform atomic_uint samples_finished;
 
-PixelState read_state(ivec2 pixel)
+// The state at pixel (a pixel, or a compact slot), or in a compacted pass the state of a
+// run that has not begun when the slot was last written in another round (the texel's
+// counters.w against the pixel map's round, core/tracer_interface.h): no path in flight
+// and sums of zero, which is how compacted runs start without a clear of their textures.
+PixelState read_state(ivec2 pixel, uint round)
 {
     PixelState s;
     vec4 origin = texelFetch(state_origin, pixel, 0);
@@ -27,16 +31,25 @@ PixelState read_state(ivec2 pixel)
     s.statistics = texelFetch(state_statistics, pixel, 0);
     s.squares = texelFetch(state_squares, pixel, 0);
     s.finished_here = 0u;
+    if (round != 0u && counters.w != round) {
+        s.light_total = 0.0;
+        s.previous_pdf = 0.0;
+        s.samples_started = 0u;
+        s.bounce = 0u;
+        s.accumulated = vec4(0.0);
+        s.statistics = vec4(0.0);
+        s.squares = vec4(0.0);
+    }
     return s;
 }
 
-void write_state(PixelState s)
+void write_state(PixelState s, uint round)
 {
     out_origin = vec4(s.origin, s.since_vertex);
     out_direction = vec4(s.direction, s.light_total);
     out_throughput = vec4(s.throughput, s.previous_pdf);
     out_radiance = vec4(s.radiance, 0.0);
-    out_counters = uvec4(s.samples_started, s.bounce, s.media, 0u);
+    out_counters = uvec4(s.samples_started, s.bounce, s.media, round);
     out_accumulated = s.accumulated;
     out_statistics = s.statistics;
     out_squares = s.squares;
@@ -45,18 +58,27 @@ void write_state(PixelState s)
 void main()
 {
     // The state lives where this invocation draws: the pixel itself, or its compact slot.
+    // A compact slot traces a run of its pixel's samples (core/tracer_interface.h), and its
+    // samples_started counts from the run's first.
     ivec2 slot = ivec2(gl_FragCoord.xy);
     frame_pixel = slot;
+    first_sample = sample_start;
+    uint round = 0u;
     if (compact_pixels != 0u) {
-        frame_pixel = mapped_pixel(texelFetch(pixel_map, slot, 0).x);
+        uvec4 run = texelFetch(pixel_map, slot, 0);
+        round = run.w;
+        frame_pixel = mapped_pixel(run.x);
         if (frame_pixel.x < 0)
             discard;
+        first_sample = sample_start + run.y;
+        sample_limit = run.z - run.y;
+    } else {
+        sample_limit = min(samples_per_pixel, texelFetch(sample_limits, frame_pixel, 0).x);
     }
-    PixelState s = read_state(slot);
-    sample_limit = min(samples_per_pixel, texelFetch(sample_limits, frame_pixel, 0).x);
+    PixelState s = read_state(slot, round);
     read_header();
     begin_pixel();
-    rng_sample = sample_start + s.samples_started - 1u;   // the sample of the path in flight
+    rng_sample = first_sample + s.samples_started - 1u;   // the sample of the path in flight
     work = 0;
     overflow = false;
     integrate(s);
@@ -68,5 +90,5 @@ void main()
         atomicCounterIncrement(unfinished_pixels);
     for (uint i = 0u; i < s.finished_here; i++)
         atomicCounterIncrement(samples_finished);
-    write_state(s);
+    write_state(s, round);
 }

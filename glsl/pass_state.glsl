@@ -1,8 +1,7 @@
-// pass_state.glsl: the pass state as the programs that read and write it see it: the
-// state textures of the previous pass (TRACER_STATE_* of core/tracer_interface.h, one
-// unit each), the outputs of this one (the same numbers as locations), and the tables a
-// pass looks its pixel up in. The tracer's passes (glsl/main.glsl) and the copies of
-// compacted passes (glsl/compact_gather.frag, glsl/compact_scatter.frag) share it.
+// pass_state.glsl: the pass state as a tracer pass (glsl/main.glsl) sees it: the state
+// textures of the previous pass (TRACER_STATE_* of core/tracer_interface.h, one unit
+// each), the outputs of this one (the same numbers as locations), and the tables a pass
+// looks its pixel up in.
 
 layout(binding = TRACER_STATE_ORIGIN) uniform sampler2D state_origin;
 layout(binding = TRACER_STATE_DIRECTION) uniform sampler2D state_direction;
@@ -26,24 +25,11 @@ layout(location = TRACER_STATE_ACCUMULATED) out vec4 out_accumulated;
 layout(location = TRACER_STATE_STATISTICS) out vec4 out_statistics;
 layout(location = TRACER_STATE_SQUARES) out vec4 out_squares;          // rgb: sums of squared radiance
 
-// The framebuffer pixel (row 0 at the bottom) of a pixel map entry, or (-1, -1) for
+// The framebuffer pixel (row 0 at the bottom) of a pixel map entry's code, or (-1, -1) for
 // TRACER_NO_PIXEL.
 ivec2 mapped_pixel(uint code)
 {
     if (code == TRACER_NO_PIXEL)
         return ivec2(-1);
     return ivec2(code & ((1u << TRACER_PIXEL_MAP_SHIFT) - 1u), code >> TRACER_PIXEL_MAP_SHIFT);
-}
-
-// Writes the state the textures hold at texel as this invocation's outputs, unchanged.
-void copy_state(ivec2 texel)
-{
-    out_origin = texelFetch(state_origin, texel, 0);
-    out_direction = texelFetch(state_direction, texel, 0);
-    out_throughput = texelFetch(state_throughput, texel, 0);
-    out_radiance = texelFetch(state_radiance, texel, 0);
-    out_counters = texelFetch(state_counters, texel, 0);
-    out_accumulated = texelFetch(state_accumulated, texel, 0);
-    out_statistics = texelFetch(state_statistics, texel, 0);
-    out_squares = texelFetch(state_squares, texel, 0);
 }

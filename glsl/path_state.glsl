@@ -27,8 +27,11 @@ struct PixelState {
 };
 
 // The samples this pixel may start in this pass at most (glsl/main.glsl sets it:
-// samples_per_pixel, or less where adaptive sampling holds the pixel back).
+// samples_per_pixel, or less where adaptive sampling holds the pixel back), and the
+// absolute index of the sample samples_started counts from (sample_start, or a compact
+// slot's run's first).
 uint sample_limit;
+uint first_sample;
 
 // Prepares the next iteration of the segment loop: starts a sample (its camera ray) when
 // no path is in flight and may_start, and counts the iteration's work. trace_path is set
@@ -43,7 +46,7 @@ bool begin_segment(inout PixelState s, bool busy, bool may_start, out bool trace
     if (!busy && !budget_left)
         return false;
     if (s.bounce == 0u && may_start && budget_left && s.samples_started < sample_limit) {
-        rng_sample = sample_start + s.samples_started;
+        rng_sample = first_sample + s.samples_started;
         s.samples_started++;
         camera_ray(s.origin, s.direction);
         s.throughput = vec3(1.0);

@@ -136,6 +136,34 @@ static void going_pixels(void **state)
     adaptive_free(sampler);
 }
 
+/* The runs a pixel going on takes (gpu.h gpu_tracer_set_pass_pixels) follow the checks'
+ * sample counts alone: about ADAPTIVE_RUN_SAMPLES samples a run, 1 to ADAPTIVE_MAX_RUNS,
+ * the same for an image with 9 pixels going as for one with 18 (a tile and the whole
+ * image must split a pixel's samples alike). */
+static void runs_follow_the_checks(void **state)
+{
+    (void)state;
+    adaptive_sampler *few = NULL, *more = NULL;
+    assert_int_equal(adaptive_create(8, 8, 0.001f, 16, 1024, &few, NULL), RT_OK);
+    assert_int_equal(adaptive_create(8, 8, 0.001f, 16, 1024, &more, NULL), RT_OK);
+    float rgba[64 * 4], squares[64];
+    int checks = 0;
+    for (uint32_t n = 16; n < 1024; n = adaptive_next_check(n, 16, 1024), checks++) {
+        make_sums(rgba, squares, (int)n, 0.5f, 4, 4);
+        assert_int_equal(adaptive_check(few, rgba, squares), 9);
+        squares[1 * 8 + 1] = squares[4 * 8 + 4];   /* a second noisy pixel, far from the first */
+        assert_int_equal(adaptive_check(more, rgba, squares), 18);
+        uint32_t next = adaptive_next_check(n, 16, 1024), expected = (next - n) / ADAPTIVE_RUN_SAMPLES;
+        expected = expected < 1 ? 1 : expected > ADAPTIVE_MAX_RUNS ? ADAPTIVE_MAX_RUNS : expected;
+        assert_int_equal(adaptive_runs(few), expected);
+        assert_int_equal(adaptive_runs(more), expected);
+    }
+    /* 16 -> 32 takes 2 runs of 8; 800 -> 1000 would take 25 of 8, capped at 16. */
+    assert_true(checks > 10);
+    adaptive_free(few);
+    adaptive_free(more);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -144,6 +172,7 @@ int main(void)
         cmocka_unit_test(neighbourhood),
         cmocka_unit_test(dark_pixels_and_max),
         cmocka_unit_test(going_pixels),
+        cmocka_unit_test(runs_follow_the_checks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
