@@ -210,7 +210,7 @@ typedef struct gpu_tracer_parameters {
 
 /* What one pass reports. */
 typedef struct gpu_pass_report {
-    uint32_t unfinished_pixels;           /* pixels that still have samples to run */
+    uint32_t unfinished_pixels;           /* pixels (compact slots) that still have samples to run */
     uint32_t samples_finished;            /* samples that ended in this pass */
 } gpu_pass_report;
 
@@ -265,12 +265,13 @@ rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limit
  * pixel's sums depend on its samples and runs alone, not on the list (a tile renders its
  * pixels as the whole image does); they differ from one run's (or uncompacted passes') by
  * float rounding. With light group layers a pixel takes 1 run. Pixels left out keep their
- * sums; from the first list on, passes never return to the whole image. Costs one
- * read-back of the full state (the first list), one of the slots' sums a list (and a read
- * of them at every read of the state), and the compact state: GPU_TRACER_STATE_BYTES_PER_PIXEL
- * a slot, at most as many slots as the image has pixels (more runs go in rounds, one after
- * another), kept until the tracer is destroyed. RT_ERROR_RUNTIME when the device or the
- * host runs out of memory. */
+ * sums; from the first list on, passes never return to the whole image, and a pass's
+ * unfinished_pixels counts slots. Costs one read-back of the state (the first list), one
+ * of the slots' sums at each list and round (and at every read of the state), and, kept
+ * until the tracer is destroyed, the host's sums of every pixel (48 bytes a pixel) and a
+ * pixel map (16 bytes a pixel on the device and on the host): the slots are the state
+ * textures' own texels, one a pixel at most (more runs go in rounds, one after another).
+ * RT_ERROR_RUNTIME when the device or the host runs out of memory. */
 rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels, int count, int runs,
                                      rt_error *error);
 
