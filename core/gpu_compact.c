@@ -133,16 +133,23 @@ static rt_status start_round(gpu_tracer *tracer, int first_run, rt_error *error)
     /* A new round number tells the slots' old state from the round's (glsl/main.glsl
      * read_state): cheaper than clearing them (8 textures: about 8 ms on llvmpipe). */
     c->round = c->round == UINT32_MAX ? 1 : c->round + 1;
-    for (size_t i = 0; i < (size_t)width * height; i++) {
+    /* The region the slots take: rows from the bottom (a block row is 2), the whole width
+     * once they fill a row. Only its rows of the map are written and uploaded: nothing
+     * outside it is drawn or read. */
+    int row_slots = c->blocks ? (width / 4) * 8 : width, used_x, used_y;
+    if (slot_count >= row_slots)
+        used_x = c->blocks ? (width / 4) * 4 : width;
+    else
+        used_x = c->blocks ? (slot_count + 7) / 8 * 4 : slot_count;
+    slot_of(slot_count - 1, width, c->blocks, &(int){0}, &used_y);
+    used_y = c->blocks ? (used_y | 1) + 1 : used_y + 1;
+    for (size_t i = 0; i < (size_t)width * used_y; i++) {
         c->slot_map[i * 4] = TRACER_NO_PIXEL;
         c->slot_map[i * 4 + 1] = c->slot_map[i * 4 + 2] = c->slot_map[i * 4 + 3] = 0;
     }
-    int used_x = 0, used_y = 0;
     for (int k = 0; k < slot_count; k++) {
         int sx, sy;
         slot_of(k, width, c->blocks, &sx, &sy);
-        used_x = sx + 1 > used_x ? sx + 1 : used_x;
-        used_y = sy + 1 > used_y ? sy + 1 : used_y;
         uint64_t run = (uint64_t)(first_run + k / c->count);
         uint64_t start = c->list_start[k % c->count], limit = c->list_limit[k % c->count];
         if (limit <= start)
