@@ -194,18 +194,15 @@ void gpu_compact_note_full_read(gpu_tracer *tracer, int state, const float *sums
     }
 }
 
-bool gpu_compact_read(gpu_tracer *tracer, int state, float *out)
+rt_status gpu_compact_read(gpu_tracer *tracer, int state, float *out, bool *compacted, rt_error *error)
 {
     gpu_compact *c = &tracer->compact;
     int index = sums_index(state);
-    if (c->sums[0] == NULL || index < 0)
-        return false;
+    *compacted = c->sums[0] != NULL && index >= 0;
+    if (!*compacted)
+        return RT_OK;
     memcpy(out, c->sums[index], (size_t)tracer->width * tracer->height * 4 * sizeof *out);
-    if (c->count > 0) {
-        rt_error ignored;
-        add_round(tracer, state, out, &ignored);
-    }
-    return true;
+    return c->count > 0 ? add_round(tracer, state, out, error) : RT_OK;
 }
 
 rt_status gpu_compact_next_round(gpu_tracer *tracer, bool *next, rt_error *error)
@@ -234,8 +231,10 @@ static rt_status start_host_sums(gpu_tracer *tracer, rt_error *error)
             c->full_copies[index] = NULL;
         } else {
             c->sums[index] = malloc(pixels * 4 * sizeof(float));
-            if (c->sums[index] != NULL)
-                gpu_read_full_state(tracer, state, c->sums[index]);
+            if (c->sums[index] != NULL && gpu_read_full_state(tracer, state, c->sums[index], error) != RT_OK) {
+                free(c->sums[index]);
+                c->sums[index] = NULL;
+            }
         }
     }
     for (int i = 0; i < 3; i++) {

@@ -93,9 +93,10 @@ struct gpu_tracer {
 
 /* Reads the sums of state TRACER_STATE_ACCUMULATED, _STATISTICS or _SQUARES of every
  * pixel into out (4 floats a pixel, rows top to bottom) when passes have been compacted:
- * the host's sums plus the current round's slots (gpu_compact.c). Returns false, reading
- * nothing, when they have not (the full state textures hold every pixel). */
-bool gpu_compact_read(gpu_tracer *tracer, int state, float *out);
+ * the host's sums plus the current round's slots (gpu_compact.c), and sets *compacted.
+ * Clears it, reading nothing, when they have not (the full state textures hold every
+ * pixel). RT_ERROR_RUNTIME when memory runs out. */
+rt_status gpu_compact_read(gpu_tracer *tracer, int state, float *out, bool *compacted, rt_error *error);
 
 /* Keeps a copy of sums, just read from the full state textures' state (TRACER_STATE_*), for
  * the first list to start from (gpu_compact.c): when sample limits are set and no list
@@ -112,8 +113,8 @@ rt_status gpu_compact_next_round(gpu_tracer *tracer, bool *next, rt_error *error
 void gpu_compact_scissor(gpu_tracer *tracer, bool on);
 
 /* Reads float state texture state (TRACER_STATE_*) of the latest set into out, rows top
- * to bottom, 4 floats a texel (nothing when memory runs out). In gpu_tracer.c. */
-void gpu_read_full_state(gpu_tracer *tracer, int state, float *out);
+ * to bottom, 4 floats a texel. RT_ERROR_RUNTIME when memory runs out. In gpu_tracer.c. */
+rt_status gpu_read_full_state(gpu_tracer *tracer, int state, float *out, rt_error *error);
 
 /* Frees the tracer's compact state. */
 void gpu_compact_destroy(gpu_tracer *tracer);

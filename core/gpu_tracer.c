@@ -658,42 +658,53 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
                      tracer->parameters.shader.pass_work_budget);
 }
 
-void gpu_read_full_state(gpu_tracer *tracer, int state, float *out)
+rt_status gpu_read_full_state(gpu_tracer *tracer, int state, float *out, rt_error *error)
 {
     size_t row_bytes = (size_t)tracer->width * 16;
     char *bottom_up = malloc(row_bytes * tracer->height), *rows = (char *)out;
     if (bottom_up == NULL)
-        return;
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the pass state");
     glBindTexture(GL_TEXTURE_2D, tracer->state_textures[tracer->current][state]);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, bottom_up);
     for (int row = 0; row < tracer->height; row++)
         memcpy(rows + (size_t)row * row_bytes, bottom_up + (size_t)(tracer->height - 1 - row) * row_bytes, row_bytes);
     free(bottom_up);
+    return RT_OK;
 }
 
 /* Reads the sums of one state (accumulated, statistics or squares) of every pixel into
  * rows top to bottom: from the compacted passes' sums once there are some, else from the
- * full state textures. */
-static void read_state(gpu_tracer *tracer, int state, float *rgba)
+ * full state textures. RT_ERROR_RUNTIME when memory runs out. */
+static rt_status read_state(gpu_tracer *tracer, int state, float *rgba, rt_error *error)
 {
-    if (gpu_compact_read(tracer, state, rgba))
-        return;
-    gpu_read_full_state(tracer, state, rgba);
-    gpu_compact_note_full_read(tracer, state, rgba);
+    bool compacted = false;
+    rt_status status = gpu_compact_read(tracer, state, rgba, &compacted, error);
+    if (status != RT_OK || compacted)
+        return status;
+    status = gpu_read_full_state(tracer, state, rgba, error);
+    if (status == RT_OK)
+        gpu_compact_note_full_read(tracer, state, rgba);
+    return status;
 }
 
 rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squares, gpu_tracer_totals *totals,
                           rt_error *error)
 {
     glActiveTexture(GL_TEXTURE0);
-    read_state(tracer, TRACER_STATE_ACCUMULATED, rgba);
+    rt_status status = read_state(tracer, TRACER_STATE_ACCUMULATED, rgba, error);
+    if (status != RT_OK)
+        return status;
     if (totals != NULL || luminance_squares != NULL) {
         size_t count = (size_t)tracer->width * tracer->height;
         float *statistics = malloc(count * 4 * sizeof(float));
         if (statistics == NULL)
             return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading statistics");
-        read_state(tracer, TRACER_STATE_STATISTICS, statistics);
+        status = read_state(tracer, TRACER_STATE_STATISTICS, statistics, error);
+        if (status != RT_OK) {
+            free(statistics);
+            return status;
+        }
         gpu_tracer_totals sums = {0};
         for (size_t i = 0; i < count; i++) {
             sums.path_segments += statistics[i * 4 + 0];
@@ -734,7 +745,9 @@ rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_err
 rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error)
 {
     glActiveTexture(GL_TEXTURE0);
-    read_state(tracer, TRACER_STATE_SQUARES, squares);
+    rt_status status = read_state(tracer, TRACER_STATE_SQUARES, squares, error);
+    if (status != RT_OK)
+        return status;
     return gpu_check_gl("reading the sums of squares", error);
 }
 
