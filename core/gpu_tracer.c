@@ -421,6 +421,20 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32UI, tracer->width, tracer->height);
     const GLuint no_limit[4] = {UINT32_MAX, 0, 0, 0};
     glClearTexImage(tracer->sample_limits, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, no_limit);
+    /* Full passes never read the pixel map, but a texture like it sits on its unit:
+     * llvmpipe compiles a variant of the shader for each kind of texture bound to a unit it
+     * samples (nothing bound, and a power-of-two side or not, are kinds of their own), so
+     * without it the first compacted pass of an adaptive render compiled the tracer a second
+     * time: 0.2 to 0.3 s whenever Mesa's shader cache lacks that variant (a new machine, a
+     * container without a kept ~/.cache; docs/performance.md). Its sides are 1 or 3 texels,
+     * a power of two where the map's (the tracer's) are. */
+    glGenTextures(1, &tracer->no_pixel_map);
+    glBindTexture(GL_TEXTURE_2D, tracer->no_pixel_map);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    bool power_of_two_width = (tracer->width & (tracer->width - 1)) == 0;
+    bool power_of_two_height = (tracer->height & (tracer->height - 1)) == 0;
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32UI, power_of_two_width ? 1 : 3, power_of_two_height ? 1 : 3);
     rt_status status = gpu_check_gl("creating the state textures", error);
     if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
         return state_out_of_memory(tracer, "GL_OUT_OF_MEMORY", error);
@@ -617,7 +631,7 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
         glBindTexture(GL_TEXTURE_2D, source_textures[state]);
     }
     glActiveTexture(GL_TEXTURE0 + TRACER_PIXEL_MAP_UNIT);
-    glBindTexture(GL_TEXTURE_2D, compacted ? compact->pixel_map : 0);
+    glBindTexture(GL_TEXTURE_2D, compacted ? compact->pixel_map : tracer->no_pixel_map);
     glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
     glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
     glActiveTexture(GL_TEXTURE0 + TRACER_SAMPLE_LIMITS_UNIT);
@@ -847,6 +861,7 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
     glDeleteBuffers(1, &tracer->parameter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);
     glDeleteTextures(1, &tracer->sample_limits);
+    glDeleteTextures(1, &tracer->no_pixel_map);
     gpu_compact_destroy(tracer);
     free(tracer);
 }
