@@ -162,6 +162,15 @@ bench() {
     shift 5
     out="$work/$name.exr" log="$work/$name.log"
     rm -f "$out"     # a failed render must not leave the last run's image to be measured
+    # First an untimed 8x8 render with the row's options, so that Mesa's shader cache holds
+    # this variant's machine code: else the first run on a machine (or after a Mesa update)
+    # times each variant's compile inside its first row (docs/performance.md, the fourth
+    # machine's first run). The start-up probes time exactly that, so they are not warmed.
+    case $name in
+    startup*) ;;
+    *) env $render_environment "$program" render "$scene" -o "$work/warm-up.exr" --size 8x8 --spp "$spp" --quiet \
+        "$@" >/dev/null 2>&1 || : ;;
+    esac
     if ! env $render_environment "$work/peak_rss" "$program" render "$scene" -o "$out" --size "$size" --spp "$spp" \
         --verbose "$@" 2>"$log" >/dev/null; then
         echo "$name: rtspheres FAILED (exit status in $log:)"; tail -n 3 "$log"
