@@ -79,7 +79,8 @@ struct gpu_tracer {
     GLuint counter_buffer;
     GLuint parameter_buffer;     /* the parameter block (tracer_parameter_block) */
     GLuint sample_limits;        /* R32UI per-pixel sample limits (TRACER_SAMPLE_LIMITS_UNIT) */
-    GLuint no_pixel_map;         /* RGBA32UI 1 x 1, on the pixel map's unit in full passes */
+    GLuint no_pixel_map;         /* RGBA32UI, 1 or 3 texels a side, on the pixel map's unit in full
+                                  * passes (core/gpu_tracer.c create_state says why) */
     gpu_compact compact;         /* compacted passes (gpu_compact.c) */
     GLuint light_group_texture;  /* the light group layers (2D array, rgba32f), or 0 when the
                                   * program has no light group code */
