@@ -67,12 +67,23 @@ session_processes() {
 }
 
 # end_session SID: kills with SIGKILL every process left in a test's session: its process
-# group, and the processes that made groups of their own (a test's own `timeout` does).
+# group, and the processes that made groups of their own (a test's own `timeout` does),
+# and returns once none is left (at most about 5 s). One round is not enough: a process
+# killed by PID may have forked after the list was read (a `timeout` starting its
+# command), and a killed process is listed until it has died (CI once saw a `sleep` left
+# by the interrupted-run check of tests/render/test-runner.sh that way).
 end_session() {
-    kill -KILL "-$1" 2>/dev/null
-    left=$(session_processes "$1")
-    # shellcheck disable=SC2086 # a list of PIDs
-    [ -z "$left" ] || kill -KILL $left 2>/dev/null
+    end_tries=0
+    while :; do
+        kill -KILL "-$1" 2>/dev/null
+        left=$(session_processes "$1")
+        [ -n "$left" ] || return 0
+        # shellcheck disable=SC2086 # a list of PIDs
+        kill -KILL $left 2>/dev/null
+        end_tries=$((end_tries + 1))
+        [ "$end_tries" -lt 50 ] || return 0
+        sleep 0.1
+    done
 }
 
 # An interrupted run (Ctrl-C, a job killed) ends the tests in flight too: each runs in a
