@@ -87,8 +87,12 @@ end_session() {
 }
 
 # An interrupted run (Ctrl-C, a job killed) ends the tests in flight too: each runs in a
-# session of its own, so the terminal's signals do not reach it.
-trap 'ended=""; sessions=""
+# session of its own, so the terminal's signals do not reach it. Their runners (run_one
+# below, background subshells, which ignore SIGINT as every background job of a
+# non-interactive shell does) are ended first, so that none goes on after the run to
+# report into the scratch directory this removes.
+trap 'for file in "$scratch"/*.runner; do [ ! -f "$file" ] || kill -KILL "$(cat "$file")" 2>/dev/null; done
+ended=""; sessions=""
 for file in "$scratch"/*.log.session; do
     [ -f "$file" ] || continue
     test_name=$(basename "$file" .log.session); ended="${ended:+$ended, }$test_name"
@@ -226,8 +230,10 @@ while [ "$reported" -lt "$total" ]; do
     finished=$(find "$scratch" -maxdepth 1 -name '*.result' | wc -l)
     while [ "$started" -lt "$total" ] && [ $((started - reported - finished)) -lt "$jobs" ]; do
         started=$((started + 1))
-        # shellcheck disable=SC2046 # the line is "KIND NAME"
-        (run_one $(sed -n "${started}p" "$scratch/chosen")) &
+        line=$(sed -n "${started}p" "$scratch/chosen")
+        # shellcheck disable=SC2086 # the line is "KIND NAME"
+        (run_one $line) &
+        echo $! >"$scratch/${line#* }.runner"
     done
     name=$(sed -n "$((reported + 1))p" "$scratch/chosen" | cut -d' ' -f2)
     if [ ! -f "$scratch/$name.result" ]; then
@@ -236,7 +242,7 @@ while [ "$reported" -lt "$total" ]; do
         continue
     fi
     read -r status seconds stray n_pass n_fail n_skip limit <"$scratch/$name.result"
-    rm -f "$scratch/$name.result"
+    rm -f "$scratch/$name.result" "$scratch/$name.runner"
     log="$scratch/$name.log"
     [ ! -f "$scratch/$name.skipped" ] || cat "$scratch/$name.skipped" >>"$scratch/skipped"
     report "$name" "$n_pass" "$n_fail" "$n_skip"

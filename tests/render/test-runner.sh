@@ -125,6 +125,13 @@ if [ "$code" = 130 ] && [ -n "$session" ] && [ -z "$left" ] &&
    grep -qxF "tests/run.sh: interrupted during test-hang, which was ended" "$scratch/stopped.out"; then
     pass "a stopped run ends the test in flight and says so"
 else fail "a stopped run ends the test in flight" "exit $code, session '$session', left '$left': $(cat "$scratch/stopped.out")"; fi
+# ... and says nothing else, then or a little later: the test's runner (a background
+# subshell of run.sh) once went on after the run, reporting into its removed scratch
+# directory ("cannot create ...: Directory nonexistent"), after a shell's "Killed".
+sleep 0.5
+if [ "$(cat "$scratch/stopped.out")" = "tests/run.sh: interrupted during test-hang, which was ended" ]; then
+    pass "a stopped run prints that one line"
+else fail "a stopped run prints that one line" "$(tr '\n' '|' <"$scratch/stopped.out" | head -c 600)"; fi
 
 # --- V=1, names, unknown names, a bad time-out
 verbose=$scratch/verbose.out
