@@ -206,7 +206,7 @@ FUZZ_FLAGS := -std=c11 -D_GNU_SOURCE -g -O1 -fno-omit-frame-pointer -Icore -Igls
 	-fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
 # The packer and the CPU traversal of what it packs (core/pack_internal.h lists its files).
 FUZZ_PACK_SOURCES := core/pack.c core/pack_collect.c core/pack_geometry.c core/pack_lights.c \
-	core/pack_materials.c core/packed_traverse.c
+	core/pack_materials.c core/packed_traverse.c core/light_tree.c
 # The scene parser's parts (core/scene_parse.c lists what each does); its gltf statement
 # reads glTF files through the C++ shim (core/gltf_load.cpp over tinygltf).
 FUZZ_PARSER_SOURCES := core/scene_parse.c core/scene_report.c core/scene_lexer.c core/scene_values.c \

@@ -143,6 +143,8 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_MANY_LIGHTS     at most one light: no light to choose, no search for a hit
  *                            emitter's light
  *   GPU_OMIT_LAMBERTIAN, GPU_OMIT_METAL, GPU_OMIT_DIELECTRIC  no material of that kind
+ *   GPU_OMIT_LIGHT_TREE      no light tree (at most LIGHT_LOCAL_CHOICE_MAX lights, or no
+ *                            light sampling): lights are not chosen by walking it
  *   GPU_FIX_UNIFORMS         the integrator, the sky type and the sampler compiled in as constants
  *                            (the values in the parameters), not read from the
  *                            parameter block
@@ -171,7 +173,8 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_LAMBERTIAN (1u << 21)
 #define GPU_OMIT_METAL (1u << 22)
 #define GPU_OMIT_DIELECTRIC (1u << 23)
-#define GPU_VARIANT_BITS 24
+#define GPU_OMIT_LIGHT_TREE (1u << 24)
+#define GPU_VARIANT_BITS 25
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct

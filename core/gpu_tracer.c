@@ -195,6 +195,7 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
         {GPU_OMIT_LAMBERTIAN, "RTSPHERES_OMIT_LAMBERTIAN"},
         {GPU_OMIT_METAL, "RTSPHERES_OMIT_METAL"},
         {GPU_OMIT_DIELECTRIC, "RTSPHERES_OMIT_DIELECTRIC"},
+        {GPU_OMIT_LIGHT_TREE, "RTSPHERES_OMIT_LIGHT_TREE"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;

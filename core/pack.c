@@ -7,7 +7,9 @@
 #include <string.h>
 
 #include "hash.h"
+#include "light_tree.h"
 #include "pack_internal.h"
+#include "tracer_interface.h"
 
 /* The shader's traversal stack keeps a leaf's primitive count in the 32 - PACKED_FIRST_BITS
  * top bits of a word, beside the counts 6 and 7 that mark instances (glsl/traverse.glsl). */
@@ -108,7 +110,19 @@ static rt_status plan_layout(packer *p, rt_error *error)
     }
     layout->light_offset = layout->image_offset + (uint64_t)s->image_count * PACKED_IMAGE_STRIDE;
     layout->environment_offset = layout->light_offset + layout->light_count * PACKED_LIGHT_STRIDE;
-    layout->pixel_offset = layout->environment_offset + layout->environment_texels;
+    /* More lights than the tracer weighs one by one: a light tree (core/light_tree.h). */
+    layout->light_tree_offset = PACKED_NONE;
+    layout->light_tree_nodes = 0;
+    uint64_t after_lights = layout->environment_offset + layout->environment_texels;
+    if (layout->light_count > LIGHT_TREE_MAX_LIGHTS)
+        return rt_error_set(error, RT_ERROR_INPUT, "PACK: %llu lights, more than the %u the light tree takes",
+                            (unsigned long long)layout->light_count, LIGHT_TREE_MAX_LIGHTS);
+    if (layout->light_count > LIGHT_LOCAL_CHOICE_MAX) {
+        layout->light_tree_offset = after_lights;
+        layout->light_tree_nodes = 2 * layout->light_count - 1;
+        after_lights += layout->light_tree_nodes * PACKED_LIGHT_TREE_NODE_STRIDE;
+    }
+    layout->pixel_offset = after_lights;
     uint64_t image_pixels = 0;
     for (int i = 0; i < s->image_count; i++)
         image_pixels += (uint64_t)s->images[i].width * s->images[i].height;
@@ -148,6 +162,7 @@ static void write_header(packer *p)
     out->light_offset = (uint32_t)l->light_offset;
     out->light_count = (uint32_t)l->light_count;
     out->area_light_count = (uint32_t)l->area_light_count;
+    out->light_tree_offset = (uint32_t)l->light_tree_offset;
     uint32_t environment_offset = (uint32_t)l->environment_offset;
     put_texel(p->texels, 0, PACKED_MAGIC, PACKED_LAYOUT_VERSION, out->material_offset, out->material_count);
     put_texel(p->texels, 1, out->primitive_offset, out->primitive_count, out->node_offset, out->node_count);
@@ -155,7 +170,7 @@ static void write_header(packer *p)
     put_texel(p->texels, 3, out->texture_offset, out->texture_count, out->image_offset, out->image_count);
     put_texel(p->texels, 4, out->light_offset, out->light_count, environment_offset, out->area_light_count);
     put_texel(p->texels, 5, out->shape_offset, out->vertex_offset, out->uv_offset, out->vertex_count);
-    put_texel(p->texels, 6, out->color_offset, 0, 0, 0);
+    put_texel(p->texels, 6, out->color_offset, out->light_tree_offset, 0, 0);
 }
 
 /* Allocates the packer's per-object, per-instance and per-mesh arrays. */

@@ -92,6 +92,9 @@ typedef struct packed_scene {
     uint32_t image_offset, image_count;
     uint32_t light_offset, light_count;
     uint32_t area_light_count;                  /* the first lights: emissive primitives */
+    uint32_t light_tree_offset;                 /* PACKED_NONE: no light tree (at most
+                                                 * LIGHT_LOCAL_CHOICE_MAX lights) */
+    uint32_t light_tree_depth;                  /* its deepest leaf (0: none) */
     uint32_t default_material;
     uint32_t triangle_count;     /* triangles stored (mesh triangles once per object) */
     int bvh_depth;               /* deepest level of any BVH */

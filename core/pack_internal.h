@@ -84,6 +84,7 @@ typedef struct pack_layout {
     uint64_t image_offset;
     uint64_t light_offset, light_count, area_light_count;
     uint64_t environment_offset, environment_texels;
+    uint64_t light_tree_offset, light_tree_nodes;   /* PACKED_NONE and 0: no light tree */
     uint64_t pixel_offset;                        /* image pixels, after all the records */
     uint64_t texel_count;
 } pack_layout;

@@ -1,13 +1,15 @@
 /* pack_lights.c: the packer's light section (pack_internal.h): the emissive world
  * primitives (area lights), the scene's point, spot and sun lights and the environment
- * map, each with its power, which the cdf of choosing a light follows; and the
- * environment's sampling distribution. */
+ * map, each with its power, which the cdf of choosing a light follows; the environment's
+ * sampling distribution; and, with more than LIGHT_LOCAL_CHOICE_MAX lights, the light tree
+ * (core/light_tree.h) over each light's bounds. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <cglm/cglm.h>
 
+#include "light_tree.h"
 #include "pack_internal.h"
 
 /* Whether a world primitive is an area light: a sphere, quad or triangle whose material
@@ -28,8 +30,11 @@ uint32_t pack_count_area_lights(const packer *p)
 }
 
 /* Writes the area lights, in primitive slot order, from light 0 on; their powers go to
- * power[]: emission luminance x area (x pi for the cosine lobe). */
-static void write_area_lights(packer *p, double *power)
+ * power[]: emission luminance x area (x pi for the cosine lobe); their bounds for the light
+ * tree to bounds[]: the estimate glsl/lights.glsl light_importance makes of one light, as
+ * an intensity over the squared distance (luminance x area; a sphere's projected area is a
+ * quarter of its area) with a flat light's normal as the axis of its facing. */
+static void write_area_lights(packer *p, double *power, light_bounds *bounds)
 {
     const scene *s = p->scene;
     uint32_t light = 0;
@@ -58,6 +63,31 @@ static void write_area_lights(packer *p, double *power)
         }
         /* A light of no power is still listed (for MIS weights) but never chosen. */
         power[light] = luminance * area * M_PI;
+        light_bounds *b = &bounds[light];
+        b->box = bvh_box_empty();
+        if (item->type == PRIMITIVE_SPHERE) {
+            float radius = fabsf(item->data[0][3]);
+            for (int axis = 0; axis < 3; axis++) {
+                b->box.min[axis] = centre[axis] - radius;
+                b->box.max[axis] = centre[axis] + radius;
+            }
+            b->cos_spread = -1;
+            b->intensity = (float)(luminance * area * 0.25);
+        } else {
+            vec3 corner;
+            bvh_box_add_point(&b->box, item->data[0]);
+            glm_vec3_add((float *)item->data[0], (float *)item->data[1], corner);
+            bvh_box_add_point(&b->box, corner);
+            glm_vec3_add((float *)item->data[0], (float *)item->data[2], corner);
+            bvh_box_add_point(&b->box, corner);
+            if (item->type == PRIMITIVE_QUAD) {
+                glm_vec3_add(corner, (float *)item->data[1], corner);
+                bvh_box_add_point(&b->box, corner);
+            }
+            glm_vec3_copy(normal, b->axis);
+            b->cos_spread = 1;
+            b->intensity = (float)(luminance * area);
+        }
         /* Slots ascend with light: the shader finds a primitive's light by a binary
          * search of the first area_light_count lights. */
         uint64_t base = p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
@@ -89,9 +119,11 @@ static double scene_radius(const packer *p)
     return radius;
 }
 
-/* Writes the scene's point, spot and sun lights from light first on, with their powers.
- * A sun's power is its irradiance over the scene's cross-section. */
-static void write_scene_lights(packer *p, uint32_t first, double radius, double *power)
+/* Writes the scene's point, spot and sun lights from light first on, with their powers
+ * and their bounds for the light tree (a point or spot: its intensity's luminance at a
+ * point, the spot's cone left out; a sun: its irradiance's, anywhere). A sun's power is its
+ * irradiance over the scene's cross-section. */
+static void write_scene_lights(packer *p, uint32_t first, double radius, double *power, light_bounds *bounds)
 {
     const scene *s = p->scene;
     uint32_t light = first;
@@ -110,6 +142,16 @@ static void write_scene_lights(packer *p, uint32_t first, double radius, double 
             power[light] = 2 * M_PI * (1 - 0.5 * (cos_outer + cos_inner)) * luminance;
         else
             power[light] = M_PI * radius * radius * luminance;
+        light_bounds *b = &bounds[light];
+        b->box = bvh_box_empty();
+        b->cos_spread = -1;
+        if (type == LIGHT_SUN) {
+            b->infinite = true;
+            b->irradiance = (float)luminance;
+        } else {
+            bvh_box_add_point(&b->box, source->position);
+            b->intensity = (float)luminance;
+        }
         bool polynomial = source->falloff == FALLOFF_POLYNOMIAL;
         uint64_t base = p->layout.light_offset + (uint64_t)light * PACKED_LIGHT_STRIDE;
         put_texel(p->texels, base, type, polynomial ? float_bits(source->attenuation[0]) : 0,
@@ -136,7 +178,8 @@ static void write_scene_lights(packer *p, uint32_t first, double radius, double 
  * cross-section from all around. Rows, then pixels in each row, are weighted by
  * luminance x sin(latitude) (the solid angle a pixel covers); a small floor keeps every
  * pixel reachable. */
-static rt_status write_environment(packer *p, uint32_t light, double radius, double *power, rt_error *error)
+static rt_status write_environment(packer *p, uint32_t light, double radius, double *power, light_bounds *bounds,
+                                   rt_error *error)
 {
     const scene_image *environment = p->environment;
     uint32_t *texels = p->texels;
@@ -180,8 +223,39 @@ static rt_status write_environment(packer *p, uint32_t light, double radius, dou
     put_texel(texels, base, LIGHT_ENVIRONMENT, (uint32_t)width, (uint32_t)height, 0);
     /* The irradiance it gives a surface facing any way, about pi x its mean radiance. */
     put_texel(texels, base + 2, 0, 0, 0, float_bits((float)(M_PI * mean * p->scene->sky.intensity)));
+    bounds[light].box = bvh_box_empty();
+    bounds[light].cos_spread = -1;
+    bounds[light].infinite = true;
+    bounds[light].irradiance = (float)(M_PI * mean * p->scene->sky.intensity);
     put_texel(texels, base + 4, (uint32_t)p->scene->sky.light_group, 0, 0, 0);
     p->out->summary.light_types |= 1u << LIGHT_ENVIRONMENT;
+    return RT_OK;
+}
+
+/* Writes the light tree over bounds[] (light_count lights) to its section and each light's
+ * trail to texel 4 of its record (packed_layout.h, lights). */
+static rt_status write_light_tree(packer *p, const light_bounds *bounds, uint32_t light_count, rt_error *error)
+{
+    light_tree tree = {0};
+    rt_status status = light_tree_build(bounds, light_count, &tree, error);
+    if (status != RT_OK)
+        return status;
+    for (uint32_t n = 0; n < tree.node_count; n++) {
+        const light_tree_node *node = &tree.nodes[n];
+        uint64_t base = p->layout.light_tree_offset + (uint64_t)n * PACKED_LIGHT_TREE_NODE_STRIDE;
+        put_texel(p->texels, base, float_bits(node->box.min[0]), float_bits(node->box.min[1]),
+                  float_bits(node->box.min[2]), float_bits(node->intensity));
+        put_texel(p->texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
+                  float_bits(node->box.max[2]), float_bits(node->irradiance));
+        put_texel(p->texels, base + 2, packed_encode_normal(node->axis), float_bits(node->cos_spread),
+                  node->leaf ? node->first | LIGHT_TREE_LEAF : node->first, 0);
+    }
+    for (uint32_t l = 0; l < light_count; l++) {
+        uint64_t base = p->layout.light_offset + (uint64_t)l * PACKED_LIGHT_STRIDE;
+        p->texels[4 * (base + 4) + 1] = tree.trails[l];
+    }
+    p->out->light_tree_depth = tree.depth;
+    light_tree_free(&tree);
     return RT_OK;
 }
 
@@ -191,18 +265,25 @@ rt_status pack_write_lights(packer *p, rt_error *error)
     if (light_count == 0)
         return RT_OK;
     double *power = malloc(light_count * sizeof *power);
-    if (power == NULL)
+    light_bounds *bounds = calloc(light_count, sizeof *bounds);
+    if (power == NULL || bounds == NULL) {
+        free(power);
+        free(bounds);
         return rt_error_set(error, RT_ERROR_RUNTIME, "PACK: out of memory");
+    }
     uint32_t area_lights = (uint32_t)p->layout.area_light_count;
     double radius = scene_radius(p);
-    write_area_lights(p, power);
-    write_scene_lights(p, area_lights, radius, power);
-    if (p->environment != NULL) {
-        rt_status status = write_environment(p, area_lights + (uint32_t)p->scene->light_count, radius, power, error);
-        if (status != RT_OK) {
-            free(power);
-            return status;
-        }
+    write_area_lights(p, power, bounds);
+    write_scene_lights(p, area_lights, radius, power, bounds);
+    rt_status status = RT_OK;
+    if (p->environment != NULL)
+        status = write_environment(p, area_lights + (uint32_t)p->scene->light_count, radius, power, bounds, error);
+    if (status == RT_OK && p->layout.light_tree_offset != PACKED_NONE)
+        status = write_light_tree(p, bounds, light_count, error);
+    free(bounds);
+    if (status != RT_OK) {
+        free(power);
+        return status;
     }
     /* The cdf of choosing each light, by power (all alike when none has any). */
     double total = 0;

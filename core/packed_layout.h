@@ -36,12 +36,14 @@
  *   images      PACKED_IMAGE_STRIDE texels each (a record), pixels elsewhere in the section
  *   lights      PACKED_LIGHT_STRIDE texels each, for light sampling
  *   environment the environment map's sampling distribution (see lights)
+ *   light tree  PACKED_LIGHT_TREE_NODE_STRIDE texels a node, with more than
+ *               LIGHT_LOCAL_CHOICE_MAX lights (core/tracer_interface.h; see lights)
  */
 #ifndef RT_PACKED_LAYOUT_H
 #define RT_PACKED_LAYOUT_H
 
 /* Bumped whenever a record below changes meaning. */
-#define PACKED_LAYOUT_VERSION 5
+#define PACKED_LAYOUT_VERSION 6
 #define PACKED_NONE 4294967295u
 
 /* ---- header (7 texels), field i is component i % 4 of texel i / 4 */
@@ -72,6 +74,7 @@
 #define PACKED_HEADER_UV_OFFSET 22
 #define PACKED_HEADER_VERTEX_COUNT 23
 #define PACKED_HEADER_COLOR_OFFSET 24    /* PACKED_NONE: no vertex colour section */
+#define PACKED_HEADER_LIGHT_TREE_OFFSET 25   /* PACKED_NONE: no light tree */
 
 /* ---- materials: 6 texels
  *   texel 0 = (type tag | flags, albedo.r, albedo.g, albedo.b)    albedo: pbr's base colour
@@ -199,7 +202,10 @@
  *             cdf: the probability of choosing this light or any before it
  *   texel 2 = (intensity colour.rgb (point, spot: per steradian; sun: irradiance), 0)
  *   texel 3 = (spot direction.xyz, cos of the spot's inner half-angle)
- *   texel 4 = (light group (scene.h light_groups; the environment: the sky's), 0, 0, 0)
+ *   texel 4 = (light group (scene.h light_groups; the environment: the sky's), trail, 0, 0)
+ *             trail: the way to the light's leaf in the light tree (below; 0 when there is
+ *             none): bit k is set when the walk from the root takes the second child at
+ *             depth k; the walk ends at the leaf
  *   point, spot, sun: texel 0 .yzw = polynomial attenuation c, l, q (all 0: inverse square),
  *   texel 1 .xyz = position (point, spot) or the direction towards the sun, texel 2 .w = cos
  *   of the spot's outer half-angle or of the sun's angular radius.
@@ -211,8 +217,24 @@
  * height, 0), texel 2 .w = the irradiance it gives (pi x its mean luminance x the sky's
  * intensity); it is importance-sampled by the environment section: one float per texel
  * (in .x): the cumulative distribution over rows (height values), then for each row the
- * cumulative distribution over its pixels (width values), of luminance x sin(latitude). */
+ * cumulative distribution over its pixels (width values), of luminance x sin(latitude).
+ *
+ * light tree (scenes of more than LIGHT_LOCAL_CHOICE_MAX lights; core/light_tree.h builds
+ * it): a binary tree over the lights, one light a leaf, root at node 0, an interior
+ * node's children contiguous (first, first + 1). The shader walks it from the root to
+ * choose a light for a point, each child in proportion to an estimate of what its lights
+ * give the point (glsl/lights.glsl). A node is 3 texels:
+ *   texel 0 = (box min.xyz of its finite lights, their intensity: the sum of what an
+ *             estimate divides by the squared distance)
+ *   texel 1 = (box max.xyz, irradiance of its infinite lights (sun, environment))
+ *   texel 2 = (axis of the cone of its flat lights' normals, octahedral (packed_encode_normal
+ *             of core/pack.h), cosine of the cone's half-angle (-1: lights that shine every
+ *             way), child: interior: its first child's node index; leaf: the light's index
+ *             | LIGHT_TREE_LEAF, 0) */
 #define PACKED_LIGHT_STRIDE 5
+#define PACKED_LIGHT_TREE_NODE_STRIDE 3
+#define LIGHT_TREE_LEAF 2147483648u
+#define LIGHT_TREE_MAX_DEPTH 32        /* a trail's bits */
 #define LIGHT_SPHERE 0
 #define LIGHT_QUAD 1
 #define LIGHT_TRIANGLE 2

@@ -12,8 +12,10 @@
 // with its power-based chance (POWER_SHARE of it) so that every light that could light
 // the point keeps a chance. The estimate leaves out the receiver's orientation, so the
 // probability MIS needs when a path hits an emitter depends only on the position of the
-// vertex it came from. Scenes with more lights choose by power: the estimate's loop over
-// all lights would cost more than it saves (a light tree is the answer for those).
+// vertex it came from. By the light tree (choose_light_in_tree, light_tree_probability),
+// for scenes of more lights, where a loop over all of them would cost more than it saves:
+// a walk from the root that takes each child in proportion to an estimate of what its
+// lights give the point (tree_node_importance), as pbrt-v4's BVH light sampler does.
 const uint LOCAL_CHOICE_MAX = uint(LIGHT_LOCAL_CHOICE_MAX);
 const float POWER_SHARE = 0.25;
 const vec3 LUMINANCE = vec3(0.2126, 0.7152, 0.0722);   // Rec. 709, as the packer's powers
@@ -64,6 +66,73 @@ float light_importance(uint light, vec3 p)
     return importance;
 }
 
+// ---- the light tree (core/packed_layout.h "light tree", built by core/light_tree.c)
+
+// Whether lights are chosen by walking the light tree in this scene (more than
+// LOCAL_CHOICE_MAX lights; the variant leaves the walk out otherwise).
+bool chooses_by_tree() { return HAS_LIGHT_TREE && light_tree_offset != NONE; }
+
+// An estimate of what the lights of a tree node (its three texels) give point p, in the
+// units of light_importance: the infinite lights' irradiance, plus the finite lights'
+// intensity over the squared distance to the centre of their box (at least the box's
+// half-diagonal squared, so that a point inside or near the box does not blow it up),
+// times the largest cosine any of their normals can make with a direction from the box
+// to p (two-sided: emitters shine from both faces): the angle to the cone's axis less the
+// cone's half-angle and the half-angle the box's bounding sphere covers (pbrt-v4's
+// LightBounds::Importance, without the receiver's cosine, which MIS could not recompute
+// at an emitter hit from the vertex's position alone). It is zero only where no light
+// below the node can shine (in the plane of flat lights that all lie in it).
+float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p)
+{
+    float intensity = uintBitsToFloat(t0.w);
+    vec3 low = uintBitsToFloat(t0.xyz), high = uintBitsToFloat(t1.xyz);
+    vec3 half_size = 0.5 * (high - low);
+    vec3 to_p = p - 0.5 * (low + high);
+    float radius_squared = dot(half_size, half_size);
+    float distance_squared = dot(to_p, to_p);
+    float cos_spread = uintBitsToFloat(t2.y);
+    float facing = 1.0;
+    if (cos_spread > -1.0) {
+        float distance = sqrt(distance_squared);
+        float cos_axis = min(abs(dot(decode_normal(t2.x), to_p)) / max(distance, 1e-30), 1.0);
+        float sin_box = distance_squared > radius_squared ? sqrt(radius_squared / distance_squared) : 1.0;
+        facing = cos(max(acos(cos_axis) - acos(min(cos_spread, 1.0)) - asin(sin_box), 0.0));
+    }
+    // A node of infinite lights alone has an empty box (infinite corners): no finite part.
+    float finite = intensity > 0.0 ? intensity * facing / max(max(distance_squared, radius_squared), 1e-30) : 0.0;
+    return uintBitsToFloat(t1.w) + finite;
+}
+
+// Walks the light tree from the root to a leaf for point p and returns its light; chance
+// receives the probability of that walk. Each interior node's children are estimated
+// (tree_node_importance) and the second is taken with its share of the two (half when
+// both are zero): by u (uniform in [0, 1), rescaled at each level to what is left of it)
+// or, when by_trail, by the bits of trail (packed_layout.h, lights: the walk to one
+// light's leaf), which gives the probability that u would have taken it.
+uint walk_light_tree(vec3 p, bool by_trail, uint trail, float u, out float chance)
+{
+    chance = 1.0;
+    uint child = packed_texel(light_tree_offset + 2u).z;   // the root's
+    // At most LIGHT_TREE_MAX_DEPTH levels (a trail's bits); the loop ends at the leaf.
+    for (uint level = 0u; level < uint(LIGHT_TREE_MAX_DEPTH) && (child & LIGHT_TREE_LEAF) == 0u; level++) {
+        work++;
+        uint base = light_tree_offset + child * uint(PACKED_LIGHT_TREE_NODE_STRIDE);
+        uvec4 first2 = packed_texel(base + 2u), second2 = packed_texel(base + 5u);
+        float first_importance = tree_node_importance(packed_texel(base), packed_texel(base + 1u), first2, p);
+        float second_importance = tree_node_importance(packed_texel(base + 3u), packed_texel(base + 4u), second2, p);
+        float both = first_importance + second_importance;
+        float second_share = both > 0.0 ? second_importance / both : 0.5;
+        float first_share = 1.0 - second_share;
+        bool second = by_trail ? ((trail >> level) & 1u) != 0u : u >= first_share;
+        // What is left of u, uniform again within the branch taken.
+        u = second ? (u - first_share) / max(second_share, 1e-30) : u / max(first_share, 1e-30);
+        u = min(u, 0.99999994);
+        chance *= second ? second_share : first_share;
+        child = second ? second2.z : first2.z;
+    }
+    return child & ~LIGHT_TREE_LEAF;
+}
+
 // Whether lights are chosen by the point (see above) in this scene. The variant leaves the
 // code out when the host knows they are not (HAS_LIGHT_CHOICE): llvmpipe would run its
 // loops once however many lights there are.
@@ -81,6 +150,11 @@ float mixed_probability(uint light, float importance, float total)
 // importances' total (its out parameter).
 float light_choice_probability(uint light, vec3 p, float total)
 {
+    if (chooses_by_tree()) {
+        float chance;
+        walk_light_tree(p, true, packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE) + 4u).y, 0.0, chance);
+        return chance;
+    }
     if (!chooses_by_point())
         return light_power_probability(light);
     return mixed_probability(light, light_importance(light, p), total);
@@ -92,6 +166,8 @@ float light_choice_probability(uint light, vec3 p, float total)
 uint choose_light_at(float u, vec3 p, out float probability, out float total)
 {
     total = 0.0;
+    if (chooses_by_tree())
+        return walk_light_tree(p, false, 0u, u, probability);
     if (!chooses_by_point()) {
         uint light = choose_light(u);
         probability = light_power_probability(light);

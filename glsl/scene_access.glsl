@@ -27,6 +27,7 @@ uint light_offset;
 uint light_count;    // the scene's lights; an integrator narrows it to what it samples
 uint environment_offset;
 uint color_offset;   // the vertex colour section, NONE when there is none
+uint light_tree_offset;   // the light tree, NONE when there is none
 
 // Reads the packed scene's header (packed_layout.h "header") into the globals above.
 void read_header()
@@ -49,7 +50,9 @@ void read_header()
     shape_offset = header5.x;
     vertex_offset = header5.y;
     uv_offset = header5.z;
-    color_offset = HAS_VERTEX_COLORS ? packed_texel(6u).x : NONE;
+    uvec4 header6 = packed_texel(6u);
+    color_offset = HAS_VERTEX_COLORS ? header6.x : NONE;
+    light_tree_offset = HAS_LIGHT_TREE ? header6.y : NONE;
 }
 
 // A vertex normal from its octahedral encoding (core/pack.h packed_encode_normal).

@@ -26,6 +26,7 @@ const bool HAS_TRIANGLE_LIGHTS = RTSPHERES_OMIT_TRIANGLE_LIGHTS == 0; // emissiv
 const bool HAS_DELTA_LIGHTS = RTSPHERES_OMIT_DELTA_LIGHTS == 0;       // point, spot and sun lights
 const bool HAS_ENVIRONMENT_LIGHT = RTSPHERES_OMIT_ENVIRONMENT_LIGHT == 0;   // the sky sampled as a light
 const bool HAS_MANY_LIGHTS = RTSPHERES_OMIT_MANY_LIGHTS == 0;         // more than one light to choose from
+const bool HAS_LIGHT_TREE = RTSPHERES_OMIT_LIGHT_TREE == 0;           // lights chosen by walking the light tree
 const bool HAS_LAMBERTIAN = RTSPHERES_OMIT_LAMBERTIAN == 0;           // material kinds
 const bool HAS_METAL = RTSPHERES_OMIT_METAL == 0;
 const bool HAS_DIELECTRIC = RTSPHERES_OMIT_DIELECTRIC == 0;

@@ -219,23 +219,93 @@ quad 1.5 1.5 0  0.8 0 0  0.3 0.2 0.9 cool
 triangle 0 3 -2  1 3 -2  0 3 -1 warm
 sphere -2 0.5 1.5 0.25 cool
 SCENE
-a="$scratch/area-lights-on.exr"
-b="$scratch/area-lights-off.exr"
-if "$program" render "$scratch/area-lights.txt" -o "$a" --light-sampling on --quiet &&
-   "$program" render "$scratch/area-lights.txt" -o "$b" --light-sampling off --quiet; then
-    problems=""
-    for crop in 0,0,24,14 24,0,48,14 0,14,24,27 24,14,48,27; do
-        for channel in R G B; do
-            mean_a=$(channel_mean "$a" $channel $crop)
-            mean_b=$(channel_mean "$b" $channel $crop)
-            within "$mean_a" "$mean_b" 0.03 || problems="$problems $crop/$channel: $mean_a vs $mean_b;"
+# samplings_agree NAME SCENE [OPTIONS...]: renders SCENE (48x27) with light sampling on,
+# and off with OPTIONS; one check: every quarter's R, G and B means agree within 3%.
+samplings_agree() {
+    name=$1 scene=$2
+    shift 2
+    stem=$(printf '%s' "$name" | tr -c 'a-z0-9' '-')
+    on="$scratch/$stem-on.exr" off="$scratch/$stem-off.exr"
+    if "$program" render "$scene" -o "$on" --light-sampling on --quiet &&
+       "$program" render "$scene" -o "$off" --light-sampling off --quiet "$@"; then
+        problems=""
+        for crop in 0,0,24,14 24,0,48,14 0,14,24,27 24,14,48,27; do
+            for channel in R G B; do
+                mean_on=$(channel_mean "$on" $channel $crop)
+                mean_off=$(channel_mean "$off" $channel $crop)
+                within "$mean_on" "$mean_off" 0.03 || problems="$problems $crop/$channel: $mean_on vs $mean_off;"
+            done
         done
-    done
-    if [ -z "$problems" ]; then pass "four area lights: light sampling and BSDF sampling agree in every quarter (within 3%)"
-    else fail "four area lights: light sampling and BSDF sampling agree" "$problems"; fi
+        if [ -z "$problems" ]; then pass "$name: light sampling and BSDF sampling agree in every quarter (within 3%)"
+        else fail "$name: light sampling and BSDF sampling agree" "$problems"; fi
+    else
+        fail "$name" "render failed"
+    fi
+}
+samplings_agree "four area lights" "$scratch/area-lights.txt"
+
+# Many lights (more than LIGHT_LOCAL_CHOICE_MAX of core/tracer_interface.h): light sampling
+# walks the light tree (glsl/lights.glsl, walk_light_tree) to choose one. Twelve point
+# lights and a sun over a diffuse plane (albedo 0.5, black sky), the camera on one point:
+# radiance = albedo / pi x (sum of I cos / r^2 over the points + E cos of the sun), so a
+# choice whose probability were not the walk's would be off. Computed here from the list.
+many_lights=""
+for k in 0 1 2 3 4 5 6 7 8 9 10 11; do
+    x=$(awk -v k=$k 'BEGIN { printf "%.3f", 3 * cos(k * 2.4) * (1 + k % 3) }')
+    y=$(awk -v k=$k 'BEGIN { printf "%.3f", 0.5 + 0.4 * k }')
+    z=$(awk -v k=$k 'BEGIN { printf "%.3f", 3 * sin(k * 2.4) * (1 + k % 3) }')
+    intensity=$(awk -v k=$k 'BEGIN { printf "%.3f", 1 + 2 * (k % 4) }')
+    many_lights="$many_lights
+light point $x $y $z intensity $intensity"
+done
+many_lights="$many_lights
+light sun 0.6 -0.8 0 intensity 0.5 angle 0"
+expected=$(printf '%s\n' "$many_lights" | awk '
+    $1 == "light" && $2 == "point" { r2 = $3 * $3 + $4 * $4 + $5 * $5; e += $7 * $4 / sqrt(r2) / r2 }
+    $1 == "light" && $2 == "sun" { e += $7 * 0.8 }
+    END { printf "%.6f", 0.5 / 3.14159265358979 * e }')
+cat >"$scratch/many-points.txt" <<SCENE
+render size 8 8 spp 256 depth 2 seed 1
+camera from 1 3 2 at 0 0 0 up 0 1 0 fov 0.2
+sky constant 0 0 0
+ambient 0 0 0
+material floor lambertian 0.5 0.5 0.5 specular 0 0 0
+quad -50 0 -50  100 0 0  0 0 100 floor
+$many_lights
+SCENE
+if "$program" render "$scratch/many-points.txt" -o "$scratch/many-points.exr" --quiet; then
+    mean=$(channel_mean "$scratch/many-points.exr" G)
+    if within "$mean" "$expected" 0.01; then pass "12 point lights and a sun, chosen by the light tree: $mean, analytic $expected"
+    else fail "12 point lights and a sun, chosen by the light tree" "$mean, analytic $expected"; fi
 else
-    fail "four area lights" "render failed"
+    fail "12 point lights and a sun" "render failed"
 fi
+
+# Many area lights (12 quads, 2 triangles, 2 spheres, facing every way): the light tree's
+# choice and, at an emitter a path hits, the probability MIS recomputes from the light's
+# trail must agree, or light sampling and BSDF sampling alone converge to different images.
+{
+    cat <<SCENE
+render size 48 27 spp 256 depth 3 seed 1
+camera from 0 2.5 6 at 0 0.5 0 up 0 1 0 fov 45
+sky constant 0 0 0
+material floor lambertian 0.6 0.6 0.6
+material wall lambertian 0.3 0.5 0.7
+material warm emissive 1 0.8 0.6 strength 3
+material cool emissive 0.6 0.8 1 strength 6
+quad -6 0 -6  12 0 0  0 0 12 floor
+box -0.6 0 -0.6  0.6 1.2 0.6 wall
+triangle 0 3 -2  1 3 -2  0 3 -1 warm
+triangle -1 2 -3  -1 3 -3  -2 2 -3 cool
+sphere -2 0.5 1.5 0.25 cool
+sphere 2 0.3 1 0.2 warm
+SCENE
+    for k in 0 1 2 3 4 5 6 7 8 9 10 11; do
+        awk -v k=$k 'BEGIN { a = k * 0.52; printf "quad %.3f %.3f %.3f  0.5 0 0  0 %.3f %.3f  %s\n",
+            3 * cos(a) - 0.25, 1 + 0.15 * k, 3 * sin(a) - 2, 0.4 * sin(a), 0.4 * cos(a), k % 2 ? "warm" : "cool" }'
+    done
+} >"$scratch/many-areas.txt"
+samplings_agree "16 area lights (light tree)" "$scratch/many-areas.txt" --spp 1024
 
 # An environment map as a light: a dim sky with one small, very bright patch (a "sun" of
 # four pixels). Importance sampling it must give the image that BSDF sampling alone

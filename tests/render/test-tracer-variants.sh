@@ -48,6 +48,9 @@ check cornell-smoke scenes/cornell-smoke.txt
 check cornell scenes/cornell.txt
 check three-balls scenes/three-balls.txt
 check mesh-light tests/render/scenes/mesh-light.txt
+# Seventy lights (quads and points): the light tree walked, the per-point choice of 2 to 8
+# lights left out.
+check many-lights scenes/many-lights.txt
 # Textures (image, checker, noise, normal maps) and an image sky.
 check textures scenes/textures.txt
 # Moving spheres, instances, a volume, fog, textures, emitters, a black sky.

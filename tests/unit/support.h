@@ -9,6 +9,8 @@
  *   make_image(width, height, channels, value)     an image with every sample = value
  *   assert_merge_metadata_equal(actual, expected)  every field of two merge_metadata
  *   splitmix64_next(&state)                        reproducible 64-bit test data
+ *   random_source, random_float, random_below      the same, as floats and integers
+ *   same_box(a, b), box_contains(outer, inner)     bvh_box comparisons
  *   gpu_fixture_set_up / gpu_fixture_tear_down   a cmocka group setup/teardown pair making
  *            gpu_fixture_context, the one GPU context of a test binary that renders
  *   scratch: make_scratch / remove_scratch (a cmocka setup/teardown pair), in_scratch,
@@ -36,6 +38,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "bvh.h"
 #include "image_io.h"
 #include "merge.h"
 
@@ -123,6 +126,45 @@ static inline uint64_t splitmix64_next(uint64_t *state)
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
     return z ^ (z >> 31);
+}
+
+/* A splitmix64 stream for the helpers below. */
+typedef struct random_source {
+    uint64_t state;
+} random_source;
+
+/* Returns a float in [low, high). */
+static inline float random_float(random_source *source, float low, float high)
+{
+    float unit = (float)(splitmix64_next(&source->state) >> 40) * 0x1.0p-24f;
+    /* Not low + (high - low) * unit: high - low overflows for ranges near FLT_MAX. */
+    return low * (1 - unit) + high * unit;
+}
+
+/* Returns an integer in [0, bound). */
+static inline uint32_t random_below(random_source *source, uint32_t bound)
+{
+    return (uint32_t)(splitmix64_next(&source->state) % bound);
+}
+
+/* ---- boxes ------------------------------------------------------------------------------- */
+
+/* Whether two boxes are equal, bound for bound. */
+static inline bool same_box(const bvh_box *a, const bvh_box *b)
+{
+    for (int axis = 0; axis < 3; axis++)
+        if (a->min[axis] != b->min[axis] || a->max[axis] != b->max[axis])
+            return false;
+    return true;
+}
+
+/* Whether inner lies inside outer (an empty inner, min > max, lies inside anything). */
+static inline bool box_contains(const bvh_box *outer, const bvh_box *inner)
+{
+    for (int axis = 0; axis < 3; axis++)
+        if (inner->min[axis] < outer->min[axis] || inner->max[axis] > outer->max[axis])
+            return false;
+    return true;
 }
 
 /* ---- scratch directories ----------------------------------------------------------------- */

@@ -21,26 +21,6 @@
 #include "packed_layout.h"
 #include "support.h"
 
-/* ---- deterministic random numbers (splitmix64) ---- */
-
-typedef struct random_source {
-    uint64_t state;
-} random_source;
-
-/* Returns a float in [low, high). */
-static float random_float(random_source *source, float low, float high)
-{
-    float unit = (float)(splitmix64_next(&source->state) >> 40) * 0x1.0p-24f;
-    /* Not low + (high - low) * unit: high - low overflows for ranges near FLT_MAX. */
-    return low * (1 - unit) + high * unit;
-}
-
-/* Returns an integer in [0, bound). */
-static uint32_t random_below(random_source *source, uint32_t bound)
-{
-    return (uint32_t)(splitmix64_next(&source->state) % bound);
-}
-
 /* ---- boxes ---- */
 
 static bvh_box make_box(float min_x, float min_y, float min_z, float max_x, float max_y, float max_z)
@@ -56,22 +36,6 @@ static bvh_box union_of(const bvh_box *a, const bvh_box *b)
         result.max[axis] = fmaxf(a->max[axis], b->max[axis]);
     }
     return result;
-}
-
-static bool same_box(const bvh_box *a, const bvh_box *b)
-{
-    for (int axis = 0; axis < 3; axis++)
-        if (a->min[axis] != b->min[axis] || a->max[axis] != b->max[axis])
-            return false;
-    return true;
-}
-
-static bool box_contains(const bvh_box *outer, const bvh_box *inner)
-{
-    for (int axis = 0; axis < 3; axis++)
-        if (inner->min[axis] < outer->min[axis] || inner->max[axis] > outer->max[axis])
-            return false;
-    return true;
 }
 
 static double surface_area(const bvh_box *box)

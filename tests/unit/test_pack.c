@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "pack.h"
+#include "tracer_interface.h"
 #include "scene_parse.h"
 #include "packed_traverse.h"
 #include "support.h"
@@ -64,7 +65,12 @@ static void header_and_materials_round_trip(void **state)
         assert_true((info & PRIMITIVE_INFO_MATERIAL_MASK) < 4);
         assert_true(packed_float(&packed, packed.primitive_offset + slot, 3) > 0);
     }
-    assert_int_equal(packed.texel_count, packed.light_offset + packed.light_count * PACKED_LIGHT_STRIDE);
+    /* More than LIGHT_LOCAL_CHOICE_MAX lights: the light tree's 2n - 1 nodes follow them. */
+    assert_true(packed.light_count > LIGHT_LOCAL_CHOICE_MAX);
+    assert_int_equal(packed.light_tree_offset, packed.light_offset + packed.light_count * PACKED_LIGHT_STRIDE);
+    assert_int_equal(packed_uint(&packed, 6, 1), packed.light_tree_offset);
+    assert_int_equal(packed.texel_count,
+                     packed.light_tree_offset + (2 * packed.light_count - 1) * PACKED_LIGHT_TREE_NODE_STRIDE);
     /* The default material is grey Lambertian. */
     uint32_t default_base = packed.material_offset + 4 * PACKED_MATERIAL_STRIDE;
     assert_int_equal(packed_uint(&packed, default_base, 0), MATERIAL_LAMBERTIAN);

@@ -1,6 +1,7 @@
 /* test_pack_lights.c: the packed light records (pack.h, core/packed_layout.h "lights"):
- * emissive world spheres become lights with power-proportional choice probabilities, and
- * the emitters of placed objects become lights too. */
+ * emissive world spheres become lights with power-proportional choice probabilities, the
+ * emitters of placed objects become lights too, and scenes of more than
+ * LIGHT_LOCAL_CHOICE_MAX lights get a light tree whose trails lead to each light. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -16,6 +17,7 @@
 #include "packed_traverse.h"
 #include "support.h"
 #include "pack_test_scenes.h"
+#include "tracer_interface.h"
 
 /* Every emissive world sphere is a light, knows its light index, and the selection
  * probabilities (cdf steps) are proportional to emission luminance x area. */
@@ -52,6 +54,54 @@ static void emissive_spheres_become_lights(void **state)
         previous = cdf;
     }
     assert_float_equal(previous, 1.0, 1e-6);
+    packed_scene_free(&packed);
+    scene_free(&s);
+}
+
+/* A scene of many lights gets the light tree section (packed_layout.h "light tree"): the
+ * header names it, each light's trail, followed through the packed nodes from the root as
+ * the shader follows it (glsl/lights.glsl walk_light_tree), ends at that light's leaf, and
+ * the root's intensity is the lights' (luminance x area / 4 for spheres). A scene of at
+ * most LIGHT_LOCAL_CHOICE_MAX lights has none, and no trails. */
+static void many_lights_get_a_light_tree(void **state)
+{
+    (void)state;
+    scene s;
+    random_scene(&s, 60, 40);
+    packed_scene packed;
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_true(packed.light_count > LIGHT_LOCAL_CHOICE_MAX);
+    assert_int_not_equal(packed.light_tree_offset, PACKED_NONE);
+    assert_int_equal(packed_uint(&packed, PACKED_HEADER_LIGHT_TREE_OFFSET / 4, PACKED_HEADER_LIGHT_TREE_OFFSET % 4),
+                     packed.light_tree_offset);
+    assert_true(packed.light_tree_offset + (2 * packed.light_count - 1) * PACKED_LIGHT_TREE_NODE_STRIDE
+                <= packed.texel_count);
+    double intensity = 0;
+    for (uint32_t l = 0; l < packed.light_count; l++) {
+        uint32_t base = packed.light_offset + l * PACKED_LIGHT_STRIDE;
+        intensity += packed_float(&packed, base + 2, 3) * 0.25;   /* luminance x area, a sphere's quarter */
+        uint32_t trail = packed_uint(&packed, base + 4, 1);
+        uint32_t child = packed_uint(&packed, packed.light_tree_offset + 2, 2);
+        int level = 0;
+        for (; level < LIGHT_TREE_MAX_DEPTH && !(child & LIGHT_TREE_LEAF); level++) {
+            uint32_t taken = child + ((trail >> level) & 1u);
+            child = packed_uint(&packed, packed.light_tree_offset + taken * PACKED_LIGHT_TREE_NODE_STRIDE + 2, 2);
+        }
+        assert_true(child & LIGHT_TREE_LEAF);
+        assert_int_equal(child & ~LIGHT_TREE_LEAF, l);
+        assert_true(level <= (int)packed.light_tree_depth);
+    }
+    assert_float_equal(packed_float(&packed, packed.light_tree_offset, 3), intensity, 1e-4 * intensity);
+    assert_float_equal(packed_float(&packed, packed.light_tree_offset + 1, 3), 0, 0);   /* no sun, no sky */
+    packed_scene_free(&packed);
+    scene_free(&s);
+
+    random_scene(&s, 6, 40);
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_true(packed.light_count <= LIGHT_LOCAL_CHOICE_MAX);
+    assert_int_equal(packed.light_tree_offset, PACKED_NONE);
+    for (uint32_t l = 0; l < packed.light_count; l++)
+        assert_int_equal(packed_uint(&packed, packed.light_offset + l * PACKED_LIGHT_STRIDE + 4, 1), 0);
     packed_scene_free(&packed);
     scene_free(&s);
 }
@@ -159,6 +209,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(emissive_spheres_become_lights),
         cmocka_unit_test(placed_emitters_become_lights),
+        cmocka_unit_test(many_lights_get_a_light_tree),
     };
     return cmocka_run_group_tests_name("pack_lights", tests, NULL, NULL);
 }
