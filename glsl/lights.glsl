@@ -80,8 +80,10 @@ bool chooses_by_tree() { return HAS_LIGHT_TREE && light_tree_offset != NONE; }
 // to p (two-sided: emitters shine from both faces): the angle to the cone's axis less the
 // cone's half-angle and the half-angle the box's bounding sphere covers (pbrt-v4's
 // LightBounds::Importance, without the receiver's cosine, which MIS could not recompute
-// at an emitter hit from the vertex's position alone). It is zero only where no light
-// below the node can shine (in the plane of flat lights that all lie in it).
+// at an emitter hit from the vertex's position alone). The angle is taken a thousandth of
+// a radian smaller than that: the axis is stored octahedral (about 1e-4 rad off), and so
+// the cosine is never zero, nor the estimate of a node whose lights have any intensity:
+// every light that can light a point keeps a chance.
 float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p)
 {
     float intensity = uintBitsToFloat(t0.w);
@@ -96,7 +98,7 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p)
         float distance = sqrt(distance_squared);
         float cos_axis = min(abs(dot(decode_normal(t2.x), to_p)) / max(distance, 1e-30), 1.0);
         float sin_box = distance_squared > radius_squared ? sqrt(radius_squared / distance_squared) : 1.0;
-        facing = cos(max(acos(cos_axis) - acos(min(cos_spread, 1.0)) - asin(sin_box), 0.0));
+        facing = cos(max(acos(cos_axis) - acos(min(cos_spread, 1.0)) - asin(sin_box) - 0.001, 0.0));
     }
     // A node of infinite lights alone has an empty box (infinite corners): no finite part.
     float finite = intensity > 0.0 ? intensity * facing / max(max(distance_squared, radius_squared), 1e-30) : 0.0;
