@@ -83,6 +83,8 @@ static void print_help(FILE *stream)
             "      --tonemap OP       for 8-bit outputs: clamp (default), reinhard or aces\n"
             "      --light-sampling on|off  sample lights at diffuse hits (next-event\n"
             "                         estimation with MIS; default on): less noise, same image\n"
+            "      --light-tree on|off  with more than 8 lights, choose one per point by the\n"
+            "                         light tree (default on) or by power: the same image\n"
             "      --sampler KIND     sobol (default: stratified, Owen-scrambled Sobol points) or\n"
             "                         independent (hashed random numbers): the same image,\n"
             "                         more noise; for comparisons\n"
@@ -110,7 +112,7 @@ static void print_help(FILE *stream)
 enum {
     OPTION_SIZE = 256, OPTION_MAX_DEPTH, OPTION_SEED, OPTION_EXPOSURE, OPTION_PASS_BUDGET, OPTION_DEVICE,
     OPTION_ROULETTE_DEPTH, OPTION_FRAMES, OPTION_SWEEP, OPTION_DISPLAY, OPTION_FPS, OPTION_SAMPLES, OPTION_CROP, OPTION_TILE, OPTION_SHARD,
-    OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_INTEGRATOR, OPTION_AOVS,
+    OPTION_SHARD_BY, OPTION_CHECKPOINT, OPTION_RESUME, OPTION_LIGHT_SAMPLING, OPTION_LIGHT_TREE, OPTION_INTEGRATOR, OPTION_AOVS,
     OPTION_LIGHT_GROUPS, OPTION_VARIANCE, OPTION_DENOISE, OPTION_BLUR, OPTION_TONEMAP, OPTION_FULL_TRACER, OPTION_SAMPLER,
     OPTION_CAMERA, OPTION_NOISE_THRESHOLD, OPTION_MIN_SPP, OPTION_TIME_LIMIT, OPTION_SAMPLES_MAP,
     OPTION_PROGRESS, OPTION_PROGRESS_INTERVAL, OPTION_STATS_JSON, OPTION_THREADS, OPTION_SKIP_EXISTING,
@@ -325,6 +327,11 @@ static const char *take_value(int option, const char *value, render_job *job)
             return "--light-sampling wants on or off";
         job->tracer.no_light_sampling = word == 1;
         return NULL;
+    case OPTION_LIGHT_TREE:
+        if (!parse_choice(value, switches, 2, &word))
+            return "--light-tree wants on or off";
+        job->tracer.no_light_tree = word == 1;
+        return NULL;
     case OPTION_SAMPLER:
         if (!parse_choice(value, samplers, 2, &word))
             return "--sampler wants sobol or independent";
@@ -500,6 +507,7 @@ int render_arguments_parse_to(int argc, char **argv, render_arguments *arguments
         {"resume", required_argument, NULL, OPTION_RESUME},
         {"camera", required_argument, NULL, OPTION_CAMERA},
         {"light-sampling", required_argument, NULL, OPTION_LIGHT_SAMPLING},
+        {"light-tree", required_argument, NULL, OPTION_LIGHT_TREE},
         {"sampler", required_argument, NULL, OPTION_SAMPLER},
         {"full-tracer", no_argument, NULL, OPTION_FULL_TRACER},
         {"integrator", required_argument, NULL, OPTION_INTEGRATOR},

@@ -152,7 +152,7 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_ENVIRONMENT_LIGHT;
     if (packed->light_count <= 1)
         omitted |= GPU_OMIT_MANY_LIGHTS;
-    if (packed->light_tree_offset == PACKED_NONE || (omitted & GPU_OMIT_DIRECT_LIGHT))
+    if (packed->light_tree_offset == PACKED_NONE || (omitted & GPU_OMIT_DIRECT_LIGHT) || options->no_light_tree)
         omitted |= GPU_OMIT_LIGHT_TREE;
     uint32_t materials = contents->material_types;
     if (!(materials & 1u << MATERIAL_LAMBERTIAN))

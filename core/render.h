@@ -90,6 +90,8 @@ typedef struct render_options {
     uint32_t pass_work_budget;
     double target_pass_seconds;
     bool no_light_sampling;      /* true: BSDF sampling only (to compare the estimators) */
+    bool no_light_tree;          /* true: scenes of more than LIGHT_LOCAL_CHOICE_MAX lights
+                                  * choose one by power, not by walking the light tree */
     bool full_tracer;            /* true: compile every feature into the tracer, even those
                                   * the scene cannot reach (gpu.h GPU_OMIT_*); for checking
                                   * that leaving them out changes no image */

@@ -37,7 +37,11 @@ uint64_t render_job_options_hash(const render_job *job, const render_job_image *
     double reals[] = {adaptive ? tracer->noise_threshold : 0.0, job->blur_sigma > 0 ? job->blur_sigma : 0.0,
                       job->exposure};
     uint64_t hash = hash_bytes(HASH_START, numbers, sizeof numbers);
-    return hash_bytes(hash, reals, sizeof reals);
+    hash = hash_bytes(hash, reals, sizeof reals);
+    /* Only when set, so that every other render keeps the hash it had before the option. */
+    if (tracer->no_light_tree)
+        hash = hash_bytes(hash, "no light tree", 13);
+    return hash;
 }
 
 /* The metadata of a file that decides what to do with it ("" where a key is missing). */

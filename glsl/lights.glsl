@@ -98,7 +98,21 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p)
         float distance = sqrt(distance_squared);
         float cos_axis = min(abs(dot(decode_normal(t2.x), to_p)) / max(distance, 1e-30), 1.0);
         float sin_box = distance_squared > radius_squared ? sqrt(radius_squared / distance_squared) : 1.0;
-        facing = cos(max(acos(cos_axis) - acos(min(cos_spread, 1.0)) - asin(sin_box) - 0.001, 0.0));
+        // cos(max(axis angle - spread - box angle - margin, 0)) by the angle-difference
+        // identities, without acos, asin and cos (each a long polynomial on llvmpipe, in a
+        // loop that runs them for both children at every level); an angle that goes below
+        // zero on the way gives 1.
+        float sin_axis = sqrt(max(1.0 - cos_axis * cos_axis, 0.0));
+        float cos_cone = min(cos_spread, 1.0), sin_cone = sqrt(max(1.0 - cos_cone * cos_cone, 0.0));
+        float cos_box = sqrt(max(1.0 - sin_box * sin_box, 0.0));
+        const float COS_MARGIN = 0.9999995, SIN_MARGIN = 0.001;   // of a thousandth of a radian
+        // axis angle - spread
+        float cos_a = cos_axis * cos_cone + sin_axis * sin_cone, sin_a = sin_axis * cos_cone - cos_axis * sin_cone;
+        // ... - box angle
+        float cos_b = cos_a * cos_box + sin_a * sin_box, sin_b = sin_a * cos_box - cos_a * sin_box;
+        // ... - margin
+        float cos_c = cos_b * COS_MARGIN + sin_b * SIN_MARGIN, sin_c = sin_b * COS_MARGIN - cos_b * SIN_MARGIN;
+        facing = sin_a <= 0.0 || sin_b <= 0.0 || sin_c <= 0.0 ? 1.0 : cos_c;
     }
     // A node of infinite lights alone has an empty box (infinite corners): no finite part.
     float finite = intensity > 0.0 ? intensity * facing / max(max(distance_squared, radius_squared), 1e-30) : 0.0;

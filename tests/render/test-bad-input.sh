@@ -167,6 +167,7 @@ bad_structure_and_command_lines() {
     expect_usage "--spp without its value" "requires an argument" render "$scene" -o "$work/a.png" --spp
     expect_usage "-o without its value" "requires an argument" render "$scene" -o
     expect_usage "-D without its value" "requires an argument" render "$scene" -o "$work/a.png" -D
+    expect_usage "--light-tree maybe" "--light-tree wants on or off" render "$scene" -o "$work/a.png" --light-tree maybe
     expect_usage "--size without its value" "requires an argument" render "$scene" -o "$work/a.png" --size
     expect_usage "--spp 2^40" "spp" render "$scene" -o "$work/a.png" --spp 1099511627776
     expect_usage "--size 100000x100000" "size" render "$scene" -o "$work/a.png" --size 100000x100000
