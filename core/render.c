@@ -471,8 +471,9 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     if (options->resume != NULL && options->resume_scene_hash != 0 && options->resume_scene_hash != hash) {
         packed_scene_free(&packed);
         return rt_error_set(error, RT_ERROR_INPUT,
-                            "RENDER: the partial render was made from another scene, camera, size or depth "
-                            "(scene hash %016llx, this render %016llx)",
+                            "RENDER: the partial render was made from another scene, camera, size or depth, "
+                            "or by an rtspheres that packs scenes another way (scene hash %016llx, this "
+                            "render %016llx)",
                             (unsigned long long)options->resume_scene_hash, (unsigned long long)hash);
     }
 
