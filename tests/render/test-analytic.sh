@@ -204,8 +204,8 @@ done
 # the point (glsl/lights.glsl, choose_light_at) and samples rectangles by solid angle, a
 # sheared parallelogram and a triangle by area, a sphere by its cone; BSDF sampling alone
 # must converge to the same image, in every quarter.
-cat >"$scratch/area-lights.txt" <<SCENE
-render size 48 27 spp 256 depth 3 seed 1
+# The room both area-light scenes below share: a floor, a box, two emissive materials.
+area_room="render size 48 27 spp 256 depth 3 seed 1
 camera from 0 2.5 6 at 0 0.5 0 up 0 1 0 fov 45
 sky constant 0 0 0
 material floor lambertian 0.6 0.6 0.6
@@ -213,7 +213,9 @@ material wall lambertian 0.3 0.5 0.7
 material warm emissive 1 0.8 0.6 strength 3
 material cool emissive 0.6 0.8 1 strength 6
 quad -6 0 -6  12 0 0  0 0 12 floor
-box -0.6 0 -0.6  0.6 1.2 0.6 wall
+box -0.6 0 -0.6  0.6 1.2 0.6 wall"
+cat >"$scratch/area-lights.txt" <<SCENE
+$area_room
 quad -3 2 -1  1.5 0 0  0 0 1 warm
 quad 1.5 1.5 0  0.8 0 0  0.3 0.2 0.9 cool
 triangle 0 3 -2  1 3 -2  0 3 -1 warm
@@ -289,15 +291,7 @@ done
 # trail must agree, or light sampling and BSDF sampling alone converge to different images.
 {
     cat <<SCENE
-render size 48 27 spp 256 depth 3 seed 1
-camera from 0 2.5 6 at 0 0.5 0 up 0 1 0 fov 45
-sky constant 0 0 0
-material floor lambertian 0.6 0.6 0.6
-material wall lambertian 0.3 0.5 0.7
-material warm emissive 1 0.8 0.6 strength 3
-material cool emissive 0.6 0.8 1 strength 6
-quad -6 0 -6  12 0 0  0 0 12 floor
-box -0.6 0 -0.6  0.6 1.2 0.6 wall
+$area_room
 triangle 0 3 -2  1 3 -2  0 3 -1 warm
 triangle -1 2 -3  -1 3 -3  -2 2 -3 cool
 sphere -2 0.5 1.5 0.25 cool
