@@ -6,12 +6,14 @@
 // (docs/performance.md). Whitted walks its shadow rays here (gathers_in_place).
 
 // How the light is gathered (LightQuery.model):
-//   DIRECT_MIS (path tracing): one light chosen by power, one point on it, weighted
-//     against BSDF sampling (material_pdf, or the phase function's density in a medium)
-//     by the power heuristic; delta lights (point, spot, sun) unweighted.
-//   DIRECT_PHONG (Whitted): ambient plus, for every light (one chosen by power when there
-//     are more than WHITTED_ALL_LIGHTS), the Phong model of glsl/material_phong.glsl; area
-//     lights are lit from a random point each sample, which averages to soft shadows.
+//   DIRECT_MIS (path tracing): one light chosen for the point (glsl/lights.glsl: by its
+//     estimated irradiance there, by the light tree, or by power), one point on it,
+//     weighted against BSDF sampling (material_pdf, or the phase function's density in a
+//     medium) by the power heuristic; delta lights (point, spot, sun) unweighted.
+//   DIRECT_PHONG (Whitted): ambient plus, for every light (one chosen when there are more
+//     than WHITTED_ALL_LIGHTS: by the light tree, else by power), the Phong model of
+//     glsl/material_phong.glsl; area lights are lit from a random point each sample, which
+//     averages to soft shadows.
 const int DIRECT_MIS = 0;
 const int DIRECT_PHONG = 1;
 const uint WHITTED_ALL_LIGHTS = 16u;
@@ -135,7 +137,7 @@ PendingShadow next_shadow_ray(inout LightQuery query, inout float light_total)
                           : fract(random4(query.bounce, 6u + (k & 1u)) + float(k >> 1u) * 0.6180339887);
     float choice = 1.0;
     uint light = k;
-    if (!phong_model)
+    if (!phong_model || (choose && chooses_by_tree()))
         light = choose_light_at(u.x, query.position, choice, light_total);
     else if (choose) {
         light = choose_light(u.x);

@@ -51,6 +51,7 @@ check mesh-light tests/render/scenes/mesh-light.txt
 # Seventy lights (quads and points): the light tree walked, the per-point choice of 2 to 8
 # lights left out.
 check many-lights scenes/many-lights.txt
+check many-lights-whitted scenes/many-lights.txt --integrator whitted
 # Textures (image, checker, noise, normal maps) and an image sky.
 check textures scenes/textures.txt
 # Moving spheres, instances, a volume, fog, textures, emitters, a black sky.
