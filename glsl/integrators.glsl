@@ -151,12 +151,13 @@ void integrate(inout PixelState s)
                 if (surface.volume_boundary) {
                     cross_volume_boundary(s, surface, frame.front_face, hit.t);
                 } else {
-                    s.since_vertex = 0.0;
                     Material material = surface_material(surface, frame);
                     // An emitter's light joins the path's; an emissive material then absorbs
-                    // (its sample ends the path), a pbr one scatters on.
+                    // (its sample ends the path), a pbr one scatters on. Its MIS weight
+                    // wants since_vertex up to here: this hit is the next vertex.
                     if (material_emits(material))
                         hit_emitter(s, hit, surface, material);
+                    s.since_vertex = 0.0;
                     BsdfSample sampled = material_sample(material, frame, s.direction, u);
                     BsdfSample bsdf = integrator_shade(s, material, frame, surface.position, sampled, query);
                     next_direction = bsdf.direction;

@@ -124,9 +124,8 @@ void cross_volume_boundary(inout PixelState s, Surface surface, bool front_face,
 // for a pbr emitter, sends it on.
 void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material)
 {
-    // MIS wants the path's last scattering vertex, origin - since_vertex * direction. But
-    // since_vertex is 0 here (a surface hit resets it first), so after volume boundaries
-    // this is the last boundary instead. Kept as it was: fixing it changes images.
+    // MIS wants the path's last scattering vertex, where light sampling chose: the ray
+    // went straight on from it through any volume boundaries since.
     vec3 vertex = s.origin - s.since_vertex * s.direction;
     float weight = emitter_mis_weight(hit, s.previous_pdf, s.light_total, vertex, surface.position, surface.geometric);
     vec3 emitted = s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
