@@ -123,10 +123,10 @@ void begin_direct_light(inout LightQuery query, vec3 view, uint media, float tim
 
 // Samples the query's next light: the shadow ray towards it and what it adds to the
 // path's radiance if nothing is in the way (pending false when the light gives nothing:
-// chosen with probability 0, out of reach, or below the surface). light_total receives
+// chosen with probability 0, out of reach, or below the surface). choice_memo receives
 // what MIS at the path's next emitter hit needs of the light choice here
 // (glsl/lights.glsl).
-PendingShadow next_shadow_ray(inout LightQuery query, inout float light_total)
+PendingShadow next_shadow_ray(inout LightQuery query, inout float choice_memo)
 {
     PendingShadow shadow = no_pending_shadow();
     uint k = query.next_light;
@@ -138,7 +138,8 @@ PendingShadow next_shadow_ray(inout LightQuery query, inout float light_total)
     float choice = 1.0;
     uint light = k;
     if (!phong_model || (choose && chooses_by_tree()))
-        light = choose_light_at(u.x, query.position, choice, light_total);
+        light = choose_light_at(u.x, query.position, query.in_medium ? vec3(0.0) : query.frame.normal, choice,
+                                choice_memo);
     else if (choose) {
         light = choose_light(u.x);
         choice = light_power_probability(light);
@@ -202,11 +203,11 @@ bool gathers_in_place() { return tracer_integrator() == INTEGRATOR_WHITTED; }
 // Takes all the query's light samples (begin_direct_light counted them), walking each
 // shadow ray to its light through the volume boundaries on its way, and adds what gets
 // through to radiance.
-void direct_light_in_place(inout LightQuery query, inout float light_total, inout vec3 radiance)
+void direct_light_in_place(inout LightQuery query, inout float choice_memo, inout vec3 radiance)
 {
     while (direct_light_pending(query)) {
         work++;
-        PendingShadow shadow = next_shadow_ray(query, light_total);
+        PendingShadow shadow = next_shadow_ray(query, choice_memo);
         while (shadow.pending) {
             work++;
             bool blocked;

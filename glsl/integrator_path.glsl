@@ -10,7 +10,7 @@ bool path_samples_lights() { return light_sampling != 0; }
 // an environment sky.
 float path_sky_weight(PixelState s)
 {
-    return environment_mis_weight(s.previous_pdf, s.light_total, s.origin - s.since_vertex * s.direction, s.direction);
+    return environment_mis_weight(s.previous_pdf, s.choice_memo, s.origin - s.since_vertex * s.direction, s.direction);
 }
 
 // At a surface the path goes on as the material samples it, and gathers direct light

@@ -175,9 +175,9 @@ void integrate(inout PixelState s)
         if (HAS_DIRECT_LIGHT && shade && query.wanted) {
             begin_direct_light(query, -incoming, s.media, time, segment_bounce, s.radiance);
             if (gathers_in_place())
-                direct_light_in_place(query, s.light_total, s.radiance);
+                direct_light_in_place(query, s.choice_memo, s.radiance);
             else if (direct_light_pending(query))   // one light sample: the shadow ray for the next iteration
-                shadow = next_shadow_ray(query, s.light_total);
+                shadow = next_shadow_ray(query, s.choice_memo);
         }
         if (path_done) {
             s.bounce = 0u;

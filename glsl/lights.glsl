@@ -12,10 +12,13 @@
 // with its power-based chance (POWER_SHARE of it) so that every light that could light
 // the point keeps a chance. The estimate leaves out the receiver's orientation, so the
 // probability MIS needs when a path hits an emitter depends only on the position of the
-// vertex it came from. By the light tree (choose_light_in_tree, light_tree_probability),
-// for scenes of more lights, where a loop over all of them would cost more than it saves:
-// a walk from the root that takes each child in proportion to an estimate of what its
-// lights give the point (tree_node_importance), as pbrt-v4's BVH light sampler does.
+// vertex it came from and the importances' total there. By the light tree
+// (walk_light_tree), for scenes of more lights, where a loop over all of them would cost
+// more than it saves: a walk from the root that takes each child in proportion to an
+// estimate of what its lights give the point (tree_node_importance), as pbrt-v4's BVH
+// light sampler does, the receiver's normal included. What the probability at an emitter
+// hit needs besides the vertex's position (the total, or the tree's normal) is the choice
+// memo, which the path carries to its next hit (choose_light_at, light_choice_probability).
 const uint LOCAL_CHOICE_MAX = uint(LIGHT_LOCAL_CHOICE_MAX);
 const float POWER_SHARE = 0.25;
 const vec3 LUMINANCE = vec3(0.2126, 0.7152, 0.0722);   // Rec. 709, as the packer's powers
@@ -68,6 +71,32 @@ float light_importance(uint light, vec3 p)
 
 // ---- the light tree (core/packed_layout.h "light tree", built by core/light_tree.c)
 
+// A receiver's normal as a float that the pass state keeps exactly: octahedral, 12 bits a
+// coordinate, 1 + the 24-bit code (an integer a float holds exactly); 0: no normal.
+float encode_receiver(vec3 n)
+{
+    if (n == vec3(0.0))
+        return 0.0;
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 f = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    uvec2 q = uvec2(clamp(round((f * 0.5 + 0.5) * 4095.0), 0.0, 4095.0));
+    return float(1u + (q.x << 12u | q.y));
+}
+
+// The normal encode_receiver() kept (unit length), or 0.
+vec3 decode_receiver(float code)
+{
+    if (code <= 0.0)
+        return vec3(0.0);
+    uint bits = uint(code) - 1u;
+    vec2 f = vec2(float(bits >> 12u), float(bits & 4095u)) / 4095.0 * 2.0 - 1.0;
+    vec3 n = vec3(f, 1.0 - abs(f.x) - abs(f.y));
+    float t = max(-n.z, 0.0);
+    n.x += n.x >= 0.0 ? -t : t;
+    n.y += n.y >= 0.0 ? -t : t;
+    return normalize(n);
+}
+
 // Whether lights are chosen by walking the light tree in this scene (more than
 // LOCAL_CHOICE_MAX lights; the variant leaves the walk out otherwise).
 bool chooses_by_tree() { return HAS_LIGHT_TREE && light_tree_offset != NONE; }
@@ -76,15 +105,20 @@ bool chooses_by_tree() { return HAS_LIGHT_TREE && light_tree_offset != NONE; }
 // units of light_importance: the infinite lights' irradiance, plus the finite lights'
 // intensity over the squared distance to the centre of their box (at least the box's
 // half-diagonal squared, so that a point inside or near the box does not blow it up),
-// times the largest cosine any of their normals can make with a direction from the box
-// to p (two-sided: emitters shine from both faces): the angle to the cone's axis less the
-// cone's half-angle and the half-angle the box's bounding sphere covers (pbrt-v4's
-// LightBounds::Importance, without the receiver's cosine, which MIS could not recompute
-// at an emitter hit from the vertex's position alone). The angle is taken a thousandth of
-// a radian smaller than that: the axis is stored octahedral (about 1e-4 rad off), and so
-// the cosine is never zero, nor the estimate of a node whose lights have any intensity:
-// every light that can light a point keeps a chance.
-float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p)
+// times two bounds of pbrt-v4's LightBounds::Importance:
+// - the emitters' facing: the largest cosine any of their normals can make with a
+//   direction from the box to p (two-sided: emitters shine from both faces), the angle to
+//   the cone's axis less the cone's half-angle and the half-angle the box's bounding
+//   sphere covers, taken a thousandth of a radian smaller still (the axis is stored
+//   octahedral, about 1e-4 rad off), so never zero;
+// - the receiver's: with a surface normal n (facing the side light is gathered on; 0 for
+//   a point in a medium, which leaves it out), the largest cosine n can make with a
+//   direction from p to the box, the angle less the box's and a hundredth of a radian
+//   (more than encode_receiver's rounding of n), and 0 past a right angle: one-sided, as
+//   direct light is gathered from above the surface only (glsl/direct_light.glsl), so a
+//   box wholly below the surface gets nothing, and every light that can light the point
+//   keeps a chance.
+float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
 {
     float intensity = uintBitsToFloat(t0.w);
     vec3 low = uintBitsToFloat(t0.xyz), high = uintBitsToFloat(t1.xyz);
@@ -93,19 +127,19 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p)
     float radius_squared = dot(half_size, half_size);
     float distance_squared = dot(to_p, to_p);
     float cos_spread = uintBitsToFloat(t2.y);
+    float distance = sqrt(distance_squared);
+    float sin_box = distance_squared > radius_squared ? sqrt(radius_squared / distance_squared) : 1.0;
+    float cos_box = sqrt(max(1.0 - sin_box * sin_box, 0.0));
+    const float COS_MARGIN = 0.9999995, SIN_MARGIN = 0.001;   // of a thousandth of a radian
     float facing = 1.0;
     if (cos_spread > -1.0) {
-        float distance = sqrt(distance_squared);
         float cos_axis = min(abs(dot(decode_normal(t2.x), to_p)) / max(distance, 1e-30), 1.0);
-        float sin_box = distance_squared > radius_squared ? sqrt(radius_squared / distance_squared) : 1.0;
         // cos(max(axis angle - spread - box angle - margin, 0)) by the angle-difference
         // identities, without acos, asin and cos (each a long polynomial on llvmpipe, in a
         // loop that runs them for both children at every level); an angle that goes below
         // zero on the way gives 1.
         float sin_axis = sqrt(max(1.0 - cos_axis * cos_axis, 0.0));
         float cos_cone = min(cos_spread, 1.0), sin_cone = sqrt(max(1.0 - cos_cone * cos_cone, 0.0));
-        float cos_box = sqrt(max(1.0 - sin_box * sin_box, 0.0));
-        const float COS_MARGIN = 0.9999995, SIN_MARGIN = 0.001;   // of a thousandth of a radian
         // axis angle - spread
         float cos_a = cos_axis * cos_cone + sin_axis * sin_cone, sin_a = sin_axis * cos_cone - cos_axis * sin_cone;
         // ... - box angle
@@ -114,18 +148,30 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p)
         float cos_c = cos_b * COS_MARGIN + sin_b * SIN_MARGIN, sin_c = sin_b * COS_MARGIN - cos_b * SIN_MARGIN;
         facing = sin_a <= 0.0 || sin_b <= 0.0 || sin_c <= 0.0 ? 1.0 : cos_c;
     }
+    if (n != vec3(0.0)) {
+        // cos(max(receiver angle - box angle - margin, 0)), 0 past a right angle; the
+        // receiver angle runs to pi, so "below zero" is told by the cosines.
+        const float COS_RECEIVER_MARGIN = 0.99995, SIN_RECEIVER_MARGIN = 0.0099998;   // 0.01 rad
+        float cos_i = clamp(-dot(n, to_p) / max(distance, 1e-30), -1.0, 1.0);
+        float sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
+        // receiver angle - box angle
+        float cos_d = cos_i * cos_box + sin_i * sin_box, sin_d = sin_i * cos_box - cos_i * sin_box;
+        // ... - margin
+        float cos_e = cos_d * COS_RECEIVER_MARGIN + sin_d * SIN_RECEIVER_MARGIN;
+        facing *= cos_i >= cos_box ? 1.0 : max(cos_e, 0.0);
+    }
     // A node of infinite lights alone has an empty box (infinite corners): no finite part.
     float finite = intensity > 0.0 ? intensity * facing / max(max(distance_squared, radius_squared), 1e-30) : 0.0;
     return uintBitsToFloat(t1.w) + finite;
 }
 
-// Walks the light tree from the root to a leaf for point p and returns its light; chance
-// receives the probability of that walk. Each interior node's children are estimated
+// Walks the light tree from the root to a leaf for point p with normal n (0: none) and
+// returns its light; chance receives the probability of that walk. Each interior node's children are estimated
 // (tree_node_importance) and the second is taken with its share of the two (half when
 // both are zero): by u (uniform in [0, 1), rescaled at each level to what is left of it)
 // or, when by_trail, by the bits of trail (packed_layout.h, lights: the walk to one
 // light's leaf), which gives the probability that u would have taken it.
-uint walk_light_tree(vec3 p, bool by_trail, uint trail, float u, out float chance)
+uint walk_light_tree(vec3 p, vec3 n, bool by_trail, uint trail, float u, out float chance)
 {
     chance = 1.0;
     uint child = packed_texel(light_tree_offset + 2u).z;   // the root's
@@ -134,8 +180,8 @@ uint walk_light_tree(vec3 p, bool by_trail, uint trail, float u, out float chanc
         work++;
         uint base = light_tree_offset + child * uint(PACKED_LIGHT_TREE_NODE_STRIDE);
         uvec4 first2 = packed_texel(base + 2u), second2 = packed_texel(base + 5u);
-        float first_importance = tree_node_importance(packed_texel(base), packed_texel(base + 1u), first2, p);
-        float second_importance = tree_node_importance(packed_texel(base + 3u), packed_texel(base + 4u), second2, p);
+        float first_importance = tree_node_importance(packed_texel(base), packed_texel(base + 1u), first2, p, n);
+        float second_importance = tree_node_importance(packed_texel(base + 3u), packed_texel(base + 4u), second2, p, n);
         float both = first_importance + second_importance;
         float second_share = both > 0.0 ? second_importance / both : 0.5;
         float first_share = 1.0 - second_share;
@@ -162,28 +208,33 @@ float mixed_probability(uint light, float importance, float total)
     return total > 0.0 ? mix(importance / total, power, POWER_SHARE) : power;
 }
 
-// The probability that choose_light_at() picks light for point p, where it found the
-// importances' total (its out parameter).
-float light_choice_probability(uint light, vec3 p, float total)
+// The probability that choose_light_at() picks light for point p, where it left memo.
+float light_choice_probability(uint light, vec3 p, float memo)
 {
     if (chooses_by_tree()) {
         float chance;
-        walk_light_tree(p, true, packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE) + 4u).y, 0.0, chance);
+        uint trail = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE) + 4u).y;
+        walk_light_tree(p, decode_receiver(memo), true, trail, 0.0, chance);
         return chance;
     }
     if (!chooses_by_point())
         return light_power_probability(light);
-    return mixed_probability(light, light_importance(light, p), total);
+    return mixed_probability(light, light_importance(light, p), memo);
 }
 
-// Picks a light for point p from u uniform in [0, 1) (see above); probability receives the
-// chance it had, total the sum of all lights' importance at p (0 when chosen by power),
-// which light_choice_probability() needs for the same point.
-uint choose_light_at(float u, vec3 p, out float probability, out float total)
+// Picks a light for point p, on a surface of normal n facing the side light is gathered on
+// (0: a point in a medium), from u uniform in [0, 1) (see above); probability receives the
+// chance it had, memo what light_choice_probability() needs to find that chance again for
+// the same point: the tree's normal as encode_receiver() keeps it (the walk uses that
+// rounded normal, so both walks agree), the sum of all lights' importance at p (chosen by
+// the point), or 0 (by power).
+uint choose_light_at(float u, vec3 p, vec3 n, out float probability, out float memo)
 {
-    total = 0.0;
-    if (chooses_by_tree())
-        return walk_light_tree(p, false, 0u, u, probability);
+    memo = 0.0;
+    if (chooses_by_tree()) {
+        memo = encode_receiver(n);
+        return walk_light_tree(p, decode_receiver(memo), false, 0u, u, probability);
+    }
     if (!chooses_by_point()) {
         uint light = choose_light(u);
         probability = light_power_probability(light);
@@ -193,15 +244,15 @@ uint choose_light_at(float u, vec3 p, out float probability, out float total)
     for (uint l = 0u; l < light_count; l++) {
         work++;
         importance[l] = light_importance(l, p);
-        total += importance[l];
+        memo += importance[l];
     }
     uint chosen = light_count - 1u;
-    probability = mixed_probability(chosen, importance[chosen], total);
+    probability = mixed_probability(chosen, importance[chosen], memo);
     float cumulative = 0.0;
     bool found = false;
     for (uint l = 0u; l + 1u < light_count; l++) {
         work++;
-        float q = mixed_probability(l, importance[l], total);
+        float q = mixed_probability(l, importance[l], memo);
         cumulative += q;
         if (!found && u < cumulative) {
             found = true;
@@ -509,27 +560,27 @@ bool sample_light_from(uint light, vec3 p, vec2 u, out LightSample s)
 // path's last vertex chose its direction, 0 when that vertex sampled no light)
 
 // A path that hit the emissive world primitive hit.primitive at p (geometric normal n),
-// coming from vertex, where light sampling found the importances' total light_total:
+// coming from vertex, where light sampling left choice_memo (choose_light_at):
 // light sampling could have found it too.
-float emitter_mis_weight(Hit hit, float previous_pdf, float light_total, vec3 vertex, vec3 p, vec3 n)
+float emitter_mis_weight(Hit hit, float previous_pdf, float choice_memo, vec3 vertex, vec3 p, vec3 n)
 {
     uint light = previous_pdf > 0.0 && hit.instance == NONE ? area_light_of(hit.primitive) : NONE;
     if (light == NONE || light >= light_count)
         return 1.0;
-    float light_pdf = light_choice_probability(light, vertex, light_total) * light_direction_pdf(light, vertex, p, n);
+    float light_pdf = light_choice_probability(light, vertex, choice_memo) * light_direction_pdf(light, vertex, p, n);
     return power_heuristic(previous_pdf, light_pdf);
 }
 
-// A path that left the scene along direction from vertex (light_total as above): light
+// A path that left the scene along direction from vertex (choice_memo as above): light
 // sampling could have picked that direction of an environment sky too (the environment is
 // the last light).
-float environment_mis_weight(float previous_pdf, float light_total, vec3 vertex, vec3 direction)
+float environment_mis_weight(float previous_pdf, float choice_memo, vec3 vertex, vec3 direction)
 {
     if (HAS_ENVIRONMENT_LIGHT && previous_pdf > 0.0 && sky_kind() == SKY_ENVIRONMENT && light_count > 0u) {
         uint last = light_count - 1u;
         if (packed_texel(light_offset + last * uint(PACKED_LIGHT_STRIDE)).x == uint(LIGHT_ENVIRONMENT))
             return power_heuristic(previous_pdf,
-                                   light_choice_probability(last, vertex, light_total) * environment_pdf(last, direction));
+                                   light_choice_probability(last, vertex, choice_memo) * environment_pdf(last, direction));
     }
     return 1.0;
 }

@@ -20,7 +20,7 @@ PixelState read_state(ivec2 pixel, uint round)
     s.since_vertex = origin.w;
     vec4 direction = texelFetch(state_direction, pixel, 0);
     s.direction = direction.xyz;
-    s.light_total = direction.w;
+    s.choice_memo = direction.w;
     s.throughput = throughput.rgb;
     s.previous_pdf = throughput.w;
     s.radiance = texelFetch(state_radiance, pixel, 0).rgb;
@@ -32,7 +32,7 @@ PixelState read_state(ivec2 pixel, uint round)
     s.squares = texelFetch(state_squares, pixel, 0);
     s.finished_here = 0u;
     if (round != 0u && counters.w != round) {
-        s.light_total = 0.0;
+        s.choice_memo = 0.0;
         s.previous_pdf = 0.0;
         s.samples_started = 0u;
         s.bounce = 0u;
@@ -46,7 +46,7 @@ PixelState read_state(ivec2 pixel, uint round)
 void write_state(PixelState s, uint round)
 {
     out_origin = vec4(s.origin, s.since_vertex);
-    out_direction = vec4(s.direction, s.light_total);
+    out_direction = vec4(s.direction, s.choice_memo);
     out_throughput = vec4(s.throughput, s.previous_pdf);
     out_radiance = vec4(s.radiance, 0.0);
     out_counters = uvec4(s.samples_started, s.bounce, s.media, round);

@@ -12,8 +12,8 @@ struct PixelState {
     float previous_pdf;     // the BSDF density of the direction the path left its last
                             // vertex by, when that vertex also sampled a light (then an
                             // emitter hit is weighted by MIS); 0 otherwise
-    float light_total;      // the sum of light_importance over the lights at the vertex
-                            // that last sampled a light (glsl/lights.glsl): with
+    float choice_memo;      // what the light choice at the vertex that last sampled a
+                            // light left (glsl/lights.glsl, choose_light_at): with
                             // previous_pdf, what MIS needs at the next emitter hit
     vec3 radiance;          // gathered by the path in flight
     uint samples_started;
@@ -127,7 +127,7 @@ void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material
     // MIS wants the path's last scattering vertex, where light sampling chose: the ray
     // went straight on from it through any volume boundaries since.
     vec3 vertex = s.origin - s.since_vertex * s.direction;
-    float weight = emitter_mis_weight(hit, s.previous_pdf, s.light_total, vertex, surface.position, surface.geometric);
+    float weight = emitter_mis_weight(hit, s.previous_pdf, s.choice_memo, vertex, surface.position, surface.geometric);
     vec3 emitted = s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
     s.radiance += emitted;
     add_to_light_group(emitter_light_group(material), emitted);
