@@ -233,16 +233,16 @@ static float float_at_most(double value)
 }
 
 /* Sets out's cone to the union of its children a's and b's cones, both holding finite
- * lights (pbrt-v4's DirectionCone Union):
+ * lights (pbrt-v4's DirectionCone Union), two-sided unless one_sided:
  *   - either child shining every way: every way;
- *   - both spreads below pi/2 and their axes more than pi/2 apart: b's axis is flipped
- *     first (emitters are two-sided, so -axis bounds b's lights as well);
+ *   - two-sided, both spreads below pi/2 and their axes more than pi/2 apart: b's axis is
+ *     flipped first (emitters are two-sided, so -axis bounds b's lights as well);
  *   - one cone holding the other (theta_d + theta_b <= theta_a): that cone, as it is;
  *   - else the cone through both: half-angle theta = (theta_a + theta_d + theta_b) / 2,
  *     axis a's rotated towards b's by theta - theta_a (so that it reaches from a's far side
  *     to b's far side), widened by CONE_WIDENING; every way when that reaches pi.
  * theta_d is the angle between the axes. */
-static void merge_cones(const light_tree_node *a, const light_tree_node *b, light_tree_node *out)
+static void merge_cones(const light_tree_node *a, const light_tree_node *b, bool one_sided, light_tree_node *out)
 {
     if (a->cos_spread <= -1 || b->cos_spread <= -1) {
         set_whole_sphere(out);
@@ -259,7 +259,7 @@ static void merge_cones(const light_tree_node *a, const light_tree_node *b, ligh
         wb[k] /= length_b;
     }
     double dot = wa[0] * wb[0] + wa[1] * wb[1] + wa[2] * wb[2];
-    if (a->cos_spread > 0 && b->cos_spread > 0 && dot < 0) {
+    if (!one_sided && a->cos_spread > 0 && b->cos_spread > 0 && dot < 0) {
         for (int k = 0; k < 3; k++)
             wb[k] = -wb[k];
         dot = -dot;
@@ -326,6 +326,7 @@ static node_sums make_leaf(build_state *state, uint32_t index, uint32_t at, uint
     light_tree_node *node = &state->tree->nodes[index];
     node->first = light;
     node->leaf = true;
+    node->one_sided = false;
     node->axis[0] = 0;
     node->axis[1] = 0;
     node->axis[2] = 1;
@@ -355,6 +356,7 @@ static node_sums make_leaf(build_state *state, uint32_t index, uint32_t at, uint
                     node->axis[k] = (float)(v[k] / length);
             }
         }
+        node->one_sided = bounds->one_sided && node->cos_spread > -1;
     }
     state->tree->trails[light] = trail;
     state->tree->depths[light] = (uint8_t)depth;
@@ -386,12 +388,16 @@ static node_sums build_node(build_state *state, uint32_t index, uint32_t begin, 
     bvh_box_grow(&node->box, &b->box);
     bool finite_a = has_finite_lights(a), finite_b = has_finite_lights(b);
     if (finite_a && finite_b) {
-        merge_cones(a, b, node);
+        node->one_sided = a->one_sided && b->one_sided;
+        merge_cones(a, b, node->one_sided, node);
+        if (node->cos_spread <= -1)
+            node->one_sided = false;
     } else {
         /* A child without finite lights bounds no normals: it adds nothing to the cone. */
         const light_tree_node *only = finite_a ? a : b;
         memcpy(node->axis, only->axis, sizeof node->axis);
         node->cos_spread = only->cos_spread;
+        node->one_sided = only->one_sided;
     }
     node_sums sums = {sums_a.intensity + sums_b.intensity, sums_a.irradiance + sums_b.irradiance};
     node->intensity = (float)sums.intensity;

@@ -26,7 +26,11 @@
  * the same input always gives the same tree.
  *
  * Emitters are two-sided: a flat light with normal n lights the side -n faces as well, so
- * a node's cone of normals only has to hold n or -n of each of its lights.
+ * a node's cone of normals only has to hold n or -n of each of its lights. A spot light is
+ * one-sided: it shines within its cone about its direction and nowhere else, so a node
+ * whose finite lights are all one-sided has a one-sided cone, which holds each light's cone
+ * itself (never its negation), and nothing shines outside it (pbrt-v4's LightBounds with
+ * no emission beyond the cone).
  */
 #ifndef RT_LIGHT_TREE_H
 #define RT_LIGHT_TREE_H
@@ -55,6 +59,9 @@ typedef struct light_bounds {
     float intensity;    /* finite lights: what the importance divides by the squared distance (>= 0) */
     float irradiance;   /* infinite lights (sun, environment): their importance anywhere (>= 0) */
     bool infinite;      /* a sun or environment: no position; only irradiance counts */
+    bool one_sided;     /* a finite light that shines only within cos_spread of +axis and nowhere
+                           else (a spot: axis its direction, cos_spread its outer cone's); ignored
+                           when cos_spread is -1 */
 } light_bounds;
 
 /* One node: the bounds of every light below it. */
@@ -67,6 +74,8 @@ typedef struct light_tree_node {
     float irradiance;     /* sum of its infinite lights' irradiances */
     uint32_t first;       /* interior: its first child (the second is first + 1); leaf: the light's index */
     bool leaf;            /* a leaf holds exactly one light */
+    bool one_sided;       /* it has finite lights, all one-sided, and its cone holds each one's cone
+                             itself: nothing below it shines outside the cone */
 } light_tree_node;
 
 /* A built tree; every array is the tree's own (light_tree_free() frees them). */
@@ -80,12 +89,14 @@ typedef struct light_tree {
 } light_tree;
 
 /* Builds the light tree over lights[0 .. count - 1] into *out (no config: the build has no
- * knobs). A leaf copies its light's bounds: a finite light's box, axis, cos_spread and
- * intensity (irradiance 0); an infinite light's irradiance (empty box, axis (0, 0, 1),
- * cos_spread 1, intensity 0). An axis that is not of unit length is normalized in the leaf;
- * a zero axis (a degenerate flat light) makes its leaf's cos_spread -1 (any direction).
- * An interior node holds the union of its children's boxes and cones and the sums (added up
- * in double) of their intensities and irradiances.
+ * knobs). A leaf copies its light's bounds: a finite light's box, axis, cos_spread,
+ * one_sided and intensity (irradiance 0); an infinite light's irradiance (empty box, axis
+ * (0, 0, 1), cos_spread 1, intensity 0, two-sided). An axis that is not of unit length is
+ * normalized in the leaf; a zero axis (a degenerate flat light) makes its leaf's cos_spread
+ * -1 (any direction); a leaf with cos_spread -1 is never one-sided. An interior node holds
+ * the union of its children's boxes and cones and the sums (added up in double) of their
+ * intensities and irradiances; it is one-sided when every child with finite lights is, and
+ * its cone is then the one-sided union (no axis flipped), else the two-sided one.
  *
  * Returns RT_OK, or RT_ERROR_RUNTIME with a message starting "LIGHT_TREE: " (the packer
  * makes these bounds, so a bad one is a bug rather than the user's input) for: count 0 or

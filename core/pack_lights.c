@@ -121,8 +121,8 @@ static double scene_radius(const packer *p)
 
 /* Writes the scene's point, spot and sun lights from light first on, with their powers
  * and their bounds for the light tree (a point or spot: its intensity's luminance at a
- * point, the spot's cone left out; a sun: its irradiance's, anywhere). A sun's power is its
- * irradiance over the scene's cross-section. */
+ * point, a spot's within its outer cone only; a sun: its irradiance's, anywhere). A sun's
+ * power is its irradiance over the scene's cross-section. */
 static void write_scene_lights(packer *p, uint32_t first, double radius, double *power, light_bounds *bounds)
 {
     const scene *s = p->scene;
@@ -145,6 +145,11 @@ static void write_scene_lights(packer *p, uint32_t first, double radius, double 
         light_bounds *b = &bounds[light];
         b->box = bvh_box_empty();
         b->cos_spread = -1;
+        if (type == LIGHT_SPOT) {
+            glm_vec3_copy((float *)source->direction, b->axis);
+            b->cos_spread = (float)cos_outer;
+            b->one_sided = true;
+        }
         if (type == LIGHT_SUN) {
             b->infinite = true;
             b->irradiance = (float)luminance;
@@ -248,7 +253,8 @@ static rt_status write_light_tree(packer *p, const light_bounds *bounds, uint32_
         put_texel(p->texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
                   float_bits(node->box.max[2]), float_bits(node->irradiance));
         put_texel(p->texels, base + 2, packed_encode_normal(node->axis), float_bits(node->cos_spread),
-                  node->leaf ? node->first | LIGHT_TREE_LEAF : node->first, 0);
+                  node->leaf ? node->first | LIGHT_TREE_LEAF : node->first,
+                  node->one_sided ? LIGHT_TREE_ONE_SIDED : 0);
     }
     for (uint32_t l = 0; l < light_count; l++) {
         uint64_t base = p->layout.light_offset + (uint64_t)l * PACKED_LIGHT_STRIDE;

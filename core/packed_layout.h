@@ -227,13 +227,17 @@
  *   texel 0 = (box min.xyz of its finite lights, their intensity: the sum of what an
  *             estimate divides by the squared distance)
  *   texel 1 = (box max.xyz, irradiance of its infinite lights (sun, environment))
- *   texel 2 = (axis of the cone of its flat lights' normals, octahedral (packed_encode_normal
- *             of core/pack.h), cosine of the cone's half-angle (-1: lights that shine every
- *             way), child: interior: its first child's node index; leaf: the light's index
- *             | LIGHT_TREE_LEAF, 0) */
+ *   texel 2 = (axis of the cone of its flat lights' normals and spots' directions,
+ *             octahedral (packed_encode_normal of core/pack.h), cosine of the cone's
+ *             half-angle (-1: lights that shine every way), child: interior: its first
+ *             child's node index; leaf: the light's index | LIGHT_TREE_LEAF, flags:
+ *             LIGHT_TREE_ONE_SIDED when its lights are all spots, which shine within the
+ *             cone about +axis and nowhere else; otherwise the cone holds each light's
+ *             normal or its negation, as emitters are two-sided) */
 #define PACKED_LIGHT_STRIDE 5
 #define PACKED_LIGHT_TREE_NODE_STRIDE 3
 #define LIGHT_TREE_LEAF 2147483648u
+#define LIGHT_TREE_ONE_SIDED 1u
 #define LIGHT_TREE_MAX_DEPTH 32        /* a trail's bits */
 #define LIGHT_SPHERE 0
 #define LIGHT_QUAD 1

@@ -110,7 +110,9 @@ bool chooses_by_tree() { return HAS_LIGHT_TREE && light_tree_offset != NONE; }
 //   direction from the box to p (two-sided: emitters shine from both faces), the angle to
 //   the cone's axis less the cone's half-angle and the half-angle the box's bounding
 //   sphere covers, taken a thousandth of a radian smaller still (the axis is stored
-//   octahedral, about 1e-4 rad off), so never zero;
+//   octahedral, about 1e-4 rad off), so never zero; for a node of spots alone
+//   (LIGHT_TREE_ONE_SIDED), 1 where that angle, measured from +axis, is within the cone,
+//   0 beyond it: a spot lights nothing outside its outer cone;
 // - the receiver's: with a surface normal n (facing the side light is gathered on; 0 for
 //   a point in a medium, which leaves it out), the largest cosine n can make with a
 //   direction from p to the box, the angle less the box's and a hundredth of a radian
@@ -133,7 +135,8 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
     const float COS_MARGIN = 0.9999995, SIN_MARGIN = 0.001;   // of a thousandth of a radian
     float facing = 1.0;
     if (cos_spread > -1.0) {
-        float cos_axis = min(abs(dot(decode_normal(t2.x), to_p)) / max(distance, 1e-30), 1.0);
+        float axis_cosine = clamp(dot(decode_normal(t2.x), to_p) / max(distance, 1e-30), -1.0, 1.0);
+        float cos_axis = abs(axis_cosine);
         // cos(max(axis angle - spread - box angle - margin, 0)) by the angle-difference
         // identities, without acos, asin and cos (each a long polynomial on llvmpipe, in a
         // loop that runs them for both children at every level); an angle that goes below
@@ -147,6 +150,13 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
         // ... - margin
         float cos_c = cos_b * COS_MARGIN + sin_b * SIN_MARGIN, sin_c = sin_b * COS_MARGIN - cos_b * SIN_MARGIN;
         facing = sin_a <= 0.0 || sin_b <= 0.0 || sin_c <= 0.0 ? 1.0 : cos_c;
+        if ((t2.w & uint(LIGHT_TREE_ONE_SIDED)) != 0u) {
+            // spread + box angle, then + margin; at or past pi the point is lit from anywhere.
+            float cos_s = cos_cone * cos_box - sin_cone * sin_box, sin_s = sin_cone * cos_box + cos_cone * sin_box;
+            float cos_t = cos_s * COS_MARGIN - sin_s * SIN_MARGIN, sin_t = sin_s * COS_MARGIN + cos_s * SIN_MARGIN;
+            bool everywhere = (sin_s <= 0.0 && cos_s < 0.0) || (sin_t <= 0.0 && cos_t < 0.0);
+            facing = everywhere || axis_cosine >= cos_t ? 1.0 : 0.0;
+        }
     }
     if (n != vec3(0.0)) {
         // cos(max(receiver angle - box angle - margin, 0)), 0 past a right angle; the

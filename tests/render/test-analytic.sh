@@ -281,6 +281,34 @@ for integrator in path whitted; do
     done
 done
 
+# Many spots (the tree bounds a node of spots alone by their cones, one-sided, and gives it
+# nothing outside them: glsl/lights.glsl, tree_node_importance): twelve aimed at the point
+# (cone 20 30, the point well inside 20 degrees), twelve aimed away from it (at least 45
+# degrees off, outside their 30), and two point lights among them. Radiance = albedo / pi x
+# the aimed spots' and the points' I cos / r^2.
+many_spots=""
+for k in 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25; do
+    many_spots="$many_spots
+$(awk -v k=$k 'BEGIN { x = 2.5 * cos(k * 2.4) * (1 + k % 2); z = 2.5 * sin(k * 2.4) * (1 + k % 2); y = 1.5 + 0.3 * (k % 5)
+        if (k >= 24) printf "light point %.3f %.3f %.3f intensity 2", x, y, z
+        else if (k % 2 == 0) printf "light spot %.3f %.3f %.3f at 0 0 0 intensity %d cone 20 30", x, y, z, 2 + k % 3
+        else printf "light spot %.3f %.3f %.3f at %.3f 0 %.3f intensity 5 cone 20 30", x, y, z, 2 * x, 2 * z }')"
+done
+expected=$(printf '%s\n' "$many_spots" | awk '
+    $1 == "light" && ($2 == "point" || ($7 == "0" && $9 == "0")) {
+        r2 = $3 * $3 + $4 * $4 + $5 * $5; i = $2 == "point" ? $7 : $11; e += i * $4 / sqrt(r2) / r2 }
+    $1 == "light" && $2 == "spot" && !($7 == "0" && $9 == "0") {
+        # the angle between the spot and the way to the point must be over 30 degrees
+        ax = $7 - $3; ay = -$4; az = $9 - $5; dot = -(ax * $3 + ay * $4 + az * $5)
+        cosine = dot / sqrt((ax * ax + ay * ay + az * az) * ($3 * $3 + $4 * $4 + $5 * $5))
+        if (cosine > 0.7) bad = 1 }
+    END { if (bad) print "bad"; else printf "%.6f", 0.5 / 3.14159265358979 * e }')
+for integrator in path whitted; do
+    for tree in on off; do
+        plane_light "many-spots-$tree" "0 0 0" "$many_spots" "$expected" $integrator --spp 1024 --light-tree $tree
+    done
+done
+
 # Many area lights (12 quads, 2 triangles, 2 spheres, facing every way): the light tree's
 # choice and, at an emitter a path hits, the probability MIS recomputes from the light's
 # trail must agree, or light sampling and BSDF sampling alone converge to different images.

@@ -6,9 +6,10 @@
  * its bounds, each light's trail and depth leading from the root to its leaf, the depth
  * bound of median splits, boxes and sums exactly those of the children, and every node's
  * cone of normals holding the cone (or its negation: emitters are two-sided) of every light
- * below it. Then particular cases: where the median split puts the odd light, two far
- * clusters kept apart, finite lights split from infinite ones, the cone union of two flat
- * lights, determinism and the errors.
+ * below it, or with one-sided lights (spots) alone below it, each light's cone itself.
+ * Then particular cases: where the median split puts the odd light, two far clusters kept
+ * apart, finite lights split from infinite ones, the cone union of two flat lights and of
+ * spots, determinism and the errors.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -67,6 +68,14 @@ static light_bounds make_flat(const float centre[3], float half_size, const floa
     return light;
 }
 
+/* A spot light at centre aimed along axis, shining within acos(cos_outer) of it. */
+static light_bounds make_spot(const float centre[3], const float axis[3], float cos_outer, float intensity)
+{
+    light_bounds light = make_flat(centre, 0, axis, cos_outer, intensity);
+    light.one_sided = true;
+    return light;
+}
+
 /* A sun or environment; its unused fields hold what the packer leaves there. */
 static light_bounds make_infinite(float irradiance)
 {
@@ -76,8 +85,9 @@ static light_bounds make_infinite(float irradiance)
 
 /* What random_lights() makes. */
 typedef enum light_mix {
-    MIX_ALL,          /* points, spheres, flat lights, patches */
+    MIX_ALL,          /* points, spheres, flat lights, patches, spots */
     MIX_FLAT_NEAR_Z,  /* flat lights facing within 20 degrees of +z or -z */
+    MIX_SPOTS,        /* spots aimed every way, cones of 5 to 80 degrees */
 } light_mix;
 
 /* Fills lights with count random lights of the given mix in [-extent, extent]^3, then
@@ -100,7 +110,13 @@ static void random_lights(random_source *source, light_bounds *lights, uint32_t 
             lights[i] = make_flat(centre, random_float(source, 0, 0.5f), axis, 1, intensity);
             continue;
         }
-        switch (random_below(source, 4)) {
+        if (mix == MIX_SPOTS) {
+            random_unit(source, axis);
+            float outer = random_float(source, (float)(5 * M_PI / 180), (float)(80 * M_PI / 180));
+            lights[i] = make_spot(centre, axis, cosf(outer), intensity);
+            continue;
+        }
+        switch (random_below(source, 5)) {
         case 0:
             lights[i] = make_point(centre[0], centre[1], centre[2], intensity);
             break;
@@ -111,10 +127,14 @@ static void random_lights(random_source *source, light_bounds *lights, uint32_t 
             random_unit(source, axis);
             lights[i] = make_flat(centre, random_float(source, 0, 0.5f), axis, 1, intensity);
             break;
-        default:
+        case 3:
             random_unit(source, axis);
             lights[i] = make_flat(centre, random_float(source, 0, 0.5f), axis, random_float(source, 0.3f, 1),
                                   intensity);
+            break;
+        default:
+            random_unit(source, axis);
+            lights[i] = make_spot(centre, axis, random_float(source, 0.2f, 1), intensity);
             break;
         }
     }
@@ -168,6 +188,12 @@ static void check_light_under(const light_tree_node *node, const light_bounds *l
     if (node->cos_spread == -1)
         return;
     double angle = angle_between(light->axis, node->axis);
+    if (node->one_sided) {
+        /* Nothing below shines outside the cone: the light is one-sided, its cone inside. */
+        assert_true(light->one_sided);
+        assert_true(angle + acos(light->cos_spread) <= acos(node->cos_spread) + tolerance);
+        return;
+    }
     double two_sided = fmin(angle, M_PI - angle);
     assert_true(two_sided + acos(light->cos_spread) <= acos(node->cos_spread) + tolerance);
 }
@@ -237,7 +263,10 @@ static void check_tree(const light_tree *tree, const light_bounds *lights, uint3
                 assert_true(node->cos_spread == light->cos_spread);
                 if (light->cos_spread > -1)
                     assert_memory_equal(node->axis, light->axis, sizeof node->axis);
+                assert_true(node->one_sided == (light->one_sided && light->cos_spread > -1));
             }
+            if (light->infinite)
+                assert_false(node->one_sided);
             continue;
         }
 
@@ -254,6 +283,11 @@ static void check_tree(const light_tree *tree, const light_bounds *lights, uint3
         assert_close(node->irradiance, irradiance, 1e-5 * irradiance);
         if (a->cos_spread == -1 || b->cos_spread == -1)
             assert_true(node->cos_spread == -1);
+        /* One-sided exactly when every child with finite lights is (and the cone is not
+         * every way). */
+        bool finite_a = !box_is_empty(&a->box), finite_b = !box_is_empty(&b->box);
+        bool all_one_sided = (!finite_a || a->one_sided) && (!finite_b || b->one_sided) && (finite_a || finite_b);
+        assert_true(node->one_sided == (all_one_sided && node->cos_spread > -1));
         for (uint32_t child = 0; child < 2; child++) {
             stack_node[stack_size] = node->first + child;
             stack_depth[stack_size++] = depth + 1;
@@ -354,7 +388,7 @@ static void test_random_sets(void **state)
         random_source source = {seed};
         for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++) {
             uint32_t count = sizes[s];
-            light_mix mix = seed % 3 == 0 ? MIX_FLAT_NEAR_Z : MIX_ALL;
+            light_mix mix = seed % 3 == 0 ? MIX_FLAT_NEAR_Z : seed == 5 ? MIX_SPOTS : MIX_ALL;
             /* Some sets with a few suns or an environment among them. */
             uint32_t infinite_count = seed % 2 == 0 ? 1 + random_below(&source, 3) : 0;
             random_lights(&source, lights, count, mix, 50, infinite_count);
@@ -370,6 +404,17 @@ static void test_random_sets(void **state)
         }
     }
     assert_int_equal(narrow_roots, 12);
+    /* Spots alone: every node one-sided unless its cone went every way (check_tree checks
+     * that each holds its spots' cones themselves). */
+    random_source spot_source = {31};
+    random_lights(&spot_source, lights, 200, MIX_SPOTS, 20, 0);
+    light_tree spots;
+    build_and_check(lights, 200, &spots);
+    uint32_t one_sided_nodes = 0;
+    for (uint32_t n = 0; n < spots.node_count; n++)
+        one_sided_nodes += spots.nodes[n].one_sided;
+    assert_true(one_sided_nodes >= 200);   /* the leaves at least */
+    light_tree_free(&spots);
 
     /* Every light at one point (all centroids equal): median splits by index alone. */
     for (uint32_t i = 0; i < 100; i++)
@@ -553,6 +598,33 @@ static void test_cone_union(void **state)
     double through_both = 0.5 * (acos(-0.2f) + M_PI + acos(0.9f));
     assert_close(acos(tree.nodes[0].cos_spread), through_both, 1e-4);
     assert_close(tree.nodes[0].axis[2], cos(through_both - acos(-0.2f)), 1e-5);
+    light_tree_free(&tree);
+
+    /* Two spots aimed opposite ways: one-sided, so not flipped into one narrow cone (each
+     * lights its own side only); the cone through both, pi / 2 + 0.2 rad each way. */
+    float cos_narrow = (float)cos(0.2);
+    light_bounds spots[2] = {make_spot(zero, up, cos_narrow, 1), make_spot(far, down, cos_narrow, 1)};
+    build_and_check(spots, 2, &tree);
+    assert_true(tree.nodes[0].one_sided);
+    assert_close(acos(tree.nodes[0].cos_spread), M_PI / 2 + 0.2, 1e-4);
+    light_tree_free(&tree);
+    /* A spot and a flat light: two-sided (the flat light shines both ways); a spot and a
+     * point light: every way; a spot and a sun: the spot's cone, one-sided. */
+    light_bounds spot_and_flat[2] = {make_spot(zero, up, cos_narrow, 1), make_flat(far, 1, down, 1, 1)};
+    build_and_check(spot_and_flat, 2, &tree);
+    assert_false(tree.nodes[0].one_sided);
+    assert_true(tree.nodes[0].cos_spread >= cos_narrow);
+    light_tree_free(&tree);
+    light_bounds spot_and_point[2] = {make_spot(zero, up, cos_narrow, 1), make_point(3, 0, 0, 1)};
+    build_and_check(spot_and_point, 2, &tree);
+    assert_false(tree.nodes[0].one_sided);
+    assert_true(tree.nodes[0].cos_spread == -1);
+    light_tree_free(&tree);
+    light_bounds spot_and_sun[2] = {make_spot(zero, x, cos_narrow, 1), make_infinite(1)};
+    build_and_check(spot_and_sun, 2, &tree);
+    assert_true(tree.nodes[0].one_sided);
+    assert_true(tree.nodes[0].cos_spread == cos_narrow);
+    assert_memory_equal(tree.nodes[0].axis, x, sizeof x);
     light_tree_free(&tree);
 
     /* Wide cones more than pi apart in all: any direction. */

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "pack.h"
+#include "scene_parse.h"
 #include "packed_traverse.h"
 #include "support.h"
 #include "pack_test_scenes.h"
@@ -102,6 +103,49 @@ static void many_lights_get_a_light_tree(void **state)
     assert_int_equal(packed.light_tree_offset, PACKED_NONE);
     for (uint32_t l = 0; l < packed.light_count; l++)
         assert_int_equal(packed_uint(&packed, packed.light_offset + l * PACKED_LIGHT_STRIDE + 4, 1), 0);
+    packed_scene_free(&packed);
+    scene_free(&s);
+}
+
+/* Spots are one-sided in the light tree (packed_layout.h "light tree", texel 2 .w): a
+ * spot's leaf and a node of spots alone carry LIGHT_TREE_ONE_SIDED, with the spot's
+ * direction and outer cone; a node with a point light under it does not. */
+static void spots_are_one_sided_in_the_tree(void **state)
+{
+    (void)state;
+    char text[2048] = "";
+    for (int k = 0; k < 10; k++) {
+        char line[160];
+        snprintf(line, sizeof line, "light spot %d 3 0 at %d 0 0 cone 10 20\n", 4 * k, 4 * k);
+        strcat(text, line);
+    }
+    strcat(text, "light point 100 3 0\n");
+    scene s;
+    rt_error error = {0};
+    assert_int_equal(scene_load_string(text, "spots", NULL, &s, &error), RT_OK);
+    packed_scene packed;
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_int_equal(packed.light_count, 11);
+    assert_int_not_equal(packed.light_tree_offset, PACKED_NONE);
+    uint32_t one_sided_inner = 0;
+    for (uint32_t n = 0; n < 2 * packed.light_count - 1; n++) {
+        uint32_t base = packed.light_tree_offset + n * PACKED_LIGHT_TREE_NODE_STRIDE;
+        uint32_t child = packed_uint(&packed, base + 2, 2), flags = packed_uint(&packed, base + 2, 3);
+        float cos_spread = packed_float(&packed, base + 2, 1);
+        if (child & LIGHT_TREE_LEAF) {
+            uint32_t light = child & ~LIGHT_TREE_LEAF;
+            bool spot = packed_uint(&packed, packed.light_offset + light * PACKED_LIGHT_STRIDE, 0) == LIGHT_SPOT;
+            assert_int_equal(flags, spot ? LIGHT_TREE_ONE_SIDED : 0);
+            assert_float_equal(cos_spread, spot ? cosf(20 * (float)M_PI / 180) : -1, 1e-6);
+        } else {
+            one_sided_inner += flags == LIGHT_TREE_ONE_SIDED;
+            if (flags == LIGHT_TREE_ONE_SIDED)
+                assert_true(cos_spread >= cosf(20 * (float)M_PI / 180) - 1e-4f);   /* all aimed straight down */
+        }
+    }
+    assert_true(one_sided_inner >= 4);   /* the subtrees of spots alone */
+    /* The root holds the point light: two-sided, every way. */
+    assert_int_equal(packed_uint(&packed, packed.light_tree_offset + 2, 3), 0);
     packed_scene_free(&packed);
     scene_free(&s);
 }
@@ -210,6 +254,7 @@ int main(void)
         cmocka_unit_test(emissive_spheres_become_lights),
         cmocka_unit_test(placed_emitters_become_lights),
         cmocka_unit_test(many_lights_get_a_light_tree),
+        cmocka_unit_test(spots_are_one_sided_in_the_tree),
     };
     return cmocka_run_group_tests_name("pack_lights", tests, NULL, NULL);
 }
