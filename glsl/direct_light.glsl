@@ -126,7 +126,7 @@ void begin_direct_light(inout LightQuery query, vec3 view, uint media, float tim
 // chosen with probability 0, out of reach, or below the surface). choice_memo receives
 // what MIS at the path's next emitter hit needs of the light choice here
 // (glsl/lights.glsl).
-PendingShadow next_shadow_ray(inout LightQuery query, inout float choice_memo)
+PendingShadow next_shadow_ray(inout LightQuery query, inout vec2 choice_memo)
 {
     PendingShadow shadow = no_pending_shadow();
     uint k = query.next_light;
@@ -203,7 +203,7 @@ bool gathers_in_place() { return tracer_integrator() == INTEGRATOR_WHITTED; }
 // Takes all the query's light samples (begin_direct_light counted them), walking each
 // shadow ray to its light through the volume boundaries on its way, and adds what gets
 // through to radiance.
-void direct_light_in_place(inout LightQuery query, inout float choice_memo, inout vec3 radiance)
+void direct_light_in_place(inout LightQuery query, inout vec2 choice_memo, inout vec3 radiance)
 {
     while (direct_light_pending(query)) {
         work++;

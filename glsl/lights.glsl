@@ -37,8 +37,12 @@ float light_power_probability(uint light)
 uint choose_light(float u);
 
 // An estimate of the irradiance light gives point p, up to one factor common to all
-// lights (luminance, no receiver cosine, no occlusion): what choose_light_at weighs by.
-float light_importance(uint light, vec3 p)
+// lights (luminance, no occlusion): what choose_light_at weighs by. With a surface normal
+// n (facing the side light is gathered on; 0: none, a point in a medium), times the
+// receiver's cosine: exact for a point, spot or sun, for an area light the largest over a
+// sphere of radius sqrt(area) about its centre; 0 below the surface (the power share of
+// mixed_probability still leaves every light a chance).
+float light_importance(uint light, vec3 p, vec3 n)
 {
     uint base = light_offset + light * uint(PACKED_LIGHT_STRIDE);
     uvec4 head = packed_texel(base);
@@ -47,15 +51,24 @@ float light_importance(uint light, vec3 p)
     if (HAS_ENVIRONMENT_LIGHT && head.x == uint(LIGHT_ENVIRONMENT))
         return colour.w;
     if (HAS_DELTA_LIGHTS && head.x == uint(LIGHT_SUN))
-        return dot(colour.rgb, LUMINANCE);
+        return dot(colour.rgb, LUMINANCE) * (n == vec3(0.0) ? 1.0 : max(dot(n, where.xyz), 0.0));
     vec3 to_light = where.xyz - p;
     float distance_squared = max(dot(to_light, to_light), 1e-20);
+    float receiving = 1.0;
+    if (n != vec3(0.0)) {
+        // cos(max(receiver angle - the sphere's angle, 0)), 0 past a right angle.
+        float distance = sqrt(distance_squared);
+        float cos_i = clamp(dot(n, to_light) / distance, -1.0, 1.0), sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
+        float radius = !HAS_DELTA_LIGHTS || head.x <= uint(LIGHT_TRIANGLE) ? sqrt(packed_vec4(base + 3u).x) : 0.0;
+        float sin_r = min(radius / distance, 1.0), cos_r = sqrt(max(1.0 - sin_r * sin_r, 0.0));
+        receiving = cos_i >= cos_r ? 1.0 : max(cos_i * cos_r + sin_i * sin_r, 0.0);
+    }
     if (!HAS_DELTA_LIGHTS || head.x <= uint(LIGHT_TRIANGLE)) {
         // Radiance x the solid angle it covers (at most a hemisphere): the projected area
         // over the squared distance; a sphere's projected area is a quarter of its area.
         float area = max(packed_vec4(base + 3u).x, 1e-30);
         float facing = HAS_SPHERE_LIGHTS && head.x == uint(LIGHT_SPHERE) ? 0.25 : abs(dot(colour.xyz, to_light)) * inversesqrt(distance_squared);
-        return colour.w / area * min(area * facing / distance_squared, 2.0 * PI);
+        return receiving * colour.w / area * min(area * facing / distance_squared, 2.0 * PI);
     }
     vec3 attenuation = uintBitsToFloat(head.yzw);
     float distance = sqrt(distance_squared);
@@ -66,7 +79,7 @@ float light_importance(uint light, vec3 p)
         vec4 spot = packed_vec4(base + 3u);
         importance *= smoothstep(colour.w, max(spot.w, colour.w + 1e-6), dot(-to_light / distance, spot.xyz));
     }
-    return importance;
+    return importance * receiving;
 }
 
 // ---- the light tree (core/packed_layout.h "light tree", built by core/light_tree.c)
@@ -210,7 +223,7 @@ uint walk_light_tree(vec3 p, vec3 n, bool by_trail, uint trail, float u, out flo
 // loops once however many lights there are.
 bool chooses_by_point() { return HAS_LIGHT_CHOICE && light_count > 1u && light_count <= LOCAL_CHOICE_MAX; }
 
-// The probability that choose_light_at(u, p) picks light (importance: its
+// The probability that choose_light_at(u, p, n) picks light (importance: its
 // light_importance at p, total: the sum over all lights).
 float mixed_probability(uint light, float importance, float total)
 {
@@ -219,32 +232,31 @@ float mixed_probability(uint light, float importance, float total)
 }
 
 // The probability that choose_light_at() picks light for point p, where it left memo.
-float light_choice_probability(uint light, vec3 p, float memo)
+float light_choice_probability(uint light, vec3 p, vec2 memo)
 {
     if (chooses_by_tree()) {
         float chance;
         uint trail = packed_texel(light_offset + light * uint(PACKED_LIGHT_STRIDE) + 4u).y;
-        walk_light_tree(p, decode_receiver(memo), true, trail, 0.0, chance);
+        walk_light_tree(p, decode_receiver(memo.y), true, trail, 0.0, chance);
         return chance;
     }
     if (!chooses_by_point())
         return light_power_probability(light);
-    return mixed_probability(light, light_importance(light, p), memo);
+    return mixed_probability(light, light_importance(light, p, decode_receiver(memo.y)), memo.x);
 }
 
 // Picks a light for point p, on a surface of normal n facing the side light is gathered on
 // (0: a point in a medium), from u uniform in [0, 1) (see above); probability receives the
 // chance it had, memo what light_choice_probability() needs to find that chance again for
-// the same point: the tree's normal as encode_receiver() keeps it (the walk uses that
-// rounded normal, so both walks agree), the sum of all lights' importance at p (chosen by
-// the point), or 0 (by power).
-uint choose_light_at(float u, vec3 p, vec3 n, out float probability, out float memo)
+// the same point: y the normal as encode_receiver() keeps it (the choice uses that
+// rounded normal, so that both agree), x the sum of all lights' importance at p (chosen by
+// the point; 0 by the tree or by power).
+uint choose_light_at(float u, vec3 p, vec3 n, out float probability, out vec2 memo)
 {
-    memo = 0.0;
-    if (chooses_by_tree()) {
-        memo = encode_receiver(n);
-        return walk_light_tree(p, decode_receiver(memo), false, 0u, u, probability);
-    }
+    memo = vec2(0.0, encode_receiver(n));
+    vec3 normal = decode_receiver(memo.y);
+    if (chooses_by_tree())
+        return walk_light_tree(p, normal, false, 0u, u, probability);
     if (!chooses_by_point()) {
         uint light = choose_light(u);
         probability = light_power_probability(light);
@@ -253,16 +265,16 @@ uint choose_light_at(float u, vec3 p, vec3 n, out float probability, out float m
     float importance[LOCAL_CHOICE_MAX];
     for (uint l = 0u; l < light_count; l++) {
         work++;
-        importance[l] = light_importance(l, p);
-        memo += importance[l];
+        importance[l] = light_importance(l, p, normal);
+        memo.x += importance[l];
     }
     uint chosen = light_count - 1u;
-    probability = mixed_probability(chosen, importance[chosen], memo);
+    probability = mixed_probability(chosen, importance[chosen], memo.x);
     float cumulative = 0.0;
     bool found = false;
     for (uint l = 0u; l + 1u < light_count; l++) {
         work++;
-        float q = mixed_probability(l, importance[l], memo);
+        float q = mixed_probability(l, importance[l], memo.x);
         cumulative += q;
         if (!found && u < cumulative) {
             found = true;
@@ -572,7 +584,7 @@ bool sample_light_from(uint light, vec3 p, vec2 u, out LightSample s)
 // A path that hit the emissive world primitive hit.primitive at p (geometric normal n),
 // coming from vertex, where light sampling left choice_memo (choose_light_at):
 // light sampling could have found it too.
-float emitter_mis_weight(Hit hit, float previous_pdf, float choice_memo, vec3 vertex, vec3 p, vec3 n)
+float emitter_mis_weight(Hit hit, float previous_pdf, vec2 choice_memo, vec3 vertex, vec3 p, vec3 n)
 {
     uint light = previous_pdf > 0.0 && hit.instance == NONE ? area_light_of(hit.primitive) : NONE;
     if (light == NONE || light >= light_count)
@@ -584,7 +596,7 @@ float emitter_mis_weight(Hit hit, float previous_pdf, float choice_memo, vec3 ve
 // A path that left the scene along direction from vertex (choice_memo as above): light
 // sampling could have picked that direction of an environment sky too (the environment is
 // the last light).
-float environment_mis_weight(float previous_pdf, float choice_memo, vec3 vertex, vec3 direction)
+float environment_mis_weight(float previous_pdf, vec2 choice_memo, vec3 vertex, vec3 direction)
 {
     if (HAS_ENVIRONMENT_LIGHT && previous_pdf > 0.0 && sky_kind() == SKY_ENVIRONMENT && light_count > 0u) {
         uint last = light_count - 1u;

@@ -20,10 +20,11 @@ PixelState read_state(ivec2 pixel, uint round)
     s.since_vertex = origin.w;
     vec4 direction = texelFetch(state_direction, pixel, 0);
     s.direction = direction.xyz;
-    s.choice_memo = direction.w;
+    vec4 radiance = texelFetch(state_radiance, pixel, 0);
+    s.choice_memo = vec2(direction.w, radiance.w);
     s.throughput = throughput.rgb;
     s.previous_pdf = throughput.w;
-    s.radiance = texelFetch(state_radiance, pixel, 0).rgb;
+    s.radiance = radiance.rgb;
     s.samples_started = counters.x;
     s.bounce = counters.y;
     s.media = counters.z;
@@ -32,7 +33,7 @@ PixelState read_state(ivec2 pixel, uint round)
     s.squares = texelFetch(state_squares, pixel, 0);
     s.finished_here = 0u;
     if (round != 0u && counters.w != round) {
-        s.choice_memo = 0.0;
+        s.choice_memo = vec2(0.0);
         s.previous_pdf = 0.0;
         s.samples_started = 0u;
         s.bounce = 0u;
@@ -46,9 +47,9 @@ PixelState read_state(ivec2 pixel, uint round)
 void write_state(PixelState s, uint round)
 {
     out_origin = vec4(s.origin, s.since_vertex);
-    out_direction = vec4(s.direction, s.choice_memo);
+    out_direction = vec4(s.direction, s.choice_memo.x);
     out_throughput = vec4(s.throughput, s.previous_pdf);
-    out_radiance = vec4(s.radiance, 0.0);
+    out_radiance = vec4(s.radiance, s.choice_memo.y);
     out_counters = uvec4(s.samples_started, s.bounce, s.media, round);
     out_accumulated = s.accumulated;
     out_statistics = s.statistics;

@@ -17,9 +17,9 @@ layout(binding = TRACER_SAMPLE_LIMITS_UNIT) uniform usampler2D sample_limits;
 layout(binding = TRACER_PIXEL_MAP_UNIT) uniform usampler2D pixel_map;
 
 layout(location = TRACER_STATE_ORIGIN) out vec4 out_origin;            // xyz: origin, w: since_vertex
-layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction, w: choice_memo
+layout(location = TRACER_STATE_DIRECTION) out vec4 out_direction;      // xyz: direction, w: choice_memo.x
 layout(location = TRACER_STATE_THROUGHPUT) out vec4 out_throughput;    // rgb: throughput, a: previous_pdf
-layout(location = TRACER_STATE_RADIANCE) out vec4 out_radiance;        // rgb: radiance
+layout(location = TRACER_STATE_RADIANCE) out vec4 out_radiance;        // rgb: radiance, w: choice_memo.y
 layout(location = TRACER_STATE_COUNTERS) out uvec4 out_counters;       // samples_started, bounce, media
 layout(location = TRACER_STATE_ACCUMULATED) out vec4 out_accumulated;
 layout(location = TRACER_STATE_STATISTICS) out vec4 out_statistics;

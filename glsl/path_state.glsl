@@ -12,7 +12,7 @@ struct PixelState {
     float previous_pdf;     // the BSDF density of the direction the path left its last
                             // vertex by, when that vertex also sampled a light (then an
                             // emitter hit is weighted by MIS); 0 otherwise
-    float choice_memo;      // what the light choice at the vertex that last sampled a
+    vec2 choice_memo;       // what the light choice at the vertex that last sampled a
                             // light left (glsl/lights.glsl, choose_light_at): with
                             // previous_pdf, what MIS needs at the next emitter hit
     vec3 radiance;          // gathered by the path in flight
