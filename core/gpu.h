@@ -395,6 +395,33 @@ rt_status gpu_material_test(gpu_context *context, const uint32_t *packed_texels,
                             const gpu_material_query *queries, int count, gpu_material_result *results,
                             rt_error *error);
 
+/* One query of the light choice test: a point p, on a surface of unit normal n facing the
+ * side light is gathered on (all 0: a point in a medium), u the uniform number in [0, 1)
+ * the choice draws from, and a light whose chance at p is read as well. */
+typedef struct gpu_light_query {
+    float p[3];
+    float n[3];
+    float u;
+    uint32_t light;
+} gpu_light_query;
+
+/* What glsl/lights.glsl returns for one query. */
+typedef struct gpu_light_result {
+    uint32_t picked;             /* choose_light_at(u, p, n): the light */
+    float chance;                /* the probability it reports for that light */
+    float memo[2];               /* the memo it leaves for MIS */
+    float picked_again;          /* light_choice_probability(picked, p, memo) */
+    float light_chance;          /* light_choice_probability(query's light, p, memo) */
+} gpu_light_result;
+
+/* Runs the tracer's light choice (the whole tracer's: no part left out) on the device for
+ * count queries against a packed scene (texels as gpu_tracer_create takes them), filling
+ * results[0 .. count - 1]. For testing the choice of a light against its probabilities
+ * (tests/unit/test_light_choice.c). The caller owns both arrays. */
+rt_status gpu_light_choice_test(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
+                                const gpu_light_query *queries, int count, gpu_light_result *results,
+                                rt_error *error);
+
 /* Compiles the whole tracer (no part left out) and reads where the GL placed the members
  * of its parameter block: offsets[i] receives the byte offset of the member called
  * names[i] (-1 when the program has none of that name), *block_size the block's size

@@ -1,7 +1,8 @@
 /* gpu_test_programs.c: the programs of the GPU module that only tests use (gpu.h): the
- * random-number test (glsl/random_test.frag), the material test (glsl/material_test.frag)
- * and the parameter block's layout as the GLSL compiler lays it out. They share the
- * tracer's program assembly and helpers through gpu_internal.h. */
+ * random-number test (glsl/random_test.frag), the material test (glsl/material_test.frag),
+ * the light choice test (glsl/light_test.frag) and the parameter block's layout as the GLSL
+ * compiler lays it out. They share the tracer's program assembly and helpers through
+ * gpu_internal.h. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -64,15 +65,106 @@ rt_status gpu_random_numbers(gpu_context *context, const gpu_random_request *req
     return gpu_check_gl("drawing random numbers", error);
 }
 
-/* Queries per draw of the material test (rows of MATERIAL_TEST_WIDTH). */
-#define MATERIAL_TEST_WIDTH 1024
-#define MATERIAL_TEST_ROWS 256
+/* Queries per draw of the query tests (rows of QUERY_TEST_WIDTH). */
+#define QUERY_TEST_WIDTH 1024
+#define QUERY_TEST_ROWS 256
+#define QUERY_TEST_MAX_OUTPUTS 4
+
+/* Runs a query test's program (a SHADER_PROGRAM_* bit, the whole tracer's variant: no
+ * part left out) over count queries of texels_per_query RGBA32F texels each (query_texels,
+ * on the buffer texture unit query_unit) against a packed scene, one pixel a query, row by
+ * row: outputs[k] (output_count of them, each count RGBA floats) receives what the
+ * program writes to location k for each query. The caller owns every array. */
+static rt_status run_query_test(gpu_context *context, uintptr_t program_bit, const char *what,
+                                const uint32_t *packed_texels, uint32_t texel_count, const float *query_texels,
+                                int texels_per_query, int query_unit, int count, int output_count, float **outputs,
+                                rt_error *error)
+{
+    rt_status status = gpu_check_packed_size(context, texel_count, error);
+    if (status != RT_OK || count <= 0)
+        return status;
+    char defines[2048];
+    gpu_variant_defines(0, NULL, defines, sizeof defines);
+    GLuint program = build_program(program_bit, defines, error);
+    if (program == 0)
+        return RT_ERROR_RUNTIME;
+    int rows = (count + QUERY_TEST_WIDTH - 1) / QUERY_TEST_WIDTH;
+    rows = rows > QUERY_TEST_ROWS ? QUERY_TEST_ROWS : rows;
+    float *image = malloc((size_t)QUERY_TEST_WIDTH * rows * 4 * sizeof(float));
+    if (image == NULL) {
+        glDeleteProgram(program);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for %s", what);
+    }
+    GLuint buffers[2], inputs[2], images[QUERY_TEST_MAX_OUTPUTS], framebuffer, vertex_array;
+    gpu_create_buffer_texture(GL_RGBA32UI, packed_texels, (size_t)texel_count * 4 * sizeof(uint32_t), &buffers[0],
+                              &inputs[0]);
+    gpu_create_buffer_texture(GL_RGBA32F, query_texels, (size_t)count * texels_per_query * 4 * sizeof(float),
+                              &buffers[1], &inputs[1]);
+    glGenTextures(output_count, images);
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    GLenum draw_buffers[QUERY_TEST_MAX_OUTPUTS];
+    for (int k = 0; k < output_count; k++) {
+        glBindTexture(GL_TEXTURE_2D, images[k]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, QUERY_TEST_WIDTH, rows);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, GL_TEXTURE_2D, images[k], 0);
+        draw_buffers[k] = GL_COLOR_ATTACHMENT0 + k;
+    }
+    glDrawBuffers(output_count, draw_buffers);
+    glGenVertexArrays(1, &vertex_array);
+    glBindVertexArray(vertex_array);
+    glUseProgram(program);
+    glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
+    glBindTexture(GL_TEXTURE_BUFFER, inputs[0]);
+    glActiveTexture(GL_TEXTURE0 + query_unit);
+    glBindTexture(GL_TEXTURE_BUFFER, inputs[1]);
+    glUniform1i(glGetUniformLocation(program, "query_width"), QUERY_TEST_WIDTH);
+    /* One draw per QUERY_TEST_ROWS rows of queries, each read back before the next. */
+    for (int first = 0; first < count; first += QUERY_TEST_WIDTH * rows) {
+        int n = count - first < QUERY_TEST_WIDTH * rows ? count - first : QUERY_TEST_WIDTH * rows;
+        int used_rows = (n + QUERY_TEST_WIDTH - 1) / QUERY_TEST_WIDTH;
+        glUniform1i(glGetUniformLocation(program, "query_first"), first);
+        glUniform1i(glGetUniformLocation(program, "query_count"), n);
+        glViewport(0, 0, QUERY_TEST_WIDTH, used_rows);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        for (int k = 0; k < output_count; k++) {
+            glReadBuffer(GL_COLOR_ATTACHMENT0 + k);
+            glReadPixels(0, 0, QUERY_TEST_WIDTH, used_rows, GL_RGBA, GL_FLOAT, image);
+            memcpy(outputs[k] + 4 * (size_t)first, image, (size_t)n * 4 * sizeof(float));
+        }
+    }
+    status = gpu_check_gl(what, error);
+    glDeleteVertexArrays(1, &vertex_array);
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(output_count, images);
+    glDeleteTextures(2, inputs);
+    glDeleteBuffers(2, buffers);
+    glDeleteProgram(program);
+    free(image);
+    return status;
+}
+
+/* Allocates output_count arrays of count RGBA floats into outputs; false (and nothing
+ * allocated) when memory runs out. */
+static bool allocate_outputs(int count, int output_count, float **outputs)
+{
+    bool allocated = true;
+    for (int k = 0; k < output_count; k++)
+        allocated = (outputs[k] = malloc((size_t)(count > 0 ? count : 1) * 4 * sizeof(float))) != NULL && allocated;
+    if (!allocated)
+        for (int k = 0; k < output_count; k++) {
+            free(outputs[k]);
+            outputs[k] = NULL;
+        }
+    return allocated;
+}
 
 /* The material test's queries as the texels glsl/material_test.frag reads; NULL when
  * memory runs out. The caller frees it. */
 static float *material_query_texels(const gpu_material_query *queries, int count)
 {
-    float *texels = malloc((size_t)count * MATERIAL_TEST_QUERY_TEXELS * 4 * sizeof(float));
+    float *texels = malloc((size_t)(count > 0 ? count : 1) * MATERIAL_TEST_QUERY_TEXELS * 4 * sizeof(float));
     if (texels == NULL)
         return NULL;
     for (int i = 0; i < count; i++) {
@@ -90,8 +182,8 @@ static float *material_query_texels(const gpu_material_query *queries, int count
     return texels;
 }
 
-/* Copies the material test's outputs (MATERIAL_TEST_OUTPUTS images of count pixels, row
- * by row as queries are) into results. */
+/* Copies the material test's outputs (MATERIAL_TEST_OUTPUTS arrays of count RGBA floats,
+ * in query order) into results. */
 static void material_results(float *const outputs[MATERIAL_TEST_OUTPUTS], int count, gpu_material_result *results)
 {
     for (int i = 0; i < count; i++) {
@@ -115,77 +207,49 @@ rt_status gpu_material_test(gpu_context *context, const uint32_t *packed_texels,
                             const gpu_material_query *queries, int count, gpu_material_result *results,
                             rt_error *error)
 {
-    rt_status status = gpu_check_packed_size(context, texel_count, error);
-    if (status != RT_OK)
-        return status;
-    char defines[2048];
-    gpu_variant_defines(0, NULL, defines, sizeof defines);
-    GLuint program = build_program(SHADER_PROGRAM_MATERIAL_TEST, defines, error);
-    if (program == 0)
-        return RT_ERROR_RUNTIME;
-    float *query_texels = material_query_texels(queries, count);
-    int rows = (count + MATERIAL_TEST_WIDTH - 1) / MATERIAL_TEST_WIDTH;
-    rows = rows > MATERIAL_TEST_ROWS ? MATERIAL_TEST_ROWS : rows;
-    size_t image_floats = (size_t)MATERIAL_TEST_WIDTH * (rows > 0 ? rows : 1) * 4;
     float *outputs[MATERIAL_TEST_OUTPUTS] = {NULL};
-    bool allocated = query_texels != NULL;
-    for (int k = 0; k < MATERIAL_TEST_OUTPUTS; k++)
-        allocated = (outputs[k] = malloc(image_floats * sizeof(float))) != NULL && allocated;
-    if (!allocated || count <= 0) {
+    float *query_texels = material_query_texels(queries, count);
+    if (query_texels == NULL || !allocate_outputs(count, MATERIAL_TEST_OUTPUTS, outputs)) {
         free(query_texels);
-        for (int k = 0; k < MATERIAL_TEST_OUTPUTS; k++)
-            free(outputs[k]);
-        glDeleteProgram(program);
-        return allocated ? RT_OK : rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the material test");
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the material test");
     }
-    GLuint buffers[2], inputs[2], images[MATERIAL_TEST_OUTPUTS], framebuffer, vertex_array;
-    gpu_create_buffer_texture(GL_RGBA32UI, packed_texels, (size_t)texel_count * 4 * sizeof(uint32_t), &buffers[0],
-                          &inputs[0]);
-    gpu_create_buffer_texture(GL_RGBA32F, query_texels, (size_t)count * MATERIAL_TEST_QUERY_TEXELS * 4 * sizeof(float),
-                          &buffers[1], &inputs[1]);
-    glGenTextures(MATERIAL_TEST_OUTPUTS, images);
-    glGenFramebuffers(1, &framebuffer);
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    GLenum draw_buffers[MATERIAL_TEST_OUTPUTS];
-    for (int k = 0; k < MATERIAL_TEST_OUTPUTS; k++) {
-        glBindTexture(GL_TEXTURE_2D, images[k]);
-        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, MATERIAL_TEST_WIDTH, rows);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, GL_TEXTURE_2D, images[k], 0);
-        draw_buffers[k] = GL_COLOR_ATTACHMENT0 + k;
-    }
-    glDrawBuffers(MATERIAL_TEST_OUTPUTS, draw_buffers);
-    glGenVertexArrays(1, &vertex_array);
-    glBindVertexArray(vertex_array);
-    glUseProgram(program);
-    glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
-    glBindTexture(GL_TEXTURE_BUFFER, inputs[0]);
-    glActiveTexture(GL_TEXTURE0 + MATERIAL_TEST_QUERY_UNIT);
-    glBindTexture(GL_TEXTURE_BUFFER, inputs[1]);
-    glUniform1i(glGetUniformLocation(program, "query_width"), MATERIAL_TEST_WIDTH);
-    /* One draw per MATERIAL_TEST_ROWS rows of queries, each read back before the next. */
-    for (int first = 0; first < count; first += MATERIAL_TEST_WIDTH * rows) {
-        int n = count - first < MATERIAL_TEST_WIDTH * rows ? count - first : MATERIAL_TEST_WIDTH * rows;
-        int used_rows = (n + MATERIAL_TEST_WIDTH - 1) / MATERIAL_TEST_WIDTH;
-        glUniform1i(glGetUniformLocation(program, "query_first"), first);
-        glUniform1i(glGetUniformLocation(program, "query_count"), n);
-        glViewport(0, 0, MATERIAL_TEST_WIDTH, used_rows);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        glPixelStorei(GL_PACK_ALIGNMENT, 4);
-        for (int k = 0; k < MATERIAL_TEST_OUTPUTS; k++) {
-            glReadBuffer(GL_COLOR_ATTACHMENT0 + k);
-            glReadPixels(0, 0, MATERIAL_TEST_WIDTH, used_rows, GL_RGBA, GL_FLOAT, outputs[k]);
-        }
-        material_results(outputs, n, results + first);
-    }
-    status = gpu_check_gl("the material test", error);
-    glDeleteVertexArrays(1, &vertex_array);
-    glDeleteFramebuffers(1, &framebuffer);
-    glDeleteTextures(MATERIAL_TEST_OUTPUTS, images);
-    glDeleteTextures(2, inputs);
-    glDeleteBuffers(2, buffers);
-    glDeleteProgram(program);
+    rt_status status = run_query_test(context, SHADER_PROGRAM_MATERIAL_TEST, "the material test", packed_texels,
+                                      texel_count, query_texels, MATERIAL_TEST_QUERY_TEXELS, MATERIAL_TEST_QUERY_UNIT,
+                                      count, MATERIAL_TEST_OUTPUTS, outputs, error);
+    if (status == RT_OK)
+        material_results(outputs, count, results);
     free(query_texels);
     for (int k = 0; k < MATERIAL_TEST_OUTPUTS; k++)
+        free(outputs[k]);
+    return status;
+}
+
+rt_status gpu_light_choice_test(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
+                                const gpu_light_query *queries, int count, gpu_light_result *results,
+                                rt_error *error)
+{
+    float *outputs[LIGHT_TEST_OUTPUTS] = {NULL};
+    float *query_texels = malloc((size_t)(count > 0 ? count : 1) * LIGHT_TEST_QUERY_TEXELS * 4 * sizeof(float));
+    if (query_texels == NULL || !allocate_outputs(count, LIGHT_TEST_OUTPUTS, outputs)) {
+        free(query_texels);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the light choice test");
+    }
+    for (int i = 0; i < count; i++) {
+        const gpu_light_query *q = &queries[i];
+        const float rows[LIGHT_TEST_QUERY_TEXELS][4] = {{q->p[0], q->p[1], q->p[2], q->u},
+                                                        {q->n[0], q->n[1], q->n[2], (float)q->light}};
+        memcpy(query_texels + (size_t)i * LIGHT_TEST_QUERY_TEXELS * 4, rows, sizeof rows);
+    }
+    rt_status status = run_query_test(context, SHADER_PROGRAM_LIGHT_TEST, "the light choice test", packed_texels,
+                                      texel_count, query_texels, LIGHT_TEST_QUERY_TEXELS, LIGHT_TEST_QUERY_UNIT,
+                                      count, LIGHT_TEST_OUTPUTS, outputs, error);
+    for (int i = 0; status == RT_OK && i < count; i++) {
+        const float *a = outputs[0] + 4 * (size_t)i, *b = outputs[1] + 4 * (size_t)i;
+        results[i] = (gpu_light_result){.picked = (uint32_t)a[0], .chance = a[1], .memo = {a[2], a[3]},
+                                        .picked_again = b[0], .light_chance = b[1]};
+    }
+    free(query_texels);
+    for (int k = 0; k < LIGHT_TEST_OUTPUTS; k++)
         free(outputs[k]);
     return status;
 }

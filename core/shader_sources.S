@@ -8,7 +8,9 @@
  * are joined: a file may use what the files above it define. A new GLSL file is one line
  * here (a material among the materials, an integrator before glsl/integrators.glsl), its
  * programs being SHADER_PROGRAM_* bits of shader_sources.h. The material test program
- * (gpu.h gpu_material_test) is the modules up to the table of materials and its main. */
+ * (gpu.h gpu_material_test) is the modules up to the table of materials and its main; the
+ * light choice test program (gpu.h gpu_light_choice_test) the modules up to the lights
+ * and its main. */
 #include "shader_sources.h"
 
     /* module PATH, PROGRAMS: the file's text (NUL-terminated) and its path in .rodata, and
@@ -52,8 +54,9 @@ shader_modules:
     module "glsl/material_phong.glsl", SHADER_PROGRAM_SHADING       /* Whitted's shading model */
     module "glsl/material_table.glsl", SHADER_PROGRAM_SHADING       /* the table of materials */
     module "glsl/material_test.frag", SHADER_PROGRAM_MATERIAL_TEST
-    module "glsl/light_groups.glsl", SHADER_PROGRAM_TRACER         /* --light-groups layers */
-    module "glsl/lights.glsl", SHADER_PROGRAM_TRACER
+    module "glsl/light_groups.glsl", SHADER_PROGRAM_LIGHTS         /* --light-groups layers */
+    module "glsl/lights.glsl", SHADER_PROGRAM_LIGHTS
+    module "glsl/light_test.frag", SHADER_PROGRAM_LIGHT_TEST
     module "glsl/direct_light.glsl", SHADER_PROGRAM_TRACER
     module "glsl/path_state.glsl", SHADER_PROGRAM_TRACER
     module "glsl/integrator_path.glsl", SHADER_PROGRAM_PASS

@@ -68,6 +68,13 @@
 #define MATERIAL_TEST_QUERY_TEXELS 5
 #define MATERIAL_TEST_OUTPUTS 4
 
+/* ---- the light choice test (glsl/light_test.frag, gpu.h gpu_light_choice_test): its
+ * queries, LIGHT_TEST_QUERY_TEXELS RGBA32F texels each in a buffer texture on unit
+ * LIGHT_TEST_QUERY_UNIT, and its LIGHT_TEST_OUTPUTS RGBA32F outputs (locations 0 on) */
+#define LIGHT_TEST_QUERY_UNIT 0
+#define LIGHT_TEST_QUERY_TEXELS 2
+#define LIGHT_TEST_OUTPUTS 2
+
 /* ---- bindings: texture unit of the packed scene, uniform buffer of the parameter block,
  * atomic counter buffer (unfinished pixels at offset 0, finished samples at offset 4),
  * texture unit of the per-pixel sample limits (R32UI: a pixel starts no sample at or past

@@ -147,6 +147,41 @@ static inline uint32_t random_below(random_source *source, uint32_t bound)
     return (uint32_t)(splitmix64_next(&source->state) % bound);
 }
 
+/* ---- statistics -------------------------------------------------------------------------- */
+
+/* The regularised lower incomplete gamma function P(a, x): its series below a + 1, its
+ * continued fraction (modified Lentz) above. A chi-square statistic of k degrees of
+ * freedom has the p-value 1 - P(k / 2, statistic / 2). */
+static inline double lower_gamma_regularised(double a, double x)
+{
+    if (x <= 0)
+        return 0;
+    double log_prefactor = a * log(x) - x - lgamma(a);
+    if (x < a + 1) {
+        double term = 1 / a, sum = term;
+        for (int n = 1; n < 100000 && fabs(term) > fabs(sum) * 1e-15; n++) {
+            term *= x / (a + n);
+            sum += term;
+        }
+        return sum * exp(log_prefactor);
+    }
+    double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
+    for (int n = 1; n < 100000; n++) {
+        double an = -n * (n - a);
+        b += 2;
+        d = an * d + b;
+        d = fabs(d) < 1e-300 ? 1e-300 : d;
+        c = b + an / c;
+        c = fabs(c) < 1e-300 ? 1e-300 : c;
+        d = 1 / d;
+        double delta = d * c;
+        h *= delta;
+        if (fabs(delta - 1) < 1e-15)
+            break;
+    }
+    return 1 - exp(log_prefactor) * h;
+}
+
 /* ---- boxes ------------------------------------------------------------------------------- */
 
 /* Whether two boxes are equal, bound for bound. */

@@ -178,38 +178,6 @@ static gpu_material_result *draw_samples(const setup *s, const frame *f, int cou
 
 /* ---- the chi-square test ------------------------------------------------------------ */
 
-/* The regularised lower incomplete gamma function P(a, x): its series below a + 1, its
- * continued fraction (modified Lentz) above. */
-static double lower_gamma_regularised(double a, double x)
-{
-    if (x <= 0)
-        return 0;
-    double log_prefactor = a * log(x) - x - lgamma(a);
-    if (x < a + 1) {
-        double term = 1 / a, sum = term;
-        for (int n = 1; n < 100000 && fabs(term) > fabs(sum) * 1e-15; n++) {
-            term *= x / (a + n);
-            sum += term;
-        }
-        return sum * exp(log_prefactor);
-    }
-    double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
-    for (int n = 1; n < 100000; n++) {
-        double an = -n * (n - a);
-        b += 2;
-        d = an * d + b;
-        d = fabs(d) < 1e-300 ? 1e-300 : d;
-        c = b + an / c;
-        c = fabs(c) < 1e-300 ? 1e-300 : c;
-        d = 1 / d;
-        double delta = d * c;
-        h *= delta;
-        if (fabs(delta - 1) < 1e-15)
-            break;
-    }
-    return 1 - exp(log_prefactor) * h;
-}
-
 /* The grid of the test: cos theta (to the frame's normal) from -1 to 1, phi 0 to 2 pi. */
 enum { THETA_CELLS = 40, PHI_CELLS = 80, QUADRATURE = 4, CHI2_SAMPLES = 1 << 20 };
 #define POOL_BELOW 5.0
