@@ -76,10 +76,8 @@ static rt_status check_light(const light_bounds *light, uint32_t index, rt_error
         return rt_error_set(error, RT_ERROR_RUNTIME,
                             "LIGHT_TREE: light %u has irradiance %g; it must be a finite number >= 0", index,
                             (double)light->irradiance);
-    /* An infinite light's box, axis and cone are not used: whatever is there is fine. */
-    if (light->infinite)
-        return RT_OK;
-    for (int axis = 0; axis < 3; axis++) {
+    /* An infinite light's box is not used: whatever is there is fine. */
+    for (int axis = 0; axis < 3 && !light->infinite; axis++) {
         float low = light->box.min[axis], high = light->box.max[axis];
         if (!isfinite(low) || !isfinite(high))
             return rt_error_set(error, RT_ERROR_RUNTIME,
@@ -333,7 +331,6 @@ static node_sums make_leaf(build_state *state, uint32_t index, uint32_t at, uint
     node_sums sums = {0, 0};
     if (bounds->infinite) {
         node->box = bvh_box_empty();
-        node->cos_spread = 1;
         node->intensity = 0;
         node->irradiance = bounds->irradiance;
         sums.irradiance = bounds->irradiance;
@@ -342,22 +339,23 @@ static node_sums make_leaf(build_state *state, uint32_t index, uint32_t at, uint
         node->intensity = bounds->intensity;
         node->irradiance = 0;
         sums.intensity = bounds->intensity;
-        node->cos_spread = bounds->cos_spread;
-        if (bounds->cos_spread > -1) {
-            double v[3] = {bounds->axis[0], bounds->axis[1], bounds->axis[2]};
-            double length = length3(v);
-            if (!(length > 0)) {
-                /* No normal (a flat light of no area): bound it by every direction. */
-                node->cos_spread = -1;
-            } else if (fabs(length - 1) <= 1e-6) {
-                memcpy(node->axis, bounds->axis, sizeof node->axis);
-            } else {
-                for (int k = 0; k < 3; k++)
-                    node->axis[k] = (float)(v[k] / length);
-            }
-        }
-        node->one_sided = bounds->one_sided && node->cos_spread > -1;
     }
+    /* The cone: of a finite light's normals, of the directions an infinite one comes from. */
+    node->cos_spread = bounds->cos_spread;
+    if (bounds->cos_spread > -1) {
+        double v[3] = {bounds->axis[0], bounds->axis[1], bounds->axis[2]};
+        double length = length3(v);
+        if (!(length > 0)) {
+            /* No normal (a flat light of no area): bound it by every direction. */
+            node->cos_spread = -1;
+        } else if (fabs(length - 1) <= 1e-6) {
+            memcpy(node->axis, bounds->axis, sizeof node->axis);
+        } else {
+            for (int k = 0; k < 3; k++)
+                node->axis[k] = (float)(v[k] / length);
+        }
+    }
+    node->one_sided = !bounds->infinite && bounds->one_sided && node->cos_spread > -1;
     state->tree->trails[light] = trail;
     state->tree->depths[light] = (uint8_t)depth;
     if (depth > state->tree->depth)
@@ -392,12 +390,16 @@ static node_sums build_node(build_state *state, uint32_t index, uint32_t begin, 
         merge_cones(a, b, node->one_sided, node);
         if (node->cos_spread <= -1)
             node->one_sided = false;
-    } else {
+    } else if (finite_a || finite_b) {
         /* A child without finite lights bounds no normals: it adds nothing to the cone. */
         const light_tree_node *only = finite_a ? a : b;
         memcpy(node->axis, only->axis, sizeof node->axis);
         node->cos_spread = only->cos_spread;
         node->one_sided = only->one_sided;
+    } else {
+        /* Infinite lights alone: the directions they come from. */
+        node->one_sided = false;
+        merge_cones(a, b, true, node);
     }
     node_sums sums = {sums_a.intensity + sums_b.intensity, sums_a.irradiance + sums_b.irradiance};
     node->intensity = (float)sums.intensity;

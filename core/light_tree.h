@@ -53,9 +53,12 @@
 /* What the builder knows of one light: the bounds of what it can give a point. */
 typedef struct light_bounds {
     bvh_box box;        /* a finite light's extent (a point light: min == max); unused for infinite lights */
-    float axis[3];      /* unit normal of a flat (two-sided) emitter; unused when cos_spread is -1 */
+    float axis[3];      /* unit normal of a flat (two-sided) emitter; an infinite light's direction
+                           towards it (a sun's); unused when cos_spread is -1 */
     float cos_spread;   /* cosine of the half-angle of the cone of normals about axis: 1 for one flat
-                           light; -1 for lights that shine every way (spheres, point and spot lights) */
+                           light; -1 for lights that shine every way (spheres, point and spot lights);
+                           an infinite light's: of the cone of directions it comes from (a sun's
+                           angular radius; -1 for an environment, from everywhere) */
     float intensity;    /* finite lights: what the importance divides by the squared distance (>= 0) */
     float irradiance;   /* infinite lights (sun, environment): their importance anywhere (>= 0) */
     bool infinite;      /* a sun or environment: no position; only irradiance counts */
@@ -68,8 +71,9 @@ typedef struct light_bounds {
 typedef struct light_tree_node {
     bvh_box box;          /* the union of its finite lights' boxes; bvh_box_empty() when it has none */
     float axis[3];        /* a unit axis of a cone holding every finite light's normal cone below it
-                             (or its negation); (0, 0, 1) when cos_spread is -1 or it has no finite lights */
-    float cos_spread;     /* that cone's half-angle's cosine (-1: any direction; 1 with no finite lights) */
+                             (or its negation); with no finite lights, every infinite light's cone
+                             of directions (one-sided); (0, 0, 1) when cos_spread is -1 */
+    float cos_spread;     /* that cone's half-angle's cosine (-1: any direction) */
     float intensity;      /* sum of its finite lights' intensities */
     float irradiance;     /* sum of its infinite lights' irradiances */
     uint32_t first;       /* interior: its first child (the second is first + 1); leaf: the light's index */
@@ -90,18 +94,21 @@ typedef struct light_tree {
 
 /* Builds the light tree over lights[0 .. count - 1] into *out (no config: the build has no
  * knobs). A leaf copies its light's bounds: a finite light's box, axis, cos_spread,
- * one_sided and intensity (irradiance 0); an infinite light's irradiance (empty box, axis
- * (0, 0, 1), cos_spread 1, intensity 0, two-sided). An axis that is not of unit length is
+ * one_sided and intensity (irradiance 0); an infinite light's irradiance, axis and
+ * cos_spread (empty box, intensity 0, not one_sided). An axis that is not of unit length is
  * normalized in the leaf; a zero axis (a degenerate flat light) makes its leaf's cos_spread
  * -1 (any direction); a leaf with cos_spread -1 is never one-sided. An interior node holds
  * the union of its children's boxes and cones and the sums (added up in double) of their
- * intensities and irradiances; it is one-sided when every child with finite lights is, and
- * its cone is then the one-sided union (no axis flipped), else the two-sided one.
+ * intensities and irradiances; with finite lights it is one-sided when every child with
+ * finite lights is, and its cone is then the one-sided union (no axis flipped), else the
+ * two-sided one; a child without finite lights adds nothing to it (only the root has both
+ * kinds, and the walk never weighs the root). A node of infinite lights alone holds the
+ * one-sided union of their cones of directions.
  *
  * Returns RT_OK, or RT_ERROR_RUNTIME with a message starting "LIGHT_TREE: " (the packer
  * makes these bounds, so a bad one is a bug rather than the user's input) for: count 0 or
  * above LIGHT_TREE_MAX_LIGHTS; a NaN or infinite coordinate or min > max in a finite light's
- * box; a NaN or infinite axis of a finite light whose cos_spread is not -1; a cos_spread
+ * box; a NaN or infinite axis of a light whose cos_spread is not -1; a cos_spread
  * outside [-1, 1]; an intensity or irradiance (of any light) that is NaN, infinite or
  * negative; sums too large for a float; out of memory. On error *out is left zeroed and
  * nothing is allocated. The caller frees *out with light_tree_free(). */

@@ -121,8 +121,9 @@ static double scene_radius(const packer *p)
 
 /* Writes the scene's point, spot and sun lights from light first on, with their powers
  * and their bounds for the light tree (a point or spot: its intensity's luminance at a
- * point, a spot's within its outer cone only; a sun: its irradiance's, anywhere). A sun's
- * power is its irradiance over the scene's cross-section. */
+ * point, a spot's within its outer cone only; a sun: its irradiance's, from within its
+ * angular radius of the way towards it). A sun's power is its irradiance over the scene's
+ * cross-section. */
 static void write_scene_lights(packer *p, uint32_t first, double radius, double *power, light_bounds *bounds)
 {
     const scene *s = p->scene;
@@ -153,6 +154,9 @@ static void write_scene_lights(packer *p, uint32_t first, double radius, double 
         if (type == LIGHT_SUN) {
             b->infinite = true;
             b->irradiance = (float)luminance;
+            /* It comes from within its angular radius of the way towards it. */
+            glm_vec3_negate_to((float *)source->direction, b->axis);
+            b->cos_spread = (float)cos_sun;
         } else {
             bvh_box_add_point(&b->box, source->position);
             b->intensity = (float)luminance;

@@ -227,7 +227,8 @@
  *   texel 0 = (box min.xyz of its finite lights, their intensity: the sum of what an
  *             estimate divides by the squared distance)
  *   texel 1 = (box max.xyz, irradiance of its infinite lights (sun, environment))
- *   texel 2 = (axis of the cone of its flat lights' normals and spots' directions,
+ *   texel 2 = (axis of the cone of its flat lights' normals and spots' directions (of a
+ *             node of infinite lights alone: of the directions they come from),
  *             octahedral (packed_encode_normal of core/pack.h), cosine of the cone's
  *             half-angle (-1: lights that shine every way), child: interior: its first
  *             child's node index; leaf: the light's index | LIGHT_TREE_LEAF, flags:

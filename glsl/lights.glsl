@@ -132,7 +132,9 @@ bool chooses_by_tree() { return HAS_LIGHT_TREE && light_tree_offset != NONE; }
 //   (more than encode_receiver's rounding of n), and 0 past a right angle: one-sided, as
 //   direct light is gathered from above the surface only (glsl/direct_light.glsl), so a
 //   box wholly below the surface gets nothing, and every light that can light the point
-//   keeps a chance.
+//   keeps a chance;
+// - for a node of infinite lights alone, the receiver's largest cosine with the directions
+//   they come from (a sun's angular radius; an environment's are all).
 float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
 {
     float intensity = uintBitsToFloat(t0.w);
@@ -185,7 +187,19 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
     }
     // A node of infinite lights alone has an empty box (infinite corners): no finite part.
     float finite = intensity > 0.0 ? intensity * facing / max(max(distance_squared, radius_squared), 1e-30) : 0.0;
-    return uintBitsToFloat(t1.w) + finite;
+    // Its cone holds the directions its lights come from: their irradiance times the
+    // receiver's largest cosine with those (the same bound, margin and one side as above).
+    // Only such nodes have irradiance (the root, which has both, is never weighed).
+    float from_sky = 1.0;
+    if (n != vec3(0.0) && cos_spread > -1.0) {
+        const float COS_SKY_MARGIN = 0.99995, SIN_SKY_MARGIN = 0.0099998;   // 0.01 rad
+        float cos_i = clamp(dot(n, decode_normal(t2.x)), -1.0, 1.0), sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
+        float cos_cone = min(cos_spread, 1.0), sin_cone = sqrt(max(1.0 - cos_cone * cos_cone, 0.0));
+        // receiver angle - the cone's half-angle, then - margin
+        float cos_d = cos_i * cos_cone + sin_i * sin_cone, sin_d = sin_i * cos_cone - cos_i * sin_cone;
+        from_sky = cos_i >= cos_cone ? 1.0 : max(cos_d * COS_SKY_MARGIN + sin_d * SIN_SKY_MARGIN, 0.0);
+    }
+    return uintBitsToFloat(t1.w) * from_sky + finite;
 }
 
 // Walks the light tree from the root to a leaf for point p with normal n (0: none) and

@@ -76,10 +76,19 @@ static light_bounds make_spot(const float centre[3], const float axis[3], float 
     return light;
 }
 
-/* A sun or environment; its unused fields hold what the packer leaves there. */
+/* An environment (light from every direction); its box holds what the packer leaves there. */
 static light_bounds make_infinite(float irradiance)
 {
     light_bounds light = {.box = bvh_box_empty(), .cos_spread = -1, .irradiance = irradiance, .infinite = true};
+    return light;
+}
+
+/* A sun: light from within acos(cos_radius) of the unit direction towards it. */
+static light_bounds make_sun(const float towards[3], float cos_radius, float irradiance)
+{
+    light_bounds light = make_infinite(irradiance);
+    memcpy(light.axis, towards, sizeof light.axis);
+    light.cos_spread = cos_radius;
     return light;
 }
 
@@ -138,8 +147,14 @@ static void random_lights(random_source *source, light_bounds *lights, uint32_t 
             break;
         }
     }
-    for (uint32_t made = 0; made < infinite_count && made < count; made++)
-        lights[random_below(source, count)] = make_infinite(random_float(source, 0, 3));
+    /* Suns (from a small cone of directions) and environments (from all). */
+    for (uint32_t made = 0; made < infinite_count && made < count; made++) {
+        float towards[3];
+        random_unit(source, towards);
+        float irradiance = random_float(source, 0, 3), cos_radius = random_float(source, 0.99f, 1);
+        bool sun = random_below(source, 2) != 0;
+        lights[random_below(source, count)] = sun ? make_sun(towards, cos_radius, irradiance) : make_infinite(irradiance);
+    }
 }
 
 /* ---- tree invariants ---- */
@@ -177,6 +192,16 @@ static void check_light_under(const light_tree_node *node, const light_bounds *l
 {
     if (light->infinite) {
         assert_true(node->irradiance >= light->irradiance);
+        if (!box_is_empty(&node->box))
+            return;   /* the root, with finite lights too: its cone is theirs (never weighed) */
+        /* A node of infinite lights alone: its cone holds each one's directions. */
+        if (light->cos_spread <= -1) {
+            assert_true(node->cos_spread == -1);
+            return;
+        }
+        if (node->cos_spread > -1)
+            assert_true(angle_between(light->axis, node->axis) + acos(light->cos_spread)
+                        <= acos(node->cos_spread) + tolerance);
         return;
     }
     assert_true(box_contains(&node->box, &light->box));
@@ -240,10 +265,9 @@ static void check_tree(const light_tree *tree, const light_bounds *lights, uint3
         assert_close(sqrt((double)node->axis[0] * node->axis[0] + (double)node->axis[1] * node->axis[1] +
                           (double)node->axis[2] * node->axis[2]),
                      1, 1e-5);
-        if (box_is_empty(&node->box)) {  /* no finite lights: no intensity, no cone */
+        if (box_is_empty(&node->box)) {  /* no finite lights: no intensity, never one-sided */
             assert_true(node->intensity == 0);
-            assert_true(node->cos_spread == 1);
-            assert_true(node->axis[2] == 1);
+            assert_false(node->one_sided);
         }
 
         if (node->leaf) {
@@ -256,6 +280,9 @@ static void check_tree(const light_tree *tree, const light_bounds *lights, uint3
             if (light->infinite) {
                 assert_true(box_is_empty(&node->box));
                 assert_true(node->irradiance == light->irradiance);
+                assert_true(node->cos_spread == light->cos_spread);
+                if (light->cos_spread > -1)
+                    assert_memory_equal(node->axis, light->axis, sizeof node->axis);
             } else {
                 assert_true(same_box(&node->box, &light->box));
                 assert_true(node->intensity == light->intensity);
@@ -281,11 +308,13 @@ static void check_tree(const light_tree *tree, const light_bounds *lights, uint3
         double intensity = (double)a->intensity + b->intensity, irradiance = (double)a->irradiance + b->irradiance;
         assert_close(node->intensity, intensity, 1e-5 * intensity);
         assert_close(node->irradiance, irradiance, 1e-5 * irradiance);
-        if (a->cos_spread == -1 || b->cos_spread == -1)
+        /* A child that shines every way makes the node do so, unless it is the infinite
+         * side of the root (whose cone is its finite lights'). */
+        bool finite_a = !box_is_empty(&a->box), finite_b = !box_is_empty(&b->box);
+        if ((a->cos_spread == -1 && (finite_a || !finite_b)) || (b->cos_spread == -1 && (finite_b || !finite_a)))
             assert_true(node->cos_spread == -1);
         /* One-sided exactly when every child with finite lights is (and the cone is not
          * every way). */
-        bool finite_a = !box_is_empty(&a->box), finite_b = !box_is_empty(&b->box);
         bool all_one_sided = (!finite_a || a->one_sided) && (!finite_b || b->one_sided) && (finite_a || finite_b);
         assert_true(node->one_sided == (all_one_sided && node->cos_spread > -1));
         for (uint32_t child = 0; child < 2; child++) {
@@ -394,16 +423,17 @@ static void test_random_sets(void **state)
             random_lights(&source, lights, count, mix, 50, infinite_count);
             light_tree tree;
             build_and_check(lights, count, &tree);
-            if (mix == MIX_FLAT_NEAR_Z) {
+            if (mix == MIX_FLAT_NEAR_Z && !box_is_empty(&tree.nodes[0].box)) {
                 /* Normals within 20 degrees of the z axis (either way): the cones merge
-                 * into one that is still far from "any direction". */
+                 * into one that is still far from "any direction" (the root's cone is
+                 * its finite lights', a set made all suns and skies aside). */
                 assert_true(tree.nodes[0].cos_spread > 0.5f);
                 narrow_roots++;
             }
             light_tree_free(&tree);
         }
     }
-    assert_int_equal(narrow_roots, 12);
+    assert_true(narrow_roots >= 11);
     /* Spots alone: every node one-sided unless its cone went every way (check_tree checks
      * that each holds its spots' cones themselves). */
     random_source spot_source = {31};
@@ -625,6 +655,19 @@ static void test_cone_union(void **state)
     assert_true(tree.nodes[0].one_sided);
     assert_true(tree.nodes[0].cos_spread == cos_narrow);
     assert_memory_equal(tree.nodes[0].axis, x, sizeof x);
+    light_tree_free(&tree);
+
+    /* Suns: a node of suns alone holds the directions they come from (one-sided); with an
+     * environment among them, every direction. */
+    const float sun_a[3] = {0, (float)sin(0.3), (float)cos(0.3)}, sun_b[3] = {0, (float)-sin(0.3), (float)cos(0.3)};
+    light_bounds suns[2] = {make_sun(sun_a, (float)cos(0.01), 1), make_sun(sun_b, (float)cos(0.01), 2)};
+    build_and_check(suns, 2, &tree);
+    assert_close(acos(tree.nodes[0].cos_spread), 0.31, 1e-4);
+    assert_close(tree.nodes[0].axis[2], 1, 1e-6);
+    light_tree_free(&tree);
+    light_bounds sun_and_sky[2] = {make_sun(sun_a, 1, 1), make_infinite(1)};
+    build_and_check(sun_and_sky, 2, &tree);
+    assert_true(tree.nodes[0].cos_spread == -1);
     light_tree_free(&tree);
 
     /* Wide cones more than pi apart in all: any direction. */
