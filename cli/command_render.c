@@ -237,13 +237,25 @@ static void show_summary(void *user, const render_job_image *image, const render
     shown->resumed = false;
     if (shown->arguments->verbose) {
         uint64_t geometry_bytes = result->packed_bytes - result->image_bytes;
+        /* How a point's light is picked (docs/sampling.md), where there is a choice. */
+        char choice[80] = "";
+        if (result->light_choice == RENDER_LIGHTS_NONE && result->light_count > 0)
+            snprintf(choice, sizeof choice, " (not sampled)");
+        else if (result->light_choice == RENDER_LIGHTS_ALL)
+            snprintf(choice, sizeof choice, " (each sampled at every point)");
+        else if (result->light_choice == RENDER_LIGHTS_BY_POINT)
+            snprintf(choice, sizeof choice, " (chosen by the point)");
+        else if (result->light_choice == RENDER_LIGHTS_BY_TREE)
+            snprintf(choice, sizeof choice, " (chosen by a light tree %u levels deep)", result->light_tree_depth);
+        else if (result->light_choice == RENDER_LIGHTS_BY_POWER)
+            snprintf(choice, sizeof choice, " (chosen by power)");
         fprintf(stderr,
-                "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights; BVH depth %d, "
+                "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights%s; BVH depth %d, "
                 "built in %.3f s; packed %llu bytes (%.1f per triangle without images)%s; first pass "
                 "done %.3f s after start (context, parse, BVH, upload, compile); after it %.3f s for "
                 "%llu samples (%.3g us/sample); tracer program %s\n",
                 result->primitive_count, result->triangle_count, result->instance_count, result->light_count,
-                result->bvh_depth, result->bvh_build_seconds, (unsigned long long)result->packed_bytes,
+                choice, result->bvh_depth, result->bvh_build_seconds, (unsigned long long)result->packed_bytes,
                 result->triangle_count ? (double)geometry_bytes / result->triangle_count : 0.0,
                 result->reused_scene ? ", already on the device" : "", shown->first_pass, result->steady_seconds,
                 (unsigned long long)result->steady_samples,

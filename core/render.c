@@ -49,6 +49,18 @@ const char *render_stop_reason_name(render_stop_reason reason)
     }
 }
 
+const char *render_light_choice_name(render_light_choice choice)
+{
+    switch (choice) {
+    case RENDER_LIGHTS_ONE: return "one";
+    case RENDER_LIGHTS_ALL: return "all";
+    case RENDER_LIGHTS_BY_POINT: return "point";
+    case RENDER_LIGHTS_BY_TREE: return "tree";
+    case RENDER_LIGHTS_BY_POWER: return "power";
+    default: return "none";
+    }
+}
+
 /* Fills the tracer's parameters from the scene, its camera frame and the options
  * (tracer_interface.h says what each is); core/gpu_tracer.c adds the device's work cap. */
 static void tracer_parameters(const scene *s, const camera_frame *frame, const render_options *options,
@@ -162,6 +174,25 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
     if (!(materials & 1u << MATERIAL_DIELECTRIC))
         omitted |= GPU_OMIT_DIELECTRIC;
     return omitted;
+}
+
+/* Returns how the tracer picks the light it samples at a point (render.h
+ * render_light_choice), as glsl/direct_light.glsl and glsl/lights.glsl decide it. */
+static render_light_choice light_choice_of(const packed_scene *packed, const render_options *options)
+{
+    uint32_t lights = packed->light_count;
+    bool whitted = options->integrator == INTEGRATOR_WHITTED;
+    if (lights == 0 || (!whitted && options->no_light_sampling))
+        return RENDER_LIGHTS_NONE;
+    if (lights == 1)
+        return RENDER_LIGHTS_ONE;
+    if (whitted && lights <= LIGHT_WHITTED_ALL_MAX)
+        return RENDER_LIGHTS_ALL;
+    if (packed->light_tree_offset != PACKED_NONE && !options->no_light_tree)
+        return RENDER_LIGHTS_BY_TREE;
+    if (!whitted && lights <= LIGHT_LOCAL_CHOICE_MAX)
+        return RENDER_LIGHTS_BY_POINT;
+    return RENDER_LIGHTS_BY_POWER;
 }
 
 /* Returns the scene hash (render.h, render_result): the packed scene's texel hash carried
@@ -466,6 +497,8 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     result->primitive_count = packed.primitive_count;
     result->instance_count = packed.instance_count;
     result->light_count = packed.light_count;
+    result->light_choice = light_choice_of(&packed, options);
+    result->light_tree_depth = result->light_choice == RENDER_LIGHTS_BY_TREE ? packed.light_tree_depth : 0;
     uint64_t hash = scene_hash(s, &packed, &frame, options);
     result->scene_hash = hash;
     if (options->resume != NULL && options->resume_scene_hash != 0 && options->resume_scene_hash != hash) {

@@ -57,6 +57,21 @@
 #include "scene.h"
 #include "status.h"
 
+/* How the tracer picks the light it samples at a point (docs/sampling.md, "Light
+ * sampling"), for a packed scene and the render's options. */
+typedef enum render_light_choice {
+    RENDER_LIGHTS_NONE,       /* no light, or --light-sampling off (path tracing): none sampled */
+    RENDER_LIGHTS_ONE,        /* one light: nothing to choose */
+    RENDER_LIGHTS_ALL,        /* Whitted, up to LIGHT_WHITTED_ALL_MAX lights: each at every point */
+    RENDER_LIGHTS_BY_POINT,   /* 2 to LIGHT_LOCAL_CHOICE_MAX: by each one's estimate at the point */
+    RENDER_LIGHTS_BY_TREE,    /* more: by walking the light tree */
+    RENDER_LIGHTS_BY_POWER,   /* more, with --light-tree off: by power alone */
+} render_light_choice;
+
+/* Returns "none", "one", "all", "point", "tree" or "power": the words of --stats-json's
+ * scene.light_choice (docs/stats-json.md). */
+const char *render_light_choice_name(render_light_choice choice);
+
 /* The integrator: INTEGRATOR_PATH (0, the default) or INTEGRATOR_WHITTED, the ids of
  * core/tracer_interface.h. */
 typedef int render_integrator;
@@ -173,6 +188,8 @@ typedef struct render_result {
     uint64_t image_bytes;        /* of which image pixels */
     uint32_t triangle_count;     /* triangles stored (a mesh once however often placed) */
     uint32_t primitive_count, instance_count, light_count;
+    render_light_choice light_choice;   /* how a point's light to sample is picked */
+    uint32_t light_tree_depth;   /* the light tree's deepest leaf (0: no tree) */
     bool reused_scene;           /* the device already held this packed scene (frames) */
     uint32_t bvh_built, bvh_reused;   /* BVHs built, and taken from options.bvh_cache */
     uint64_t uploaded_bytes;     /* of the packed scene sent to the device for this render:

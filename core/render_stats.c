@@ -234,6 +234,8 @@ static void write_result(json_object *object, const render_stats_image *entry)
     field_integer(&scene, "triangles", r->triangle_count);
     field_integer(&scene, "instances", r->instance_count);
     field_integer(&scene, "lights", r->light_count);
+    field_string(&scene, "light_choice", render_light_choice_name(r->light_choice));
+    field_integer(&scene, "light_tree_depth", r->light_tree_depth);
     field_integer(&scene, "bvh_depth", r->bvh_depth);
     field_integer(&scene, "packed_bytes", (long long)r->packed_bytes);
     field_integer(&scene, "image_bytes", (long long)r->image_bytes);

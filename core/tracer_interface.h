@@ -39,8 +39,12 @@
 #define SAMPLER_COUNT 2
 
 /* ---- light choice (glsl/lights.glsl): scenes of 2 to this many lights choose a light by its
- * estimated irradiance at the point; others by power alone */
+ * estimated irradiance at the point; more by the light tree (or by power alone, with the
+ * tree left out) */
 #define LIGHT_LOCAL_CHOICE_MAX 8
+/* Whitted (glsl/direct_light.glsl) sends a shadow ray to every light of scenes of up to this
+ * many lights, and to one chosen (by the light tree, or by power) beyond */
+#define LIGHT_WHITTED_ALL_MAX 16
 
 /* ---- pass state: one texture per target, read by unit TRACER_STATE_* (sampler binding)
  * and written to colour attachment TRACER_STATE_* (output location) of each pass

@@ -16,7 +16,7 @@
 //     averages to soft shadows.
 const int DIRECT_MIS = 0;
 const int DIRECT_PHONG = 1;
-const uint WHITTED_ALL_LIGHTS = 16u;
+const uint WHITTED_ALL_LIGHTS = uint(LIGHT_WHITTED_ALL_MAX);
 
 // Where and how an integrator asks for direct light after a segment, and, once the
 // segment loop has begun gathering it (begin_direct_light), which lights are left.

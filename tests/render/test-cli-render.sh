@@ -73,4 +73,22 @@ if "$program" render $scene -o "$scratch/out.png" $small && [ "$("$program" stat
 else fail "PNG output" "no 3-channel PNG written"; fi
 
 expect_exit "info runs" 0 "" "$program" info
+
+# --verbose says how a point's light to sample is picked (render.h render_light_choice).
+light_choice() {
+    "$program" render "$@" --size 8x8 --spp 1 -o "$scratch/choice.png" --verbose 2>&1 |
+        sed -n 's/^rtspheres: scene: .* instances, \([^;]*\);.*/\1/p'
+}
+for case in "scenes/many-lights.txt|70 lights (chosen by a light tree 7 levels deep)" \
+            "scenes/many-lights.txt --light-tree off|70 lights (chosen by power)" \
+            "scenes/lights.txt|4 lights (chosen by the point)" \
+            "scenes/lights.txt --integrator whitted|4 lights (each sampled at every point)" \
+            "scenes/lights.txt --light-sampling off|4 lights (not sampled)" \
+            "scenes/cornell.txt|1 lights"; do
+    arguments=${case%%|*} expected=${case#*|}
+    # shellcheck disable=SC2086
+    said=$(light_choice $arguments)
+    if [ "$said" = "$expected" ]; then pass "--verbose: $arguments: $said"
+    else fail "--verbose: $arguments" "said '$said', expected '$expected'"; fi
+done
 finish

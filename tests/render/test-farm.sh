@@ -40,10 +40,10 @@ fi
 if command -v python3 >/dev/null 2>&1; then
     stats_of "$scratch/known.exr"
     channel_samples=$(awk -v m="$(stat_mean samples)" 'BEGIN { printf "%.0f", m * 32 * 18 }')
-    got=$(json "$scratch/known.json" '"%s %d %s %d %d %d %d %s %d %d %d" % (d["schema"], d["version"], i["outcome"], i["width"], i["height"], i["spp"], i["samples"], i["stop_reason"], i["spp_per_pixel"]["min"], i["spp_per_pixel"]["max"], len(d["images"])) if (i := d["images"][0]) else ""')
-    expected="rtspheres-render-stats 1 rendered 32 18 16 9216 spp 16 16 1"
+    got=$(json "$scratch/known.json" '"%s %d %s %d %d %d %d %s %d %d %d %d %s" % (d["schema"], d["version"], i["outcome"], i["width"], i["height"], i["spp"], i["samples"], i["stop_reason"], i["spp_per_pixel"]["min"], i["spp_per_pixel"]["max"], len(d["images"]), i["scene"]["lights"], i["scene"]["light_choice"]) if (i := d["images"][0]) else ""')
+    expected="rtspheres-render-stats 1 rendered 32 18 16 9216 spp 16 16 1 1 one"
     if [ "$got" = "$expected" ] && [ "$channel_samples" = 9216 ]; then
-        pass "stats JSON holds the known render: 32x18, 16 spp, 9216 samples (the samples channel's sum), stop reason spp"
+        pass "stats JSON holds the known render: 32x18, 16 spp, 9216 samples (the samples channel's sum), stop reason spp, one light"
     else
         fail "stats JSON of a known render" "got '$got', expected '$expected'; samples channel sum $channel_samples"
     fi
