@@ -52,6 +52,27 @@ else
     fail "deep mirrors" "render failed"
 fi
 
+# same_at_budgets NAME SCENE [OPTIONS...]: one check: SCENE rendered with OPTIONS at the
+# smallest pass budget (300) and the largest (50000) gives the same image, bit for bit.
+same_at_budgets() {
+    name=$1 scene=$2
+    shift 2
+    stem=$(printf '%s' "$name" | tr -c 'a-z0-9' '-')
+    for budget in 300 50000; do
+        if ! "$program" render "$scene" -o "$scratch/$stem-$budget.exr" --pass-budget $budget --quiet "$@" \
+            2>"$scratch/$stem-$budget.log"; then
+            fail "$name, pass budget $budget" "render failed: $(tr '\n' ' ' <"$scratch/$stem-$budget.log")"
+            return
+        fi
+    done
+    if "$program" diff "$scratch/$stem-50000.exr" "$scratch/$stem-300.exr" --fail 0 --failpercent 0 \
+        >"$scratch/$stem.diff" 2>&1; then
+        pass "$name: the largest pass budget renders the image of the smallest"
+    else
+        fail "$name" "$(tr '\n' ' ' <"$scratch/$stem.diff")"
+    fi
+}
+
 # Every loop the tracer has, in every segment (see the scene): the smallest budget (a
 # segment or so per pass) and the largest the device allows (50000 asks for the most;
 # it is clamped to `rtspheres info`'s bound) must give the same image, for both
@@ -63,47 +84,17 @@ for variant in path whitted full; do
         whitted) options="--integrator whitted" ;;
         full) options="--full-tracer" ;;
     esac
-    small="$scratch/stress-$variant-300.exr" large="$scratch/stress-$variant-max.exr"
     # shellcheck disable=SC2086
-    if "$program" render tests/render/scenes/loop-stress.txt -o "$small" --pass-budget 300 --quiet $options &&
-       "$program" render tests/render/scenes/loop-stress.txt -o "$large" --pass-budget 50000 --quiet $options; then
-        if "$program" diff "$large" "$small" --fail 0 --failpercent 0 >"$scratch/stress-$variant.diff" 2>&1; then
-            pass "loop stress ($variant): the largest pass budget gives the image of the smallest"
-        else
-            fail "loop stress ($variant)" "the images differ: $(tr '\n' ' ' <"$scratch/stress-$variant.diff")"
-        fi
-    else
-        fail "loop stress ($variant)" "render failed"
-    fi
+    same_at_budgets "loop stress ($variant)" tests/render/scenes/loop-stress.txt $options
 done
 
 # Many lights (70: the light tree) and paths whose next emitter hit comes in the next pass:
 # the choice memo (the normal the walk used, glsl/lights.glsl choose_light_at) must come
 # through the pass state, or MIS weighs those hits otherwise and the image changes.
-for budget in 300 50000; do
-    "$program" render scenes/many-lights.txt -o "$scratch/many-lights-$budget.exr" --size 12x8 --spp 64 \
-        --pass-budget $budget --quiet 2>"$scratch/many-lights-$budget.log" ||
-        fail "many lights, pass budget $budget" "render failed: $(tr '\n' ' ' <"$scratch/many-lights-$budget.log")"
-done
-if "$program" diff "$scratch/many-lights-50000.exr" "$scratch/many-lights-300.exr" --fail 0 --failpercent 0 \
-    >"$scratch/many-lights.diff" 2>&1; then
-    pass "many lights (light tree): the largest pass budget renders the image of the smallest"
-else
-    fail "many lights (light tree)" "$(tr '\n' ' ' <"$scratch/many-lights.diff")"
-fi
+same_at_budgets "many lights (light tree)" scenes/many-lights.txt --size 12x8 --spp 64
 
 # A Whitted vertex's shadow rays to 16 lights through foggy balls, at the largest budget
 # (see the scene): the render must not reach the work cap, and gives the image of the
 # smallest budget.
-for budget in 300 50000; do
-    "$program" render tests/render/scenes/lights-behind-volumes.txt -o "$scratch/lights-volumes-$budget.exr" \
-        --integrator whitted --pass-budget $budget --quiet 2>"$scratch/lights-volumes-$budget.log" ||
-        fail "lights behind volumes, pass budget $budget" "render failed: $(tr '\n' ' ' <"$scratch/lights-volumes-$budget.log")"
-done
-if "$program" diff "$scratch/lights-volumes-50000.exr" "$scratch/lights-volumes-300.exr" --fail 0 --failpercent 0 \
-    >"$scratch/lights-volumes.diff" 2>&1; then
-    pass "lights behind volumes (whitted): the largest pass budget renders the image of the smallest"
-else
-    fail "lights behind volumes (whitted)" "$(tr '\n' ' ' <"$scratch/lights-volumes.diff")"
-fi
+same_at_budgets "lights behind volumes (whitted)" tests/render/scenes/lights-behind-volumes.txt --integrator whitted
 finish
