@@ -148,16 +148,19 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
     float sin_box = distance_squared > radius_squared ? sqrt(radius_squared / distance_squared) : 1.0;
     float cos_box = sqrt(max(1.0 - sin_box * sin_box, 0.0));
     const float COS_MARGIN = 0.9999995, SIN_MARGIN = 0.001;   // of a thousandth of a radian
+    // The receiver's bounds' margin: 0.01 rad.
+    const float COS_RECEIVER_MARGIN = 0.99995, SIN_RECEIVER_MARGIN = 0.0099998;
+    vec3 axis = decode_normal(t2.x);
+    float cos_cone = min(cos_spread, 1.0), sin_cone = sqrt(max(1.0 - cos_cone * cos_cone, 0.0));
     float facing = 1.0;
     if (cos_spread > -1.0) {
-        float axis_cosine = clamp(dot(decode_normal(t2.x), to_p) / max(distance, 1e-30), -1.0, 1.0);
+        float axis_cosine = clamp(dot(axis, to_p) / max(distance, 1e-30), -1.0, 1.0);
         float cos_axis = abs(axis_cosine);
         // cos(max(axis angle - spread - box angle - margin, 0)) by the angle-difference
         // identities, without acos, asin and cos (each a long polynomial on llvmpipe, in a
         // loop that runs them for both children at every level); an angle that goes below
         // zero on the way gives 1.
         float sin_axis = sqrt(max(1.0 - cos_axis * cos_axis, 0.0));
-        float cos_cone = min(cos_spread, 1.0), sin_cone = sqrt(max(1.0 - cos_cone * cos_cone, 0.0));
         // axis angle - spread
         float cos_a = cos_axis * cos_cone + sin_axis * sin_cone, sin_a = sin_axis * cos_cone - cos_axis * sin_cone;
         // ... - box angle
@@ -176,7 +179,6 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
     if (n != vec3(0.0)) {
         // cos(max(receiver angle - box angle - margin, 0)), 0 past a right angle; the
         // receiver angle runs to pi, so "below zero" is told by the cosines.
-        const float COS_RECEIVER_MARGIN = 0.99995, SIN_RECEIVER_MARGIN = 0.0099998;   // 0.01 rad
         float cos_i = clamp(-dot(n, to_p) / max(distance, 1e-30), -1.0, 1.0);
         float sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
         // receiver angle - box angle
@@ -192,12 +194,10 @@ float tree_node_importance(uvec4 t0, uvec4 t1, uvec4 t2, vec3 p, vec3 n)
     // Only such nodes have irradiance (the root, which has both, is never weighed).
     float from_sky = 1.0;
     if (n != vec3(0.0) && cos_spread > -1.0) {
-        const float COS_SKY_MARGIN = 0.99995, SIN_SKY_MARGIN = 0.0099998;   // 0.01 rad
-        float cos_i = clamp(dot(n, decode_normal(t2.x)), -1.0, 1.0), sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
-        float cos_cone = min(cos_spread, 1.0), sin_cone = sqrt(max(1.0 - cos_cone * cos_cone, 0.0));
+        float cos_i = clamp(dot(n, axis), -1.0, 1.0), sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
         // receiver angle - the cone's half-angle, then - margin
         float cos_d = cos_i * cos_cone + sin_i * sin_cone, sin_d = sin_i * cos_cone - cos_i * sin_cone;
-        from_sky = cos_i >= cos_cone ? 1.0 : max(cos_d * COS_SKY_MARGIN + sin_d * SIN_SKY_MARGIN, 0.0);
+        from_sky = cos_i >= cos_cone ? 1.0 : max(cos_d * COS_RECEIVER_MARGIN + sin_d * SIN_RECEIVER_MARGIN, 0.0);
     }
     return uintBitsToFloat(t1.w) * from_sky + finite;
 }
