@@ -138,6 +138,7 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_ALPHA_MASK      no alpha-masked material (the traversal's alpha test)
  *   GPU_OMIT_VERTEX_COLORS   no vertex colour section
  *   GPU_OMIT_LIGHT_GROUPS    no light group layers asked for (render_options.light_groups)
+ *   GPU_OMIT_DIRECT_EMISSION  no direct emission sums asked for (render_options.direct_emission)
  *   GPU_OMIT_SPHERE_LIGHTS, GPU_OMIT_TRIANGLE_LIGHTS, GPU_OMIT_DELTA_LIGHTS (point, spot,
  *   GPU_OMIT_ENVIRONMENT_LIGHT  sun)  no light of that kind in the light section
  *   GPU_OMIT_MANY_LIGHTS     at most one light: no light to choose, no search for a hit
@@ -174,6 +175,7 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_METAL (1u << 22)
 #define GPU_OMIT_DIELECTRIC (1u << 23)
 #define GPU_OMIT_LIGHT_TREE (1u << 24)
+#define GPU_OMIT_DIRECT_EMISSION (1u << 25)
 #define GPU_VARIANT_BITS 25
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
@@ -291,6 +293,13 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
  * (sum of the group's radiance over the samples gathered r, g, b, 0). Other tracers:
  * RT_ERROR_RUNTIME. */
 rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error);
+
+/* Reads the direct emission sums (glsl/direct_emission.glsl) of a tracer created with
+ * shader.direct_emission nonzero and without GPU_OMIT_DIRECT_EMISSION: sums receives
+ * width * height * 4 floats, rows top to bottom, (sum over the pixel's samples of the
+ * radiance their first segment brought from an emitter or the sky r, g, b, 0). Other
+ * tracers: RT_ERROR_RUNTIME. */
+rt_status gpu_tracer_read_direct_emission(gpu_tracer *tracer, float *sums, rt_error *error);
 
 /* Reads the per-channel sums of squares: squares receives width*height*4 floats, rows top
  * to bottom, (sum of finished samples' squared radiance r^2, g^2, b^2, 0), from which

@@ -326,7 +326,7 @@ rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels,
     }
     /* Light group layers are added to at the pixel itself (glsl/light_groups.glsl): two
      * slots of one pixel in one pass would lose each other's additions. */
-    c->runs = runs < 1 || tracer->light_group_texture != 0 ? 1 : runs;
+    c->runs = runs < 1 || tracer->light_group_texture != 0 || tracer->direct_emission_texture != 0 ? 1 : runs;
     c->count = count;
     status = start_round(tracer, 0, error);
     if (status != RT_OK)

@@ -84,6 +84,8 @@ struct gpu_tracer {
     gpu_compact compact;         /* compacted passes (gpu_compact.c) */
     GLuint light_group_texture;  /* the light group layers (2D array, rgba32f), or 0 when the
                                   * program has no light group code */
+    GLuint direct_emission_texture;  /* the direct emission sums (a 2D array of one rgba32f
+                                      * layer), or 0 when the program has no such code */
     int current;                 /* which state set holds the latest pass */
     uint64_t passes;             /* passes run */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */

@@ -196,6 +196,7 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
         {GPU_OMIT_METAL, "RTSPHERES_OMIT_METAL"},
         {GPU_OMIT_DIELECTRIC, "RTSPHERES_OMIT_DIELECTRIC"},
         {GPU_OMIT_LIGHT_TREE, "RTSPHERES_OMIT_LIGHT_TREE"},
+        {GPU_OMIT_DIRECT_EMISSION, "RTSPHERES_OMIT_DIRECT_EMISSION"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;
@@ -442,25 +443,41 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     return status;
 }
 
-/* Creates the light group layers when the program collects them: one rgba32f layer per
- * group (light_group_count), zeroed; a single texel when the program has the code but no
- * group is asked for (the full tracer), so that its image unit is never unbound. */
-static rt_status create_light_groups(gpu_tracer *tracer, rt_error *error)
+/* Creates *texture, layers rgba32f layers of the image's size (a 2D array), zeroed, that
+ * passes add sums to by image load and store: the light group layers and the direct
+ * emission sums. A single texel when the program has the code but nothing is asked for
+ * (the full tracer), so that its image unit is never unbound. what names it in messages. */
+static rt_status create_sum_layers(gpu_tracer *tracer, uint32_t layers, GLuint *texture, const char *what,
+                                   rt_error *error)
 {
-    if (tracer->parameters.omitted_features & GPU_OMIT_LIGHT_GROUPS)
-        return RT_OK;
-    uint32_t layers = tracer->parameters.shader.light_group_count;
     int width = layers > 0 ? tracer->width : 1, height = layers > 0 ? tracer->height : 1;
-    glGenTextures(1, &tracer->light_group_texture);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, tracer->light_group_texture);
+    glGenTextures(1, texture);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, *texture);
     glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, width, height, layers > 0 ? (GLsizei)layers : 1);
     const GLfloat zero[4] = {0, 0, 0, 0};
-    glClearTexImage(tracer->light_group_texture, 0, GL_RGBA, GL_FLOAT, zero);
+    glClearTexImage(*texture, 0, GL_RGBA, GL_FLOAT, zero);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
-    rt_status status = gpu_check_gl("creating the light group layers", error);
+    char doing[64];
+    snprintf(doing, sizeof doing, "creating the %s", what);
+    rt_status status = gpu_check_gl(doing, error);
     if (status != RT_OK && strstr(error->message, "OUT_OF_MEMORY"))
-        return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for %u light group layers of %dx%d (%d MB)",
+        return rt_error_set(error, RT_ERROR_INPUT, "GPU: not enough memory for the %s (%u of %dx%d, %d MB)", what,
                             layers, width, height, (int)((double)width * height * 16 * layers / 1e6));
+    return status;
+}
+
+/* Creates the sum layers the program collects into: one per light group (light_group_count),
+ * and the direct emission's. */
+static rt_status create_sums(gpu_tracer *tracer, rt_error *error)
+{
+    uint32_t omitted = tracer->parameters.omitted_features;
+    rt_status status = RT_OK;
+    if (!(omitted & GPU_OMIT_LIGHT_GROUPS))
+        status = create_sum_layers(tracer, tracer->parameters.shader.light_group_count, &tracer->light_group_texture,
+                                   "light group layers", error);
+    if (status == RT_OK && !(omitted & GPU_OMIT_DIRECT_EMISSION))
+        status = create_sum_layers(tracer, tracer->parameters.shader.direct_emission != 0 ? 1 : 0,
+                                   &tracer->direct_emission_texture, "direct emission sums", error);
     return status;
 }
 
@@ -596,7 +613,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->parameters.resume = NULL;
     glGenBuffers(1, &tracer->parameter_buffer);
     upload_parameters(tracer);
-    status = create_light_groups(tracer, error);
+    status = create_sums(tracer, error);
     if (status == RT_OK)
         status = gpu_check_gl("setting up the tracer", error);
     if (status != RT_OK) {
@@ -640,6 +657,9 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     if (tracer->light_group_texture != 0)
         glBindImageTexture(TRACER_LIGHT_GROUP_IMAGE_UNIT, tracer->light_group_texture, 0, GL_TRUE, 0, GL_READ_WRITE,
                            GL_RGBA32F);
+    if (tracer->direct_emission_texture != 0)
+        glBindImageTexture(TRACER_DIRECT_EMISSION_IMAGE_UNIT, tracer->direct_emission_texture, 0, GL_FALSE, 0,
+                           GL_READ_WRITE, GL_RGBA32F);
     glBindVertexArray(tracer->vertex_array);
     if (compacted)
         gpu_compact_scissor(tracer, true);
@@ -648,8 +668,8 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
         gpu_compact_scissor(tracer, false);
     /* Image stores of this pass are read by the next pass and by the read-back. */
     glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT
-                    | (tracer->light_group_texture != 0 ? GL_SHADER_IMAGE_ACCESS_BARRIER_BIT
-                                                              | GL_TEXTURE_UPDATE_BARRIER_BIT : 0));
+                    | (tracer->light_group_texture != 0 || tracer->direct_emission_texture != 0
+                           ? GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT : 0));
     GLuint counters[2] = {0, 0};
     glGetBufferSubData(GL_ATOMIC_COUNTER_BUFFER, 0, sizeof counters, counters);
     tracer->current = target;
@@ -734,17 +754,17 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
     return gpu_check_gl("reading the result", error);
 }
 
-rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error)
+/* Reads count sum layers of texture (create_sum_layers) into layers, layer after layer, rows
+ * top to bottom. */
+static rt_status read_sum_layers(gpu_tracer *tracer, GLuint texture, uint32_t count, float *layers, const char *what,
+                                 rt_error *error)
 {
-    uint32_t count = tracer->parameters.shader.light_group_count;
-    if (tracer->light_group_texture == 0 || count == 0)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: this tracer collects no light groups");
     size_t row_floats = (size_t)tracer->width * 4, layer_floats = row_floats * tracer->height;
     float *bottom_up = malloc(layer_floats * count * sizeof(float));
     if (bottom_up == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the light groups");
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the %s", what);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, tracer->light_group_texture);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, texture);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glGetTexImage(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA, GL_FLOAT, bottom_up);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
@@ -754,7 +774,24 @@ rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_err
                    bottom_up + layer * layer_floats + (size_t)(tracer->height - 1 - row) * row_floats,
                    row_floats * sizeof(float));
     free(bottom_up);
-    return gpu_check_gl("reading the light groups", error);
+    char doing[64];
+    snprintf(doing, sizeof doing, "reading the %s", what);
+    return gpu_check_gl(doing, error);
+}
+
+rt_status gpu_tracer_read_light_groups(gpu_tracer *tracer, float *layers, rt_error *error)
+{
+    uint32_t count = tracer->parameters.shader.light_group_count;
+    if (tracer->light_group_texture == 0 || count == 0)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: this tracer collects no light groups");
+    return read_sum_layers(tracer, tracer->light_group_texture, count, layers, "light groups", error);
+}
+
+rt_status gpu_tracer_read_direct_emission(gpu_tracer *tracer, float *sums, rt_error *error)
+{
+    if (tracer->direct_emission_texture == 0 || tracer->parameters.shader.direct_emission == 0)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: this tracer sums no direct emission");
+    return read_sum_layers(tracer, tracer->direct_emission_texture, 1, sums, "direct emission sums", error);
 }
 
 rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error)
@@ -858,6 +895,7 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
         glDeleteBuffers(1, &tracer->packed_buffer);
     }
     glDeleteTextures(1, &tracer->light_group_texture);
+    glDeleteTextures(1, &tracer->direct_emission_texture);
     glDeleteBuffers(1, &tracer->counter_buffer);
     glDeleteBuffers(1, &tracer->parameter_buffer);
     glDeleteVertexArrays(1, &tracer->vertex_array);

@@ -351,10 +351,13 @@ static rt_status check_option(float value, const char *name, rt_error *error)
     return RT_OK;
 }
 
-rt_status postprocess_denoise(rt_image *colour, const rt_image *albedo, const rt_image *normal,
-                              const rt_image *depth, const postprocess_denoise_options *options,
-                              rt_error *error)
+rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides *given_guides,
+                              const postprocess_denoise_options *options, rt_error *error)
 {
+    postprocess_denoise_guides none = {0};
+    const postprocess_denoise_guides *g = given_guides != NULL ? given_guides : &none;
+    const rt_image *albedo = g->albedo, *normal = g->normal, *depth = g->depth, *emission = g->emission,
+                   *mean_variance = g->variance;
     rt_status status = check_image(colour, "colour", error);
     if (status == RT_OK && colour->channels < 3)
         status = rt_error_set(error, RT_ERROR_INPUT, "POSTPROCESS: the colour image has %d channel%s, 3 needed",
@@ -365,6 +368,10 @@ rt_status postprocess_denoise(rt_image *colour, const rt_image *albedo, const rt
         status = check_guide(normal, "normal", colour, 3, error);
     if (status == RT_OK)
         status = check_guide(depth, "depth", colour, 1, error);
+    if (status == RT_OK)
+        status = check_guide(emission, "emission", colour, 3, error);
+    if (status == RT_OK)
+        status = check_guide(mean_variance, "variance", colour, 1, error);
     if (status != RT_OK)
         return status;
 
@@ -383,13 +390,18 @@ rt_status postprocess_denoise(rt_image *colour, const rt_image *albedo, const rt
 
     size_t count = pixel_count(colour);
     int channels = colour->channels;
-    for (size_t i = 0; i < count; i++)
-        for (int c = 0; c < 3; c++)
-            if (!isfinite(colour->pixels[i * channels + c]))
-                return rt_error_set(error, RT_ERROR_INPUT,
-                                    "POSTPROCESS: the colour image has %s at pixel (%d, %d), channel %d",
-                                    isnan(colour->pixels[i * channels + c]) ? "NaN" : "an infinity",
-                                    (int)(i % colour->width), (int)(i / colour->width), c);
+    const rt_image *checked_images[2] = {colour, emission};
+    for (int k = 0; k < 2; k++) {
+        const rt_image *image = checked_images[k];
+        for (size_t i = 0; image != NULL && i < count; i++)
+            for (int c = 0; c < 3; c++)
+                if (!isfinite(image->pixels[i * image->channels + c]))
+                    return rt_error_set(error, RT_ERROR_INPUT,
+                                        "POSTPROCESS: the %s image has %s at pixel (%d, %d), channel %d",
+                                        k == 0 ? "colour" : "emission",
+                                        isnan(image->pixels[i * image->channels + c]) ? "NaN" : "an infinity",
+                                        (int)(i % colour->width), (int)(i / colour->width), c);
+    }
 
     int iterations = given.iterations != 0 ? given.iterations : DEFAULT_ITERATIONS;
     float sigma_normal = or_default(given.sigma_normal, DEFAULT_SIGMA_NORMAL);
@@ -423,13 +435,29 @@ rt_status postprocess_denoise(rt_image *colour, const rt_image *albedo, const rt
     load_guides(albedo, normal, depth, colour->width, colour->height, guides);
     d.guides = guides;
 
-    /* Demodulate: filter the lighting, not the texture. */
+    /* Demodulate: filter the lighting, not the texture, and not the emission seen at once. */
     for (size_t i = 0; i < count; i++)
         for (int c = 0; c < 3; c++) {
             float divisor = albedo != NULL ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
-            signal[3 * i + c] = colour->pixels[i * channels + c] / divisor;
+            float direct = emission != NULL ? emission->pixels[i * emission->channels + c] : 0.0f;
+            signal[3 * i + c] = (colour->pixels[i * channels + c] - direct) / divisor;
         }
+    /* The noise: measured around each pixel, or the render's own estimate where it has one,
+     * in the demodulated signal's units. */
     estimate_variance(&d, signal, variance);
+    if (mean_variance != NULL) {
+        for (size_t i = 0; i < count; i++) {
+            float v = mean_variance->pixels[i * mean_variance->channels];
+            if (!(v >= 0.0f) || !isfinite(v))
+                continue;
+            double total = 0.0;
+            for (int c = 0; c < 3; c++) {
+                float divisor = albedo != NULL ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
+                total += v / ((double)divisor * divisor);
+            }
+            variance[i] = (float)(total / 3.0);
+        }
+    }
     for (int i = 0; i < iterations; i++) {
         atrous_iteration(&d, 1 << i, signal, variance, blurred_variance, filtered, filtered_variance);
         float *swap = signal;
@@ -442,7 +470,8 @@ rt_status postprocess_denoise(rt_image *colour, const rt_image *albedo, const rt
     for (size_t i = 0; i < count; i++)
         for (int c = 0; c < 3; c++) {
             float factor = albedo != NULL ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
-            colour->pixels[i * channels + c] = signal[3 * i + c] * factor;
+            float direct = emission != NULL ? emission->pixels[i * emission->channels + c] : 0.0f;
+            colour->pixels[i * channels + c] = signal[3 * i + c] * factor + direct;
         }
 
 done:

@@ -25,7 +25,10 @@
  * al., HPG 2017):
  *   1. Demodulation: with an albedo image, colour / max(albedo, albedo_epsilon) per
  *      channel is filtered (the lighting, smooth across texture edges) and multiplied
- *      back afterwards, so textures stay as sharp as the albedo image.
+ *      back afterwards, so textures stay as sharp as the albedo image. With an emission
+ *      image, that part of the colour (what camera rays saw of emitters and the sky at
+ *      once: no noise but the pixel's coverage) is taken out first and added back
+ *      unfiltered, so a pixel that a light covers in part keeps its share of the light.
  *   2. Each iteration i = 0 .. iterations-1 convolves with the 5x5 B3-spline kernel
  *      (1/16, 1/4, 3/8, 1/4, 1/16 in each direction) whose taps are 2^i pixels apart
  *      (steps 1, 2, 4, 8, 16: a 125-pixel footprint after 5 iterations for 25 taps a
@@ -43,11 +46,14 @@
  *        albedo  exp(-|a_q - a_p|^2 / sigma_albedo^2)
  *      and the weighted sum is divided by the sum of the weights. Taps outside the image
  *      are left out.
- *   3. Noise estimate: before the first iteration, the variance of each pixel's colour
- *      over its 7x7 neighbourhood (weighted by the normal, depth and albedo weights, so
- *      edges do not count as noise); each iteration carries it along as the variance of
- *      the weighted mean (sum (h w)^2 var_q / (sum h w)^2), and the colour weight reads it
- *      blurred over 3x3.
+ *   3. Noise estimate: before the first iteration, from the variance guide where it has a
+ *      value (>= 0: the variance of the pixel's mean luminance, divided by the squared
+ *      demodulation divisor and averaged over the channels), else the variance of the
+ *      pixel's colour over its 7x7 neighbourhood (weighted by the normal, depth and
+ *      albedo weights, so edges do not count as noise; but a highlight only the colour
+ *      shows counts as noise there, and is spread out); each iteration carries it along
+ *      as the variance of the weighted mean (sum (h w)^2 var_q / (sum h w)^2), and the
+ *      colour weight reads it blurred over 3x3.
  * Depth is a distance; a pixel whose depth is 0, negative, infinite or NaN hit nothing
  * (sky): such pixels form their own class and never mix with pixels that hit something.
  * Between two sky pixels only the colour weight counts.
@@ -65,7 +71,10 @@
  * 0.5 region loses 800x its variance (a tilted plane 1000x); a step from 0.2 to 0.8 with
  * 20% noise, where the normal or the depth changes, keeps both sides' means and the
  * columns next to it within 1% (variance 1300x to 2700x lower); a 0.2/0.8 albedo checker
- * of 4x4 cells under 10% noise keeps its contrast within 0.5% and every pixel within 2.3%.
+ * of 4x4 cells under 10% noise keeps its contrast within 0.5% and every pixel within 2.3%;
+ * a noise-free 2x2 highlight of 5 on that region keeps 5.000 with the variance guide (0.80
+ * without); a column that a light of 10 covers at 30% keeps its value within 1% with the
+ * emission guide (20% off without). On renders: docs/sampling.md, "Denoising".
  *
  * ## Tone mapping
  * postprocess_tonemap() multiplies the colour channels by 2^exposure_stops, then:
@@ -120,6 +129,18 @@ typedef enum postprocess_tonemap_operator {
     TONEMAP_ACES,
 } postprocess_tonemap_operator;
 
+/* The images that guide postprocess_denoise(), each of the colour image's size and each
+ * NULL to go without it. */
+typedef struct postprocess_denoise_guides {
+    const rt_image *albedo;      /* three channels or more; the demodulation's divisor */
+    const rt_image *normal;      /* three channels or more, unit length */
+    const rt_image *depth;       /* the first channel: distance to the first hit */
+    const rt_image *emission;    /* three channels or more: the part of colour with no noise to
+                                  * remove (emitters and sky seen at once); not filtered */
+    const rt_image *variance;    /* the first channel: the variance of each pixel's mean
+                                  * luminance (its samples' variance over their count) */
+} postprocess_denoise_guides;
+
 /* Returns options with every field at its default (all zero). */
 postprocess_denoise_options postprocess_denoise_options_defaults(void);
 
@@ -129,16 +150,14 @@ postprocess_denoise_options postprocess_denoise_options_defaults(void);
  * RT_ERROR_INPUT; out of memory RT_ERROR_RUNTIME. */
 rt_status postprocess_gaussian_blur(rt_image *image, float sigma_pixels, int passes, rt_error *error);
 
-/* Denoises the colour channels of colour in place (see above), guided by albedo (three
- * channels or more), normal (three or more, unit length) and depth (the first channel;
- * one expected), each of which may be NULL to go without that guide (without albedo there
- * is no demodulation). options may be NULL for the defaults. Guides of another size, too
- * few channels, a non-finite colour value, a negative or NaN option or more than
- * POSTPROCESS_MAX_DENOISE_ITERATIONS iterations are RT_ERROR_INPUT; out of memory
- * RT_ERROR_RUNTIME. Nothing is allocated for the caller. */
-rt_status postprocess_denoise(rt_image *colour, const rt_image *albedo, const rt_image *normal,
-                              const rt_image *depth, const postprocess_denoise_options *options,
-                              rt_error *error);
+/* Denoises the colour channels of colour in place (see above), guided by the images of
+ * guides (NULL: none; without albedo there is no demodulation, without variance the noise
+ * is measured around each pixel). options may be NULL for the defaults. Guides of another
+ * size, too few channels, a non-finite colour or emission value, a negative or NaN option
+ * or more than POSTPROCESS_MAX_DENOISE_ITERATIONS iterations are RT_ERROR_INPUT; out of
+ * memory RT_ERROR_RUNTIME. Nothing is allocated for the caller. */
+rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides *guides,
+                              const postprocess_denoise_options *options, rt_error *error);
 
 /* Exposes and tone-maps the colour channels of image in place for an 8-bit output (see
  * above). An unknown operator, a non-finite exposure or an empty image are

@@ -30,6 +30,8 @@ uint64_t render_bytes_per_pixel(const render_options *options, int light_group_c
         bytes += 2 * 16 + 2 * 16 + 16 + 2 * 32 + 4;
     if (options->variance)       /* the squares and GL's copy, the 3 layers, joined to the AOVs */
         bytes += 2 * 16 + 12 + 44;
+    if (options->direct_emission)   /* the sums on the device, their read-back and copy, 3 channels twice */
+        bytes += 16 + 2 * 16 + 2 * 12;
     if (options->light_groups)   /* per group: the layer on the device, its read-back and copy, 3 channels twice */
         bytes += (uint64_t)light_group_count * (16 + 2 * 16 + 2 * 12);
     if (options->noise_threshold > 0)   /* the checks' read-back, limits, the sampler's arrays; */
@@ -105,6 +107,7 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
     memcpy(p->ambient, s->ambient, sizeof p->ambient);
     p->light_group_count = options->light_groups ? (uint32_t)s->light_group_count : 0;
     p->sky_light_group = (uint32_t)s->sky.light_group;
+    p->direct_emission = options->direct_emission;
     p->pass_work_budget = (int32_t)(options->pass_work_budget ? options->pass_work_budget : INITIAL_ADAPTIVE_BUDGET);
 }
 
@@ -153,6 +156,8 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_VERTEX_COLORS;
     if (!options->light_groups)
         omitted |= GPU_OMIT_LIGHT_GROUPS;
+    if (!options->direct_emission)
+        omitted |= GPU_OMIT_DIRECT_EMISSION;
     uint32_t lights = contents->light_types;
     if (!(lights & 1u << LIGHT_SPHERE))
         omitted |= GPU_OMIT_SPHERE_LIGHTS;
@@ -340,6 +345,25 @@ static rt_status render_aovs(gpu_tracer *tracer, int width, int height, const rt
     return status;
 }
 
+/* Appends the channels of layers to result->aovs (or makes them the AOVs when there are
+ * none yet); layers is consumed either way. */
+static rt_status append_to_aovs(render_result *result, rt_image *layers, rt_error *error)
+{
+    if (result->aovs.pixels == NULL) {
+        result->aovs = *layers;
+        *layers = (rt_image){0};
+        return RT_OK;
+    }
+    rt_image joined;
+    rt_status status = image_append_channels(&result->aovs, layers, &joined, error);
+    if (status == RT_OK) {
+        image_free(&result->aovs);
+        result->aovs = joined;
+    }
+    image_free(layers);
+    return status;
+}
+
 /* Builds the variance layers variance.R/G/B: each pixel's sample variance of each colour
  * channel, E[c^2] - E[c]^2 over its finished samples (as variance.Y is of luminance), from
  * the means in colour and the tracer's sums of squares (width*height*4). Float rounding
@@ -378,17 +402,37 @@ static rt_status add_variance_layers(gpu_tracer *tracer, int width, int height, 
     if (status == RT_OK)
         status = variance_layers(width, height, &result->image, squares, &layers, error);
     free(squares);
-    if (status == RT_OK && result->aovs.pixels != NULL) {
-        rt_image joined;
-        status = image_append_channels(&result->aovs, &layers, &joined, error);
-        if (status == RT_OK) {
-            image_free(&result->aovs);
-            result->aovs = joined;
+    if (status == RT_OK)
+        status = append_to_aovs(result, &layers, error);
+    return status;
+}
+
+/* Appends emission.R/G/B to result->aovs (render_result): the tracer's direct emission sums
+ * over each pixel's finished samples divided by their count, as the beauty's means are. */
+static rt_status add_direct_emission_layer(gpu_tracer *tracer, int width, int height, render_result *result,
+                                           rt_error *error)
+{
+    size_t pixel_count = (size_t)width * height;
+    float *sums = malloc(pixel_count * 4 * sizeof *sums);
+    if (sums == NULL)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
+    rt_image layer = {0};
+    rt_status status = gpu_tracer_read_direct_emission(tracer, sums, error);
+    if (status == RT_OK)
+        status = image_create(&layer, width, height, 3, error);
+    if (status == RT_OK) {
+        static const char *const names[3] = {"emission.R", "emission.G", "emission.B"};
+        for (int c = 0; c < 3; c++)
+            snprintf(layer.channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", names[c]);
+        for (size_t i = 0; i < pixel_count; i++) {
+            float samples = result->image.pixels[4 * i + 3];
+            for (int c = 0; c < 3; c++)
+                layer.pixels[3 * i + c] = samples > 0 ? sums[4 * i + c] / samples : 0.0f;
         }
-        image_free(&layers);
-    } else if (status == RT_OK) {
-        result->aovs = layers;
     }
+    free(sums);
+    if (status == RT_OK)
+        status = append_to_aovs(result, &layer, error);
     return status;
 }
 
@@ -472,6 +516,9 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     /* A partial file keeps no light groups (and its paths in flight are traced again). */
     if (options->light_groups && options->resume != NULL)
         return rt_error_set(error, RT_ERROR_INPUT, "RENDER: light groups cannot be resumed from a partial render");
+    if (options->direct_emission && options->resume != NULL)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "RENDER: direct emission sums cannot be resumed from a partial render");
     int width = region[2] - region[0], height = region[3] - region[1];
 
     camera_frame frame;
@@ -587,6 +634,8 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const sce
         status = render_aovs(tracer, width, height, &result->image, luminance_squares, &result->aovs, error);
     if (status == RT_OK && options->variance)
         status = add_variance_layers(tracer, width, height, result, error);
+    if (status == RT_OK && options->direct_emission)
+        status = add_direct_emission_layer(tracer, width, height, result, error);
     free(luminance_squares);
     if (status == RT_OK && options->light_groups)
         status = read_light_groups(tracer, s, &result->image, &result->light_groups, error);

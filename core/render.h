@@ -117,6 +117,9 @@ typedef struct render_options {
     bool light_groups;           /* also collect each light group's image (see
                                   * render_result.light_groups); not with resume */
     bool variance;               /* also make the variance layers (see render_result.aovs) */
+    bool direct_emission;        /* also sum what camera rays see of emitters and the sky at
+                                  * once, for the denoiser (see render_result.aovs); not with
+                                  * resume */
     uint32_t russian_roulette_depth;
     uint32_t sample_start;       /* first sample index: parts 0:N and N:M merge into 0:N+M */
     int region[4];               /* x0, y0, x1, y1 (row 0 at the top, x1/y1 exclusive) of the
@@ -160,7 +163,11 @@ typedef struct render_result {
                                   * options.variance, variance.R/G/B (per-pixel sample
                                   * variance of each colour channel, E[c^2] - E[c]^2 over the
                                   * pixel's finished samples: the variance of the pixel's
-                                  * mean is it / (samples - 1)); empty when neither is
+                                  * mean is it / (samples - 1)); then, with
+                                  * options.direct_emission, emission.R/G/B (the mean over
+                                  * the pixel's samples of the radiance their first segment
+                                  * brought from an emitter or the sky: the part of the
+                                  * pixel that is no scattered light); empty when none is
                                   * asked; free with image_free() */
     rt_image light_groups;       /* with options.light_groups: NAME.R, NAME.G, NAME.B for each
                                   * of the scene's light groups in order (scene.h), the mean

@@ -39,8 +39,10 @@
  *                           would not sum to the image) nor resume (a partial file keeps
  *                           no layers); tiles, crops, sample ranges and shards merge them
  *   variance                add the variance layers variance.R/G/B (render.h) to an EXR
- *   denoise                 postprocess_denoise() guided by the AOVs; an EXR keeps the noisy
- *                           colour as noisy.R/G/B
+ *   denoise                 postprocess_denoise() guided by the AOVs, the render's per-pixel
+ *                           variance and its direct emission (render.h; not when resumed);
+ *                           an EXR keeps the noisy colour as noisy.R/G/B and the direct
+ *                           emission as emission.R/G/B
  *   blur_sigma, blur_passes sigma 0: no blur; passes 0: 1
  *   tonemap, exposure       for 8-bit outputs: TONEMAP_CLAMP and 0 stops
  *   samples_map             NULL: none; else also write each pixel's samples / spp as a

@@ -61,6 +61,7 @@ shader_modules:
     module "glsl/path_state.glsl", SHADER_PROGRAM_TRACER
     module "glsl/integrator_path.glsl", SHADER_PROGRAM_PASS
     module "glsl/integrator_whitted.glsl", SHADER_PROGRAM_PASS
+    module "glsl/direct_emission.glsl", SHADER_PROGRAM_PASS       /* --denoise's direct emission */
     module "glsl/integrators.glsl", SHADER_PROGRAM_PASS             /* the table of integrators */
     module "glsl/pass_state.glsl", SHADER_PROGRAM_PASS
     module "glsl/main.glsl", SHADER_PROGRAM_PASS

@@ -89,6 +89,8 @@
 #define TRACER_COUNTER_BINDING 0
 /* image unit of the light group layers (glsl/light_groups.glsl): an rgba32f 2D array */
 #define TRACER_LIGHT_GROUP_IMAGE_UNIT 0
+/* image unit of the direct emission sums (glsl/direct_emission.glsl): an rgba32f 2D image */
+#define TRACER_DIRECT_EMISSION_IMAGE_UNIT 1
 
 /* ---- compacted passes (core/gpu_compact.c; gpu.h gpu_tracer_set_pass_pixels): the pixels
  * still taking samples packed densely into compact state textures, so that no lane of a
@@ -143,6 +145,8 @@
     P(vec3, ambient)                 /* Whitted: ambient light */ \
     P(uint, light_group_count)       /* layers of light groups collected (0: none) */ \
     P(uint, sky_light_group)         /* the sky's (and Whitted's ambient's) light group */ \
+    P(uint, direct_emission)         /* nonzero: sum the emission camera rays see at once */ \
+                                     /* (glsl/direct_emission.glsl) */ \
     P(int, pass_work_budget)         /* work units a pixel may start in one pass (core/gpu_tracer.c */ \
                                      /* clamps it to what the device allows) */ \
     P(int, work_cap)                 /* no invocation does more (core/gpu_tracer.c, from the device) */ \

@@ -133,6 +133,7 @@ void integrate(inout PixelState s)
                 vec3 sky = s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
                 s.radiance += sky;
                 add_to_light_group(sky_light_group, sky);
+                add_direct_emission(segment_bounce, sky);
                 path_done = true;
             } else {
                 at_surface = true;
@@ -156,7 +157,7 @@ void integrate(inout PixelState s)
                     // (its sample ends the path), a pbr one scatters on. Its MIS weight
                     // wants since_vertex up to here: this hit is the next vertex.
                     if (material_emits(material))
-                        hit_emitter(s, hit, surface, material);
+                        add_direct_emission(segment_bounce, hit_emitter(s, hit, surface, material));
                     s.since_vertex = 0.0;
                     BsdfSample sampled = material_sample(material, frame, s.direction, u);
                     BsdfSample bsdf = integrator_shade(s, material, frame, surface.position, sampled, query);

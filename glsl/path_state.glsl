@@ -121,8 +121,8 @@ void cross_volume_boundary(inout PixelState s, Surface surface, bool front_face,
 
 // The path hit an emitter (surface): its radiance joins the path's, weighted by MIS when
 // light sampling could have found it too. The material's sample then ends the path or,
-// for a pbr emitter, sends it on.
-void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material)
+// for a pbr emitter, sends it on. Returns the radiance added.
+vec3 hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material)
 {
     // MIS wants the path's last scattering vertex, where light sampling chose: the ray
     // went straight on from it through any volume boundaries since.
@@ -131,4 +131,5 @@ void hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material
     vec3 emitted = s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
     s.radiance += emitted;
     add_to_light_group(emitter_light_group(material), emitted);
+    return emitted;
 }

@@ -72,5 +72,8 @@ check pbr-lights tests/render/scenes/pbr-lights.txt
 check pbr-mask tests/render/scenes/pbr-mask.txt
 # The AOV pass and the denoiser use the render's variant too.
 check three-balls-aovs scenes/three-balls.txt --aovs
+# --denoise adds the direct emission sums (glsl/direct_emission.glsl), which its denoiser
+# reads from 8 samples a pixel on.
+check cornell-denoise scenes/cornell.txt --denoise --spp 8
 
 finish

@@ -219,10 +219,19 @@ static void free_buffers(buffers *b)
     image_free(&b->depth);
 }
 
+/* The denoiser with guides given by value: GUIDES(.albedo = &albedo, ...). */
+#define GUIDES(...) ((postprocess_denoise_guides){__VA_ARGS__})
+static rt_status denoise_guided(rt_image *colour, postprocess_denoise_guides guides,
+                                const postprocess_denoise_options *options, rt_error *error)
+{
+    return postprocess_denoise(colour, &guides, options, error);
+}
+
 static rt_status denoise(buffers *b, const postprocess_denoise_options *options)
 {
     rt_error error = {{0}};
-    rt_status status = postprocess_denoise(&b->colour, &b->albedo, &b->normal, &b->depth, options, &error);
+    postprocess_denoise_guides guides = {.albedo = &b->albedo, .normal = &b->normal, .depth = &b->depth};
+    rt_status status = postprocess_denoise(&b->colour, &guides, options, &error);
     if (status != RT_OK)
         print_error("postprocess_denoise: %s\n", error.message);
     return status;
@@ -250,7 +259,7 @@ static void test_denoise_without_guides_still_smooths(void **state)
     double before, after, mean;
     region_statistics(&b.colour, 0, 0, 0, SIZE, SIZE, &mean, &before);
     rt_error error;
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, NULL, &error), RT_OK);
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, &error), RT_OK);
     region_statistics(&b.colour, 0, 0, 0, SIZE, SIZE, &mean, &after);
     print_message("denoise flat, no guides: variance %.0fx lower\n", before / after);
     assert_true(after * 5 <= before);
@@ -413,7 +422,7 @@ static void test_denoise_demodulation_keeps_a_texture(void **state)
 
     /* Without the albedo image the same noise blurs the checker: the test can fail. */
     options.sigma_colour = 1e9f;
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, &b.normal, &b.depth, &options, NULL), RT_OK);
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.normal = &b.normal, .depth = &b.depth), &options, NULL), RT_OK);
     light_after = dark_after = 0;
     for (int y = 0; y < SIZE; y++)
         for (int x = 0; x < SIZE; x++)
@@ -432,11 +441,126 @@ static void test_denoise_keeps_other_channels(void **state)
             for (int c = 0; c < 3; c++)
                 *at(&rgba, x, y, c) = *at(&b.colour, x, y, c);
     rt_error error;
-    assert_int_equal(postprocess_denoise(&rgba, &b.albedo, &b.normal, &b.depth, NULL, &error), RT_OK);
+    postprocess_denoise_guides guides = {.albedo = &b.albedo, .normal = &b.normal, .depth = &b.depth};
+    assert_int_equal(postprocess_denoise(&rgba, &guides, NULL, &error), RT_OK);
     for (int y = 0; y < SIZE; y++)
         for (int x = 0; x < SIZE; x++)
             assert_close(*at(&rgba, x, y, 3), 7.0, 0);
     image_free(&rgba);
+    free_buffers(&b);
+}
+
+/* A lit flat surface (0.2, noise sd 0.05) in one plane with one albedo, and on it a light:
+ * columns x >= HALF + 1 are the light (10, no noise), column HALF sees it over 30% of the
+ * pixel (0.3 x 10 of emission, plus 0.7 of the surface). Only the colour tells the light
+ * from the surface: the emission image is what a render's camera rays saw of it at once. */
+static buffers make_light_edge(rt_image *emission)
+{
+    buffers b = make_flat(0.2f, 0.05f, 41);
+    *emission = make_image(SIZE, SIZE, 3, 0.0f);
+    for (int y = 0; y < SIZE; y++)
+        for (int x = HALF; x < SIZE; x++)
+            for (int c = 0; c < 3; c++) {
+                float direct = x == HALF ? 3.0f : 10.0f;
+                *at(emission, x, y, c) = direct;
+                *at(&b.colour, x, y, c) = x == HALF ? direct + 0.7f * *at(&b.colour, x, y, c) : direct;
+            }
+    return b;
+}
+
+static void test_denoise_leaves_the_emission_seen_at_once(void **state)
+{
+    (void)state;
+    rt_image emission;
+    buffers b = make_light_edge(&emission);
+    double truth = 3.0 + 0.7 * 0.2, before, after, variance;
+    region_statistics(&b.colour, 0, HALF, 0, HALF + 1, SIZE, &before, &variance);
+    postprocess_denoise_guides guides = {.albedo = &b.albedo, .normal = &b.normal, .depth = &b.depth,
+                                         .emission = &emission};
+    assert_int_equal(postprocess_denoise(&b.colour, &guides, NULL, NULL), RT_OK);
+    region_statistics(&b.colour, 0, HALF, 0, HALF + 1, SIZE, &after, &variance);
+    double surface_before, surface_variance_before, surface, surface_variance;
+    print_message("denoise with emission: the partly covered column %.4f -> %.4f (true %.4f)\n", before, after,
+                  truth);
+    assert_relative(after, truth, 0.01);
+    /* The light keeps its radiance and the surface is still smoothed. */
+    region_statistics(&b.colour, 0, HALF + 2, 0, SIZE, SIZE, &surface, &surface_variance);
+    assert_relative(surface, 10.0, 1e-4);
+    buffers fresh = make_light_edge(&(rt_image){0});
+    region_statistics(&fresh.colour, 0, 0, 0, HALF - 2, SIZE, &surface_before, &surface_variance_before);
+    region_statistics(&b.colour, 0, 0, 0, HALF - 2, SIZE, &surface, &surface_variance);
+    assert_true(surface_variance * 5 <= surface_variance_before);
+    assert_relative(surface, 0.2, 0.02);
+    free_buffers(&fresh);
+    free_buffers(&b);
+    /* Without it the column is averaged with the surface and the light beside it as if its
+     * difference were noise, and ends far from its value: what --denoise did to the edges of
+     * the lights it saw before it had the emission. */
+    rt_image unused;
+    b = make_light_edge(&unused);
+    guides.emission = NULL;
+    assert_int_equal(postprocess_denoise(&b.colour, &guides, NULL, NULL), RT_OK);
+    region_statistics(&b.colour, 0, HALF, 0, HALF + 1, SIZE, &after, &variance);
+    print_message("denoise without emission: the partly covered column -> %.4f\n", after);
+    assert_true(fabs(after - truth) > 0.1 * truth);
+    image_free(&unused);
+    image_free(&emission);
+    free_buffers(&b);
+}
+
+/* A flat noisy surface (0.5, noise sd 0.1) with a 2 x 2 highlight of 5 that only the colour
+ * shows (a light seen in a mirror: the guides see the mirror), noise-free; variance is the
+ * variance of each pixel's mean, as a render knows it: 0.01 on the surface, 0 on the
+ * highlight. */
+static buffers make_highlight(rt_image *variance)
+{
+    buffers b = make_flat(0.5f, 0.1f, 17);
+    *variance = make_image(SIZE, SIZE, 1, 0.01f);
+    for (int y = HALF; y < HALF + 2; y++)
+        for (int x = HALF; x < HALF + 2; x++) {
+            *at(variance, x, y, 0) = 0.0f;
+            for (int c = 0; c < 3; c++)
+                *at(&b.colour, x, y, c) = 5.0f;
+        }
+    return b;
+}
+
+static void test_denoise_keeps_a_highlight_its_variance_vouches_for(void **state)
+{
+    (void)state;
+    rt_image variance;
+    buffers b = make_highlight(&variance);
+    postprocess_denoise_guides guides = {.albedo = &b.albedo, .normal = &b.normal, .depth = &b.depth,
+                                         .variance = &variance};
+    double before, surface_variance_before, highlight, surface, surface_variance, unused;
+    region_statistics(&b.colour, 0, 0, 0, SIZE, HALF - 2, &before, &surface_variance_before);
+    assert_int_equal(postprocess_denoise(&b.colour, &guides, NULL, NULL), RT_OK);
+    region_statistics(&b.colour, 0, HALF, HALF, HALF + 2, HALF + 2, &highlight, &unused);
+    region_statistics(&b.colour, 0, 0, 0, SIZE, HALF - 2, &surface, &surface_variance);
+    print_message("denoise with the render's variance: highlight 5 -> %.4f, surface variance %.0fx lower\n",
+                  highlight, surface_variance_before / surface_variance);
+    assert_relative(highlight, 5.0, 0.02);
+    assert_true(surface_variance * 5 <= surface_variance_before);
+    assert_relative(surface, 0.5, 0.02);
+    free_buffers(&b);
+    /* Measured around each pixel, the noise looks as large as the highlight itself and the
+     * highlight is spread into the surface. */
+    b = make_highlight(&(rt_image){0});
+    guides.variance = NULL;
+    assert_int_equal(postprocess_denoise(&b.colour, &guides, NULL, NULL), RT_OK);
+    region_statistics(&b.colour, 0, HALF, HALF, HALF + 2, HALF + 2, &highlight, &unused);
+    print_message("denoise measuring the noise around each pixel: highlight 5 -> %.4f\n", highlight);
+    assert_true(highlight < 0.8 * 5.0);
+    /* A variance of -1 means "unknown": the noise is then measured around the pixel, the
+     * same image as without the guide. */
+    rt_image unknown = make_image(SIZE, SIZE, 1, -1.0f);
+    buffers again = make_highlight(&(rt_image){0});
+    guides.variance = &unknown;
+    assert_int_equal(postprocess_denoise(&again.colour, &guides, NULL, NULL), RT_OK);
+    assert_memory_equal(again.colour.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
+    image_free(&unknown);
+    image_free(&variance);
+    free_buffers(&again);
     free_buffers(&b);
 }
 
@@ -447,24 +571,34 @@ static void test_denoise_rejects_bad_input(void **state)
     rt_image small = make_image(SIZE, SIZE - 1, 3, 1.0f);
     rt_image grey = make_image(SIZE, SIZE, 1, 1.0f);
     rt_error error;
-    assert_int_equal(postprocess_denoise(&b.colour, &small, NULL, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.albedo = &small), NULL, &error), RT_ERROR_INPUT);
     assert_non_null(strstr(error.message, "albedo"));
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, &small, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.normal = &small), NULL, &error), RT_ERROR_INPUT);
     assert_non_null(strstr(error.message, "normal"));
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, &small, NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.depth = &small), NULL, &error), RT_ERROR_INPUT);
     assert_non_null(strstr(error.message, "depth"));
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, &grey, NULL, NULL, &error), RT_ERROR_INPUT);
-    assert_int_equal(postprocess_denoise(&grey, NULL, NULL, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.normal = &grey), NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.emission = &small), NULL, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "emission"));
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.emission = &grey), NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.variance = &small), NULL, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "variance"));
+    rt_image bad_emission = make_image(SIZE, SIZE, 3, 0.0f);
+    *at(&bad_emission, 7, 2, 0) = INFINITY;
+    assert_int_equal(denoise_guided(&b.colour, GUIDES(.emission = &bad_emission), NULL, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "emission image has an infinity at pixel (7, 2)"));
+    image_free(&bad_emission);
+    assert_int_equal(postprocess_denoise(&grey, NULL, NULL, &error), RT_ERROR_INPUT);
     postprocess_denoise_options options = postprocess_denoise_options_defaults();
     options.sigma_normal = -1;
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, &options, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, &options, &error), RT_ERROR_INPUT);
     options = postprocess_denoise_options_defaults();
     options.iterations = POSTPROCESS_MAX_DENOISE_ITERATIONS + 1;
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, &options, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, &options, &error), RT_ERROR_INPUT);
     *at(&b.colour, 3, 5, 1) = NAN;
     rt_image copy = make_image(SIZE, SIZE, 3, 0.0f);
     memcpy(copy.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
-    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, NULL, NULL, &error), RT_ERROR_INPUT);
+    assert_int_equal(postprocess_denoise(&b.colour, NULL, NULL, &error), RT_ERROR_INPUT);
     assert_non_null(strstr(error.message, "NaN at pixel (3, 5)"));
     /* Nothing changed on failure. */
     assert_memory_equal(copy.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
@@ -746,6 +880,8 @@ int main(void)
         cmocka_unit_test(test_denoise_smooths_a_tilted_plane),
         cmocka_unit_test(test_denoise_demodulation_keeps_a_texture),
         cmocka_unit_test(test_denoise_keeps_other_channels),
+        cmocka_unit_test(test_denoise_leaves_the_emission_seen_at_once),
+        cmocka_unit_test(test_denoise_keeps_a_highlight_its_variance_vouches_for),
         cmocka_unit_test(test_denoise_rejects_bad_input),
         cmocka_unit_test(test_tonemap_reinhard_of_one_is_a_half),
         cmocka_unit_test(test_tonemap_curves_are_monotonic_and_bounded),
