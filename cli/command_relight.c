@@ -56,24 +56,7 @@ static rt_status write_relit(const char *output, rt_image *relit, const relight_
         options.attribute_count = 1;
         return image_write(output, relit, &options, error);
     }
-    rt_image colour = {0};
-    rt_status status = image_create(&colour, relit->width, relit->height, 3, error);
-    if (status != RT_OK)
-        return status;
-    size_t pixel_count = (size_t)relit->width * relit->height;
-    for (size_t i = 0; i < pixel_count; i++)
-        memcpy(colour.pixels + 3 * i, relit->pixels + i * (size_t)relit->channels, 3 * sizeof(float));
-    image_write_options options = image_write_options_defaults();
-    options.exposure = (float)exposure;
-    if (format == IMAGE_FORMAT_EIGHT_BIT && tonemap != TONEMAP_CLAMP) {
-        /* The writer's exposure would apply a second time after tone mapping. */
-        status = postprocess_tonemap(&colour, tonemap, (float)exposure, error);
-        options.exposure = 0;
-    }
-    if (status == RT_OK)
-        status = image_write(output, &colour, &options, error);
-    image_free(&colour);
-    return status;
+    return command_write_colour(output, relit, tonemap, exposure, error);
 }
 
 /* Parses the options into the outputs; returns EXIT_OK or an exit code after saying why. */
@@ -91,7 +74,6 @@ static int parse_options(int argc, char **argv, const char **output, relight_wei
     int option;
     rt_error error = {{0}};
     while ((option = getopt_long(argc, argv, "o:qh", long_options, NULL)) != -1) {
-        char *end = NULL;
         switch (option) {
         case 'o': *output = optarg; break;
         case 'q': *quiet = true; break;
@@ -107,24 +89,12 @@ static int parse_options(int argc, char **argv, const char **output, relight_wei
             (*weight_count)++;
             break;
         case OPTION_EXPOSURE:
-            *exposure = strtod(optarg, &end);
-            if (end == optarg || *end != '\0' || !(fabs(*exposure) <= 64)) {
-                fprintf(stderr, "rtspheres relight: --exposure wants a number of stops (-64 to 64), not '%s'\n",
-                        optarg);
+            if (command_parse_exposure("relight", optarg, exposure) != 0)
                 return EXIT_BAD_INPUT;
-            }
             break;
         case OPTION_TONEMAP:
-            if (strcmp(optarg, "clamp") == 0)
-                *tonemap = TONEMAP_CLAMP;
-            else if (strcmp(optarg, "reinhard") == 0)
-                *tonemap = TONEMAP_REINHARD;
-            else if (strcmp(optarg, "aces") == 0)
-                *tonemap = TONEMAP_ACES;
-            else {
-                fprintf(stderr, "rtspheres relight: --tonemap wants clamp, reinhard or aces, not '%s'\n", optarg);
+            if (command_parse_tonemap("relight", optarg, tonemap) != 0)
                 return EXIT_BAD_INPUT;
-            }
             break;
         default: return command_help_exit(option, print_help);
         }
@@ -143,20 +113,10 @@ int command_relight(int argc, char **argv)
     int code = parse_options(argc, argv, &output, weights, &weight_count, &tonemap, &exposure, &quiet);
     if (code != EXIT_OK)
         return code;
-    if (optind != argc - 1) {
-        fprintf(stderr, "rtspheres relight: give one input image (an EXR rendered with --light-groups)\n");
-        return EXIT_BAD_INPUT;
-    }
-    const char *input = argv[optind];
-    if (output == NULL || image_format_of(output) == IMAGE_FORMAT_UNKNOWN) {
-        fprintf(stderr, "rtspheres relight: %s; give -o OUT.exr (or .hdr, .png, .jpg, .tif)\n",
-                output == NULL ? "no output" : "cannot tell the output's format");
-        return EXIT_BAD_INPUT;
-    }
-    if (strcmp(input, output) == 0 || path_same_file(input, output)) {
-        fprintf(stderr, "rtspheres relight: the output '%s' is the input; refusing to overwrite it\n", output);
-        return EXIT_BAD_INPUT;
-    }
+    const char *input = NULL;
+    code = command_image_to_image("relight", argc, argv, "an EXR rendered with --light-groups", output, &input);
+    if (code != EXIT_OK)
+        return code;
     rt_error error = {{0}};
     rt_image image = {0}, relit = {0};
     relight_layers layers;

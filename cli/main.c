@@ -22,6 +22,7 @@ static void print_usage(FILE *stream)
             "  merge PARTS... -o OUT    merge EXR parts of one render (sample ranges, tiles, shards)\n"
             "  montage IMAGES... -o OUT lay equal-size images out as a contact sheet\n"
             "  relight IN.exr -o OUT    reweigh the light group layers of a --light-groups render\n"
+            "  denoise IN.exr -o OUT    denoise a render made with --aovs (as render --denoise does)\n"
             "\n"
             "Run 'rtspheres COMMAND --help' for a command's options.\n");
 }
@@ -33,7 +34,7 @@ static const struct {
 } commands[] = {
     {"render", command_render}, {"diff", command_diff},   {"check", command_check},  {"info", command_info},
     {"stats", command_stats},   {"merge", command_merge}, {"montage", command_montage},
-    {"relight", command_relight},
+    {"relight", command_relight}, {"denoise", command_denoise},
 };
 
 int main(int argc, char **argv)

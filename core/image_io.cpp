@@ -924,6 +924,14 @@ rt_status image_append_channels(const rt_image *a, const rt_image *b, rt_image *
     return RT_OK;
 }
 
+int image_channel_index(const rt_image *image, const char *name)
+{
+    for (int c = 0; c < image->channels; c++)
+        if (std::strcmp(image->channel_names[c], name) == 0)
+            return c;
+    return -1;
+}
+
 void image_free(rt_image *image)
 {
     if (image == nullptr)

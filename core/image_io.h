@@ -92,6 +92,9 @@ rt_status image_create(rt_image *image, int width, int height, int channels, rt_
  * RT_ERROR_INPUT; more than IMAGE_MAX_CHANNELS together: RT_ERROR_INPUT. */
 rt_status image_append_channels(const rt_image *a, const rt_image *b, rt_image *out, rt_error *error);
 
+/* Returns the index of the channel of image named name (exactly), or -1. */
+int image_channel_index(const rt_image *image, const char *name);
+
 /* Frees image->pixels and zeroes *image. */
 void image_free(rt_image *image);
 

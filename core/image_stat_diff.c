@@ -51,9 +51,9 @@ double image_stat_z_threshold(double test_alpha)
  * default_index (image_io.h: "" is the default name, R G B A by position), or -1. */
 static int find_channel(const rt_image *image, const char *name, int default_index)
 {
-    for (int c = 0; c < image->channels; c++)
-        if (strcmp(image->channel_names[c], name) == 0)
-            return c;
+    int named = image_channel_index(image, name);
+    if (named >= 0)
+        return named;
     if (default_index >= 0 && default_index < image->channels && image->channel_names[default_index][0] == '\0')
         return default_index;
     return -1;

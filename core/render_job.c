@@ -12,6 +12,7 @@
 #include "clock.h"
 #include "image_io.h"
 #include "paths.h"
+#include "render_denoise.h"
 #include "render_output.h"
 #include "scene_assets.h"
 #include "scene_gltf.h"
@@ -153,62 +154,14 @@ static rt_status copy_channels(const rt_image *image, int first, int count, rt_i
     return RT_OK;
 }
 
-/* The fewest samples whose variance guides the denoiser at a pixel, and whose direct
- * emission it leaves unfiltered (denoise()). */
-#define DENOISE_VARIANCE_MIN_SAMPLES 4
-#define DENOISE_EMISSION_MIN_SAMPLES 8
-
-/* The index of the channel named name in image, or -1. */
-static int find_channel(const rt_image *image, const char *name)
-{
-    for (int c = 0; c < image->channels; c++)
-        if (strcmp(image->channel_names[c], name) == 0)
-            return c;
-    return -1;
-}
-
-/* Denoises colour guided by the result's AOVs (and its direct emission, emission.R/G/B,
- * when the render summed it) and adds the noisy colour to the AOVs as noisy.R/G/B, so an
- * EXR keeps it. */
+/* Denoises colour guided by the result's layers (render_denoise.h) and adds the noisy
+ * colour to the AOVs as noisy.R/G/B, so an EXR keeps it. */
 static rt_status denoise(rt_image *colour, render_result *result, rt_error *error)
 {
-    rt_image albedo = {0}, normal = {0}, depth = {0}, emission = {0}, mean_variance = {0}, noisy = {0}, joined = {0};
-    int emission_channel = find_channel(&result->aovs, "emission.R");
+    rt_image noisy = {0}, joined = {0};
     rt_status status = copy_channels(&result->image, 0, 3, &noisy, error);
     if (status == RT_OK)
-        status = copy_channels(&result->aovs, 0, 3, &albedo, error);
-    if (status == RT_OK)
-        status = copy_channels(&result->aovs, 3, 3, &normal, error);
-    if (status == RT_OK)
-        status = copy_channels(&result->aovs, 6, 1, &depth, error);
-    if (status == RT_OK && emission_channel >= 0)
-        status = copy_channels(&result->aovs, emission_channel, 3, &emission, error);
-    /* Below DENOISE_EMISSION_MIN_SAMPLES a pixel that a light covers in part is more wrong
-     * by its coverage's sampling noise, which filtering it whole would smooth, than by the
-     * part of the light that filtering takes away (docs/sampling.md, "Denoising"). */
-    size_t pixels = (size_t)result->image.width * result->image.height;
-    for (size_t i = 0; status == RT_OK && emission.pixels != NULL && i < pixels; i++)
-        if (result->image.pixels[4 * i + 3] < DENOISE_EMISSION_MIN_SAMPLES)
-            emission.pixels[3 * i] = emission.pixels[3 * i + 1] = emission.pixels[3 * i + 2] = 0.0f;
-    /* The variance of each pixel's mean from its samples' (variance.Y is E[L^2] - E[L]^2 over
-     * n samples: / (n - 1)); below DENOISE_VARIANCE_MIN_SAMPLES samples it says too little
-     * and the denoiser measures the noise around the pixel instead (-1). */
-    int variance_channel = find_channel(&result->aovs, "variance.Y");
-    if (status == RT_OK && variance_channel >= 0)
-        status = copy_channels(&result->aovs, variance_channel, 1, &mean_variance, error);
-    if (status == RT_OK && mean_variance.pixels != NULL) {
-        for (size_t i = 0; i < pixels; i++) {
-            float samples = result->image.pixels[4 * i + 3];
-            mean_variance.pixels[i] =
-                samples >= DENOISE_VARIANCE_MIN_SAMPLES ? mean_variance.pixels[i] / (samples - 1) : -1.0f;
-        }
-    }
-    if (status == RT_OK) {
-        postprocess_denoise_guides guides = {.albedo = &albedo, .normal = &normal, .depth = &depth,
-                                             .emission = emission_channel >= 0 ? &emission : NULL,
-                                             .variance = mean_variance.pixels != NULL ? &mean_variance : NULL};
-        status = postprocess_denoise(colour, &guides, NULL, error);
-    }
+        status = render_denoise(colour, &result->image, &result->aovs, error);
     if (status == RT_OK) {
         static const char *const names[3] = {"noisy.R", "noisy.G", "noisy.B"};
         for (int c = 0; c < 3; c++)
@@ -220,11 +173,6 @@ static rt_status denoise(rt_image *colour, render_result *result, rt_error *erro
         result->aovs = joined;
         joined = (rt_image){0};
     }
-    image_free(&albedo);
-    image_free(&normal);
-    image_free(&depth);
-    image_free(&emission);
-    image_free(&mean_variance);
     image_free(&noisy);
     image_free(&joined);
     return status;
@@ -348,7 +296,9 @@ static void image_render_options(job_image *image, render_options *options)
     options->aovs = job->aovs || job->denoise;
     options->light_groups = job->light_groups;
     options->variance = job->variance;
-    options->direct_emission = job->denoise;   /* render_image drops it when resuming */
+    /* With --aovs too, so that `rtspheres denoise` of its EXR is --denoise's image;
+     * render_image drops it when resuming. */
+    options->direct_emission = job->denoise || job->aovs;
     options->bvh_cache = image->run->bvh_cache;
     options->progress = callbacks->progress;
     options->progress_context = callbacks->user;

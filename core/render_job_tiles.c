@@ -61,8 +61,8 @@ static const char *unsupported_under_tiles(const render_job *job, const render_o
 {
     *instead = "raise --memory-budget if the machine has the memory, or render a smaller image";
     if (job->denoise) {
-        *instead = "render the EXR with --aovs and denoise it afterwards, or raise --memory-budget if the machine "
-                   "has the memory";
+        *instead = "render it with --aovs to an .exr and run `rtspheres denoise` on that, or raise "
+                   "--memory-budget if the machine has the memory";
         return "--denoise needs the whole image at once";
     }
     if (job->blur_sigma > 0)

@@ -124,6 +124,11 @@ render_split_scene() {
 # ---- what `stats` prints -------------------------------------------------------------------
 
 # stats_of FILE [--crop C]: runs `stats` once and keeps its output in $scratch/stats, which
+# channels_of FILE: the channel names of FILE, sorted, on one line.
+channels_of() {
+    "$program" stats "$1" | sed -n 's/^channel \([^:]*\):.*/\1/p' | sort | tr '\n' ' ' | sed 's/ $//'
+}
+
 # stat_mean, stat_range and stat_metadata read (each `stats` run costs an OpenImageIO
 # start-up, so a check that needs several values runs it once).
 stats_of() {

@@ -35,8 +35,8 @@ diffuse=scenes/materials/lambertian.txt
 "$program" render $diffuse -o "$scratch/denoised.exr" $small --spp 8 --denoise
 # Exactly these channels, each once (in any order): colour, samples, the four AOV layers,
 # the direct emission and the noisy colour.
-channels=$("$program" stats "$scratch/denoised.exr" | sed -n 's/^channel \([^:]*\):.*/\1/p' | sort | tr '\n' ' ')
-expected="B G R albedo.B albedo.G albedo.R depth.Z emission.B emission.G emission.R noisy.B noisy.G noisy.R normal.X normal.Y normal.Z samples variance.Y "
+channels=$(channels_of "$scratch/denoised.exr")
+expected="B G R albedo.B albedo.G albedo.R depth.Z emission.B emission.G emission.R noisy.B noisy.G noisy.R normal.X normal.Y normal.Z samples variance.Y"
 if [ "$channels" = "$expected" ]; then pass "--denoise keeps the noisy image and the AOVs as layers ($channels)"
 else fail "--denoise layers" "channels '$channels', expected '$expected'"; fi
 noisy_error=$(rms "$scratch/noisy.exr" "$scratch/reference.exr")
@@ -112,6 +112,52 @@ for region in "" 15,15,17,17 0,0,2,2 2,12,8,20; do
 done
 if [ -z "$mismatch" ]; then pass "--denoise: emission.R/G/B is the colour where camera rays see only emitters and sky"
 else fail "--denoise emission layer" "$mismatch"; fi
+
+# `rtspheres denoise` of an EXR rendered with --aovs is --denoise's image, bit for bit,
+# with the same layers; also when that EXR was rendered in tiles (which cannot denoise
+# themselves: the denoiser needs the whole image), since tiles change no pixel.
+cornell=scenes/cornell.txt
+"$program" render $cornell -o "$scratch/c-denoised.exr" --size 64x48 --spp 16 --seed 3 --quiet --denoise
+"$program" render $cornell -o "$scratch/c-aovs.exr" --size 64x48 --spp 16 --seed 3 --quiet --aovs
+"$program" render $cornell -o "$scratch/c-tiled.exr" --size 64x48 --spp 16 --seed 3 --quiet --aovs \
+    --memory-budget 700K
+"$program" stats "$scratch/c-tiled.exr" >/dev/null 2>&1 || fail "a tiled render with --aovs" "no output"
+for source in aovs tiled; do
+    name="rtspheres denoise of the --aovs render ($source) is --denoise's image"
+    if ! "$program" denoise "$scratch/c-$source.exr" -o "$scratch/c-$source-denoised.exr" --quiet; then
+        fail "$name" "denoise failed"
+    elif ! "$program" diff "$scratch/c-$source-denoised.exr" "$scratch/c-denoised.exr" --fail 0 --failpercent 0 \
+            >/dev/null; then
+        fail "$name" "$("$program" diff "$scratch/c-$source-denoised.exr" "$scratch/c-denoised.exr" | grep 'max error')"
+    elif [ "$(channels_of "$scratch/c-$source-denoised.exr")" != "$(channels_of "$scratch/c-denoised.exr")" ]; then
+        fail "$name" "layers '$(channels_of "$scratch/c-$source-denoised.exr")'"
+    else pass "$name"; fi
+done
+if "$program" render $cornell -o "$scratch/c-tiled-check.exr" --size 64x48 --spp 16 --seed 3 --aovs \
+        --memory-budget 700K 2>&1 | grep -q 'tiles'; then
+    pass "the 700K budget renders the 64x48 Cornell box in tiles"
+else fail "the tiled case of rtspheres denoise" "the 700K budget did not tile the render"; fi
+if "$program" denoise "$scratch/c-aovs.exr" -o "$scratch/c-aovs.png" --tonemap aces --quiet &&
+    [ "$(channels_of "$scratch/c-aovs.png")" = "B G R" ]; then
+    pass "rtspheres denoise writes a tone-mapped PNG"
+else fail "rtspheres denoise to a PNG" "channels '$(channels_of "$scratch/c-aovs.png")'"; fi
+"$program" render $cornell -o "$scratch/c-plain.exr" --size 64x48 --spp 4 --quiet
+expect_refusal "rtspheres denoise of an EXR without AOVs is refused" "no albedo.R/G/B layer.*--aovs" \
+    "$scratch/refused" "$program" denoise "$scratch/c-plain.exr" -o "$scratch/refused/x.exr"
+expect_refusal "rtspheres denoise of a denoised EXR is refused" "is denoised already" \
+    "$scratch/refused" "$program" denoise "$scratch/c-denoised.exr" -o "$scratch/refused/x.exr"
+expect_refusal "rtspheres denoise without -o is refused" "no output" \
+    "$scratch/refused" "$program" denoise "$scratch/c-aovs.exr"
+expect_refusal "rtspheres denoise to an unknown format is refused" "cannot tell the output's format" \
+    "$scratch/refused" "$program" denoise "$scratch/c-aovs.exr" -o "$scratch/refused/x.abc"
+expect_refusal "rtspheres denoise of a missing file is refused" "c-missing.exr" \
+    "$scratch/refused" "$program" denoise "$scratch/c-missing.exr" -o "$scratch/refused/x.exr"
+cp "$scratch/c-aovs.exr" "$scratch/c-keep.exr"
+name="rtspheres denoise never writes over its input"
+if exits_with 2 "is the input" "$program" denoise "$scratch/c-aovs.exr" -o "$scratch/c-aovs.exr" &&
+    cmp -s "$scratch/c-aovs.exr" "$scratch/c-keep.exr"; then
+    pass "$name"
+else fail "$name" "$problem"; fi
 
 # AOVs alone; a PNG cannot carry them.
 "$program" render $scene -o "$scratch/aovs.exr" $small --spp 2 --aovs

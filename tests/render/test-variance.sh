@@ -7,10 +7,6 @@
 scene=scenes/three-balls.txt
 render_options="--size 32x18 --spp 8 --seed 1"
 
-# channels_of FILE: the channel names of FILE, sorted, one line.
-channels_of() {
-    "$program" stats "$1" | sed -n 's/^channel \([^:]*\):.*/\1/p' | sort | tr '\n' ' ' | sed 's/ $//'
-}
 render "$scratch/plain.exr"
 render "$scratch/variance.exr" --variance
 render "$scratch/both.exr" --variance --aovs
@@ -19,7 +15,7 @@ if [ "$got" = "B G R samples variance.B variance.G variance.R" ]; then
     pass "--variance adds exactly variance.R/G/B"
 else fail "--variance layers" "channels '$got'"; fi
 got=$(channels_of "$scratch/both.exr")
-expected="B G R albedo.B albedo.G albedo.R depth.Z normal.X normal.Y normal.Z samples variance.B variance.G variance.R variance.Y"
+expected="B G R albedo.B albedo.G albedo.R depth.Z emission.B emission.G emission.R normal.X normal.Y normal.Z samples variance.B variance.G variance.R variance.Y"
 if [ "$got" = "$expected" ]; then pass "--variance with --aovs: the AOVs, variance.Y and variance.R/G/B"
 else fail "--variance --aovs layers" "channels '$got'"; fi
 same "--variance changes no colour" "$scratch/variance.exr" "$scratch/plain.exr"
