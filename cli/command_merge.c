@@ -37,10 +37,10 @@ static void print_help(FILE *stream)
             "missing parts, unreadable files)\n");
 }
 
-/* Writes merged to output with the merged metadata and light group layers (render_output.h:
- * all four channels and the layers for EXR, the colour only for the 8-bit and HDR
- * formats). Returns an exit code. */
-static int write_merged(const char *output, const rt_image *merged, const rt_image *layers,
+/* Writes merged to output with the merged metadata and layers (AOVs then light groups, as
+ * a render writes them; render_output.h: all four channels and the layers for EXR, the
+ * colour only for the 8-bit and HDR formats). Returns an exit code. */
+static int write_merged(const char *output, const rt_image *merged, const rt_image *layers, bool light_groups,
                         const merge_summary *summary)
 {
     render_output_metadata metadata = {
@@ -56,7 +56,7 @@ static int write_merged(const char *output, const rt_image *merged, const rt_ima
         .complete = summary->complete,
         .render_seconds = summary->render_seconds,
         .merged_parts = summary->part_count,
-        .light_groups = layers->pixels != NULL ? summary->metadata.light_groups : NULL,
+        .light_groups = light_groups ? summary->metadata.light_groups : NULL,
     };
     rt_error error = {{0}};
     rt_status status = render_output_write(output, merged, layers, &metadata, 0.0f, &error);
@@ -131,15 +131,31 @@ int command_merge(int argc, char **argv)
             image_free(&part);
         }
     }
-    rt_image merged = {0}, layers = {0};
+    rt_image merged = {0}, layers = {0}, groups = {0};
     merge_summary summary;
     if (status == RT_OK)
         status = merger_finish(m, &options, &merged, &summary, &error);
     if (status == RT_OK)
-        status = merger_light_groups(m, &layers, &error);
+        status = merger_aovs(m, &layers, &error);
+    if (status == RT_OK)
+        status = merger_light_groups(m, &groups, &error);
+    bool has_groups = groups.pixels != NULL;
+    if (status == RT_OK && has_groups && layers.pixels != NULL) {
+        rt_image joined;
+        status = image_append_channels(&layers, &groups, &joined, &error);
+        if (status == RT_OK) {
+            image_free(&layers);
+            layers = joined;
+        }
+    } else if (status == RT_OK && has_groups) {
+        layers = groups;
+        groups = (rt_image){0};
+    }
+    image_free(&groups);
     merger_free(m);
     if (status != RT_OK) {
         image_free(&merged);
+        image_free(&layers);
         fprintf(stderr, "rtspheres merge: %s\n", error.message);
         return exit_code_for_status(status);
     }
@@ -152,7 +168,7 @@ int command_merge(int argc, char **argv)
         fprintf(stderr, "rtspheres merge: warning: %lld pixels not covered by any part are left black "
                         "(--allow-missing)\n", summary.missing_pixels);
 
-    int exit_code = write_merged(output, &merged, &layers, &summary);
+    int exit_code = write_merged(output, &merged, &layers, has_groups, &summary);
     image_free(&merged);
     image_free(&layers);
     if (exit_code == EXIT_OK && !quiet)

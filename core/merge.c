@@ -5,6 +5,7 @@
 #include "metadata_keys.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -37,7 +38,23 @@ struct merger {
     double *sums;
     relight_layers layers;       /* the first part's light groups (count 0: none) */
     double *layer_sums;          /* per pixel: each layer's R*n, G*n, B*n, as sums */
+    /* The AOV layers (merge.h): the parts that had them (and the emission too), and per
+     * pixel the guides of the part of lowest sample start that had samples there (albedo
+     * R, G, B, normal X, Y, Z, depth), that start, and emission R*n, G*n, B*n and
+     * n * (variance.Y + L^2) summed, L the part's mean luminance. */
+    int aov_parts, emission_parts;
+    float *guides;
+    unsigned long long *guide_start;
+    double *aov_sums;
 };
+
+/* The AOV layers of a part that merge (render.h render_result.aovs), in the order they
+ * are written: the guides, variance.Y, then the emission. */
+static const char *const aov_names[] = {"albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z",
+                                        "depth.Z", "variance.Y", "emission.R", "emission.G", "emission.B"};
+#define GUIDE_CHANNELS 7
+#define AOV_CHANNELS 8           /* the guides and variance.Y: what --aovs always has */
+#define AOV_ALL_CHANNELS 11      /* with the emission (not after --resume) */
 
 /* A half-open sample range [start, start + count). */
 typedef struct sample_range {
@@ -69,6 +86,9 @@ void merger_free(merger *m)
     free(m->regions);
     free(m->sums);
     free(m->layer_sums);
+    free(m->guides);
+    free(m->guide_start);
+    free(m->aov_sums);
     free(m);
 }
 
@@ -269,6 +289,24 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
         m->full_width = full_width;
         m->full_height = full_height;
     }
+    int aov[AOV_ALL_CHANNELS];
+    int aov_found = 0;
+    while (aov_found < AOV_ALL_CHANNELS && (aov[aov_found] = image_channel_index(image, aov_names[aov_found])) >= 0)
+        aov_found++;
+    bool has_aovs = aov_found >= AOV_CHANNELS, has_emission = aov_found == AOV_ALL_CHANNELS;
+    if (has_aovs && m->guides == NULL) {
+        size_t full_pixels = (size_t)full_width * full_height;
+        m->guides = malloc(full_pixels * GUIDE_CHANNELS * sizeof *m->guides);
+        m->guide_start = malloc(full_pixels * sizeof *m->guide_start);
+        m->aov_sums = calloc(full_pixels * 4, sizeof *m->aov_sums);
+        if (m->guides == NULL || m->guide_start == NULL || m->aov_sums == NULL) {
+            free(name_copy);
+            return rt_error_set(error, RT_ERROR_RUNTIME, "MERGE: out of memory for the AOV layers");
+        }
+        memset(m->guides, 0, full_pixels * GUIDE_CHANNELS * sizeof *m->guides);
+        for (size_t i = 0; i < full_pixels; i++)
+            m->guide_start[i] = ULLONG_MAX;
+    }
     if (m->layer_sums == NULL && layers.count > 0) {
         size_t full_values = (size_t)full_width * full_height * 3 * (size_t)layers.count;
         if ((m->layer_sums = calloc(full_values, sizeof(double))) == NULL) {
@@ -284,6 +322,8 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
                                                  .height = image->height, .first_part = m->part_count};
     }
     m->parts[m->part_count++] = (part_record){.name = name_copy, .metadata = *metadata, .region = region_index};
+    m->aov_parts += has_aovs;
+    m->emission_parts += has_emission;
 
     for (int row = 0; row < image->height; row++)
         for (int column = 0; column < image->width; column++) {
@@ -300,6 +340,21 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
             for (int g = 0; g < layers.count; g++)
                 for (int c = 0; c < 3; c++)
                     layer_sum[3 * g + c] += (double)pixel[layers.channels[g][c]] * n;
+            if (!has_aovs)
+                continue;
+            /* A render's guides come from its first samples' camera rays: the part that
+             * starts lowest has them. */
+            if (metadata->sample_start < m->guide_start[at]) {
+                m->guide_start[at] = metadata->sample_start;
+                for (int k = 0; k < GUIDE_CHANNELS; k++)
+                    m->guides[at * GUIDE_CHANNELS + k] = pixel[aov[k]];
+            }
+            /* As render.c makes variance.Y: E[L^2] - E[L]^2 of float luminances. */
+            float luminance = 0.2126f * pixel[channel[0]] + 0.7152f * pixel[channel[1]] + 0.0722f * pixel[channel[2]];
+            double *aov_sum = &m->aov_sums[at * 4];
+            aov_sum[3] += n * ((double)pixel[aov[7]] + (double)luminance * luminance);
+            for (int c = 0; has_emission && c < 3; c++)
+                aov_sum[c] += (double)pixel[aov[8 + c]] * n;
         }
     return RT_OK;
 }
@@ -464,6 +519,13 @@ rt_status merger_finish(merger *m, const merge_options *options, rt_image *out, 
     }
     free(ranges);
     free(first_ranges);
+    if (m->aov_parts > 0 && m->aov_parts < m->part_count)
+        add_warning(summary, "%d of the %d parts have AOV layers (render --aovs): the merged image has none",
+                    m->aov_parts, m->part_count);
+    else if (m->emission_parts > 0 && m->emission_parts < m->part_count)
+        add_warning(summary, "%d of the %d parts have emission.R/G/B (a resumed part has none): the merged image "
+                    "has none, and `rtspheres denoise` filters the lights' edges with the rest",
+                    m->emission_parts, m->part_count);
 
     rt_status status = image_create(out, m->full_width, m->full_height, 4, error);
     if (status != RT_OK)
@@ -525,6 +587,34 @@ rt_status merger_light_groups(const merger *m, rt_image *layers, rt_error *error
         double n = m->sums[i * 4 + 3];
         for (size_t v = 0; v < values; v++)
             layers->pixels[i * values + v] = n > 0 ? (float)(m->layer_sums[i * values + v] / n) : 0.0f;
+    }
+    return RT_OK;
+}
+
+rt_status merger_aovs(const merger *m, rt_image *aovs, rt_error *error)
+{
+    memset(aovs, 0, sizeof *aovs);
+    if (m->part_count == 0 || m->aov_parts != m->part_count)
+        return RT_OK;
+    int channels = m->emission_parts == m->part_count ? AOV_ALL_CHANNELS : AOV_CHANNELS;
+    rt_status status = image_create(aovs, m->full_width, m->full_height, channels, error);
+    if (status != RT_OK)
+        return status;
+    for (int c = 0; c < channels; c++)
+        snprintf(aovs->channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", aov_names[c]);
+    for (size_t i = 0; i < (size_t)m->full_width * m->full_height; i++) {
+        float *out = aovs->pixels + i * (size_t)channels;
+        double n = m->sums[i * 4 + 3];
+        if (n <= 0)
+            continue;
+        memcpy(out, m->guides + i * GUIDE_CHANNELS, GUIDE_CHANNELS * sizeof *out);
+        float mean[3];
+        for (int c = 0; c < 3; c++)
+            mean[c] = (float)(m->sums[i * 4 + c] / n);
+        float luminance = 0.2126f * mean[0] + 0.7152f * mean[1] + 0.0722f * mean[2];
+        out[7] = (float)fmax(0.0, m->aov_sums[i * 4 + 3] / n - (double)luminance * luminance);
+        for (int c = 0; c < channels - AOV_CHANNELS; c++)
+            out[AOV_CHANNELS + c] = (float)(m->aov_sums[i * 4 + c] / n);
     }
     return RT_OK;
 }

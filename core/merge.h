@@ -26,7 +26,17 @@
  *     each pixel and put in place by region, so that they still sum to the merged colour
  *     (to float rounding) and a tile's are exactly the whole render's. Every part must
  *     list the same groups as the first, or none when it lists none: RT_ERROR_INPUT
- *     otherwise. Other layers (AOVs, variance) are not merged.
+ *     otherwise.
+ *   - AOV layers (render --aovs: albedo.R/G/B, normal.X/Y/Z, depth.Z, variance.Y, and
+ *     emission.R/G/B but after --resume) are merged when every part has them, for
+ *     `rtspheres denoise` of the merged image: the guides (albedo, normal, depth) of each
+ *     pixel are those of the part with the lowest sample start that has samples there
+ *     (a render's guides come from its first samples' camera rays, so a split render's
+ *     are the whole render's), emission is weighted by samples as the colour is, and
+ *     variance.Y is recombined from each part's: E[L^2] - E[L]^2 with each part's
+ *     E[L^2] = variance.Y + L^2 (L its mean luminance), to float rounding of the whole
+ *     render's. Some parts without them: a warning, and no AOV layers. variance.R/G/B
+ *     (--variance) are not merged.
  *
  * Use: merger_create, merger_add once per part (it validates the part against the ones
  * added before and adds its pixels to running double sums, so the caller may free the
@@ -116,6 +126,12 @@ rt_status merger_finish(merger *m, const merge_options *options, rt_image *out, 
  * image_free()) after a successful merger_finish(); empty (RT_OK) when the parts have no
  * layers. RT_ERROR_RUNTIME when memory runs out. */
 rt_status merger_light_groups(const merger *m, rt_image *layers, rt_error *error);
+
+/* Returns the merged AOV layers into *aovs (albedo.R/G/B, normal.X/Y/Z, depth.Z,
+ * variance.Y and, when every part had it, emission.R/G/B; full size; allocated, free with
+ * image_free()) after a successful merger_finish(); empty (RT_OK) unless every part had
+ * AOV layers. RT_ERROR_RUNTIME when memory runs out. */
+rt_status merger_aovs(const merger *m, rt_image *aovs, rt_error *error);
 
 /* Reads the part file at path: its pixels into *image (allocated; free with image_free())
  * and its rtspheres metadata into *metadata. A file that cannot be read, lacks the

@@ -585,6 +585,80 @@ static void test_light_group_layers(void **state)
     merger_free(m);
 }
 
+/* A 1x1 part (samples n of colour c, grey) with --aovs layers: guides g (albedo g, normal
+ * (0, g, 0), depth 10 g), the samples' variance of luminance v and, with emission, e. */
+static rt_image make_aov_part(float c, float n, float g, float v, bool with_emission, float e)
+{
+    rt_image base = make_part(0, 0, 1, 1, 0, 0, c, c, c, n), layers, part;
+    rt_error error;
+    int count = with_emission ? 11 : 8;
+    static const char *const names[11] = {"albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z",
+                                          "depth.Z", "variance.Y", "emission.R", "emission.G", "emission.B"};
+    const float values[11] = {g, g, g, 0, g, 0, 10 * g, v, e, e, e};
+    assert_int_equal(image_create(&layers, 1, 1, count, &error), RT_OK);
+    for (int k = 0; k < count; k++) {
+        strcpy(layers.channel_names[k], names[k]);
+        layers.pixels[k] = values[k];
+    }
+    assert_int_equal(image_append_channels(&base, &layers, &part, &error), RT_OK);
+    image_free(&base);
+    image_free(&layers);
+    return part;
+}
+
+/* Sample ranges with AOVs: the guides of the part that starts lowest, emission weighted by
+ * samples, variance.Y recombined: parts of 4 samples (mean 1, variance 0.5) and 12 (mean
+ * 3, variance 2) are 16 samples of mean 2.5 and E[L^2] = (4 * 1.5 + 12 * 11) / 16 = 8.625,
+ * so variance 8.625 - 6.25 = 2.375. Emission (4 * 1 + 12 * 2) / 16 = 1.75. */
+static void test_aov_layers_merged(void **state)
+{
+    (void)state;
+    merger *m;
+    rt_error error;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(add(m, "late", make_aov_part(3, 12, 0.75f, 2, true, 2), make_metadata(4, 12), &error), RT_OK);
+    assert_int_equal(add(m, "early", make_aov_part(1, 4, 0.25f, 0.5f, true, 1), make_metadata(0, 4), &error), RT_OK);
+    rt_image out, aovs;
+    merge_summary summary;
+    assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+    assert_int_equal(merger_aovs(m, &aovs, &error), RT_OK);
+    assert_int_equal(aovs.channels, 11);
+    assert_string_equal(aovs.channel_names[7], "variance.Y");
+    assert_string_equal(aovs.channel_names[10], "emission.B");
+    float *p = pixel(&aovs, 0, 0);
+    assert_true(p[0] == 0.25f && p[4] == 0.25f && p[6] == 2.5f);   /* the early part's guides */
+    assert_relative(p[7], 2.375, 1e-5);
+    assert_relative(p[8], 1.75, 1e-6);
+    assert_relative(pixel(&out, 0, 0)[0], 2.5, 1e-6);
+    assert_int_equal(summary.warning_count, 0);
+    image_free(&out);
+    image_free(&aovs);
+    merger_free(m);
+
+    /* A part without emission (resumed): the AOVs without it, and a warning. A part
+     * without AOVs at all: none, and a warning. */
+    for (int without = 0; without < 2; without++) {
+        assert_int_equal(merger_create(&m, &error), RT_OK);
+        assert_int_equal(add(m, "a", make_aov_part(1, 4, 0.25f, 0.5f, true, 1), make_metadata(0, 4), &error), RT_OK);
+        rt_image second = without == 0 ? make_aov_part(3, 12, 0.75f, 2, false, 0)
+                                        : make_part(0, 0, 1, 1, 0, 0, 3, 3, 3, 12);
+        assert_int_equal(add(m, "b", second, make_metadata(4, 12), &error), RT_OK);
+        assert_int_equal(merger_finish(m, NULL, &out, &summary, &error), RT_OK);
+        assert_int_equal(merger_aovs(m, &aovs, &error), RT_OK);
+        assert_int_equal(summary.warning_count, 1);
+        if (without == 0) {
+            assert_int_equal(aovs.channels, 8);
+            assert_mentions(summary.warnings[0], "1 of the 2 parts have emission.R/G/B", NULL);
+        } else {
+            assert_null(aovs.pixels);
+            assert_mentions(summary.warnings[0], "1 of the 2 parts have AOV layers", NULL);
+        }
+        image_free(&out);
+        image_free(&aovs);
+        merger_free(m);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -601,6 +675,7 @@ int main(void)
         cmocka_unit_test(test_missing_pieces_described),
         cmocka_unit_test(test_mismatched_parts),
         cmocka_unit_test(test_malformed_parts),
+        cmocka_unit_test(test_aov_layers_merged),
         scratch_test(test_read_part),
     };
     return cmocka_run_group_tests_name("merge", tests, NULL, NULL);
