@@ -3,10 +3,12 @@
 
 #include <cglm/cglm.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define DEFAULT_ITERATIONS 5
 #define DEFAULT_SIGMA_COLOUR 4.0f
@@ -17,6 +19,9 @@
 
 /* Half-width of the window the initial noise variance is measured over (7x7). */
 #define VARIANCE_RADIUS 3
+/* The denoiser's threads: at most this many, and each with at least this many rows. */
+#define DENOISE_THREADS_MAX 64
+#define DENOISE_ROWS_PER_THREAD_MIN 16
 
 postprocess_denoise_options postprocess_denoise_options_defaults(void)
 {
@@ -227,14 +232,32 @@ static float guide_weight(const denoiser *d, const guide_pixel *p, const guide_p
     return expf(-exponent);
 }
 
-/* Measures each pixel's noise variance (mean over the three channels) over its
- * (2 VARIANCE_RADIUS + 1)^2 neighbourhood, weighted by the guides so that geometric edges
- * are not mistaken for noise. signal: three floats a pixel. */
-static void estimate_variance(const denoiser *d, const float *signal, float *variance)
+/* The arrays of one stage of the filter, which runs rows y0 .. y1-1 of it at a time
+ * (run_rows): every pixel of a stage depends only on the stage's inputs. */
+typedef struct stage {
+    const denoiser *d;
+    int step;                    /* atrous_rows: the taps' spacing */
+    const float *signal;         /* three floats a pixel */
+    const float *variance;
+    float *variance_out;         /* estimate_rows, atrous_rows */
+    float *blurred;              /* blur_rows's output, atrous_rows's input */
+    float *filtered;             /* atrous_rows */
+} stage;
+
+/* Measures the noise variance (mean over the three channels) of each pixel of rows y0 ..
+ * y1-1 whose variance_out is still unknown (< 0) over its (2 VARIANCE_RADIUS + 1)^2
+ * neighbourhood, weighted by the guides so that geometric edges are not mistaken for
+ * noise. */
+static void estimate_rows(const stage *s, int y0, int y1)
 {
-    for (int y = 0; y < d->height; y++)
+    const denoiser *d = s->d;
+    const float *signal = s->signal;
+    float *variance = s->variance_out;
+    for (int y = y0; y < y1; y++)
         for (int x = 0; x < d->width; x++) {
             size_t p = (size_t)y * d->width + x;
+            if (variance[p] >= 0.0f)
+                continue;
             double weight_sum = 0.0, sum[3] = {0, 0, 0}, square_sum[3] = {0, 0, 0};
             for (int dy = -VARIANCE_RADIUS; dy <= VARIANCE_RADIUS; dy++)
                 for (int dx = -VARIANCE_RADIUS; dx <= VARIANCE_RADIUS; dx++) {
@@ -258,12 +281,16 @@ static void estimate_variance(const denoiser *d, const float *signal, float *var
         }
 }
 
-/* Blurs variance with the 3x3 binomial kernel over pixels of the same class (hit or
- * sky), into blurred: one noisy variance estimate must not decide a colour weight. */
-static void blur_variance(const denoiser *d, const float *variance, float *blurred)
+/* Blurs rows y0 .. y1-1 of variance with the 3x3 binomial kernel over pixels of the same
+ * class (hit or sky), into blurred: one noisy variance estimate must not decide a colour
+ * weight. */
+static void blur_rows(const stage *s, int y0, int y1)
 {
     static const float binomial[3] = {0.25f, 0.5f, 0.25f};
-    for (int y = 0; y < d->height; y++)
+    const denoiser *d = s->d;
+    const float *variance = s->variance;
+    float *blurred = s->blurred;
+    for (int y = y0; y < y1; y++)
         for (int x = 0; x < d->width; x++) {
             size_t p = (size_t)y * d->width + x;
             float sum = 0.0f, weight_sum = 0.0f;
@@ -283,15 +310,17 @@ static void blur_variance(const denoiser *d, const float *variance, float *blurr
         }
 }
 
-/* One à-trous iteration with taps step pixels apart: filters signal (three floats a
- * pixel) into filtered and carries the variance along from variance into
- * filtered_variance; blurred_variance is scratch. */
-static void atrous_iteration(const denoiser *d, int step, const float *signal, const float *variance,
-                             float *blurred_variance, float *filtered, float *filtered_variance)
+/* Rows y0 .. y1-1 of one à-trous iteration with taps step pixels apart: filters signal
+ * into filtered and carries the variance along from variance into variance_out, the
+ * colour weight reading blurred (blur_rows's, of the whole image). */
+static void atrous_rows(const stage *s, int y0, int y1)
 {
     static const float b3[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
-    blur_variance(d, variance, blurred_variance);
-    for (int y = 0; y < d->height; y++)
+    const denoiser *d = s->d;
+    int step = s->step;
+    const float *signal = s->signal, *variance = s->variance, *blurred_variance = s->blurred;
+    float *filtered = s->filtered, *filtered_variance = s->variance_out;
+    for (int y = y0; y < y1; y++)
         for (int x = 0; x < d->width; x++) {
             size_t p = (size_t)y * d->width + x;
             const float *cp = &signal[3 * p];
@@ -322,6 +351,50 @@ static void atrous_iteration(const denoiser *d, int step, const float *signal, c
                 filtered[3 * p + c] = (float)(sum[c] / weight_sum);
             filtered_variance[p] = (float)(variance_sum / (weight_sum * weight_sum));
         }
+}
+
+/* One thread's share of a stage: rows y0 .. y1-1. */
+typedef struct row_band {
+    const stage *stage;
+    void (*rows)(const stage *, int, int);
+    int y0, y1;
+} row_band;
+
+static void *run_band(void *argument)
+{
+    const row_band *band = argument;
+    band->rows(band->stage, band->y0, band->y1);
+    return NULL;
+}
+
+/* Runs rows over every row of the image, in bands on as many threads as the machine has
+ * cores (at most DENOISE_THREADS_MAX; fewer for small images; one when a thread cannot be
+ * started, which only costs time). Each pixel is computed alone, so the image is the
+ * same whatever the number of threads. */
+static void run_rows(const stage *s, void (*rows)(const stage *, int, int))
+{
+    int height = s->d->height;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int count = cores < 1 ? 1 : cores > DENOISE_THREADS_MAX ? DENOISE_THREADS_MAX : (int)cores;
+    if (count > height / DENOISE_ROWS_PER_THREAD_MIN)
+        count = height / DENOISE_ROWS_PER_THREAD_MIN;
+    if (count <= 1) {
+        rows(s, 0, height);
+        return;
+    }
+    pthread_t threads[DENOISE_THREADS_MAX];
+    row_band bands[DENOISE_THREADS_MAX];
+    bool started[DENOISE_THREADS_MAX];
+    for (int t = 0; t < count; t++) {
+        bands[t] = (row_band){.stage = s, .rows = rows, .y0 = height * t / count, .y1 = height * (t + 1) / count};
+        started[t] = t > 0 && pthread_create(&threads[t], NULL, run_band, &bands[t]) == 0;
+    }
+    for (int t = 0; t < count; t++)
+        if (!started[t])
+            run_band(&bands[t]);
+    for (int t = 1; t < count; t++)
+        if (started[t])
+            pthread_join(threads[t], NULL);
 }
 
 /* Checks a guide image against the colour image: same size, at least needed channels. */
@@ -442,24 +515,26 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
             float direct = emission != NULL ? emission->pixels[i * emission->channels + c] : 0.0f;
             signal[3 * i + c] = (colour->pixels[i * channels + c] - direct) / divisor;
         }
-    /* The noise: measured around each pixel, or the render's own estimate where it has one,
-     * in the demodulated signal's units. */
-    estimate_variance(&d, signal, variance);
-    if (mean_variance != NULL) {
-        for (size_t i = 0; i < count; i++) {
-            float v = mean_variance->pixels[i * mean_variance->channels];
-            if (!(v >= 0.0f) || !isfinite(v))
-                continue;
-            double total = 0.0;
-            for (int c = 0; c < 3; c++) {
-                float divisor = albedo != NULL ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
-                total += v / ((double)divisor * divisor);
-            }
-            variance[i] = (float)(total / 3.0);
+    /* The noise: the render's own estimate where it has one, in the demodulated signal's
+     * units, else (-1 until then) measured around the pixel. */
+    for (size_t i = 0; i < count; i++) {
+        float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
+        variance[i] = -1.0f;
+        if (!(v >= 0.0f) || !isfinite(v))
+            continue;
+        double total = 0.0;
+        for (int c = 0; c < 3; c++) {
+            float divisor = albedo != NULL ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
+            total += v / ((double)divisor * divisor);
         }
+        variance[i] = (float)(total / 3.0);
     }
+    run_rows(&(stage){.d = &d, .signal = signal, .variance_out = variance}, estimate_rows);
     for (int i = 0; i < iterations; i++) {
-        atrous_iteration(&d, 1 << i, signal, variance, blurred_variance, filtered, filtered_variance);
+        run_rows(&(stage){.d = &d, .variance = variance, .blurred = blurred_variance}, blur_rows);
+        run_rows(&(stage){.d = &d, .step = 1 << i, .signal = signal, .variance = variance,
+                          .blurred = blurred_variance, .filtered = filtered, .variance_out = filtered_variance},
+                 atrous_rows);
         float *swap = signal;
         signal = filtered;
         filtered = swap;

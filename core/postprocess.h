@@ -54,6 +54,9 @@
  *      shows counts as noise there, and is spread out); each iteration carries it along
  *      as the variance of the weighted mean (sum (h w)^2 var_q / (sum h w)^2), and the
  *      colour weight reads it blurred over 3x3.
+ * Each stage (the noise estimate, each iteration's variance blur and filter) runs in bands
+ * of rows on as many threads as the machine has cores (pthreads; at most 64, each with at
+ * least 16 rows); every pixel is computed alone, so the image does not depend on them.
  * Depth is a distance; a pixel whose depth is 0, negative, infinite or NaN hit nothing
  * (sky): such pixels form their own class and never mix with pixels that hit something.
  * Between two sky pixels only the colour weight counts.
