@@ -486,7 +486,9 @@ static void test_denoise_leaves_the_emission_seen_at_once(void **state)
     /* The light keeps its radiance and the surface is still smoothed. */
     region_statistics(&b.colour, 0, HALF + 2, 0, SIZE, SIZE, &surface, &surface_variance);
     assert_relative(surface, 10.0, 1e-4);
-    buffers fresh = make_light_edge(&(rt_image){0});
+    rt_image fresh_emission;
+    buffers fresh = make_light_edge(&fresh_emission);
+    image_free(&fresh_emission);
     region_statistics(&fresh.colour, 0, 0, 0, HALF - 2, SIZE, &surface_before, &surface_variance_before);
     region_statistics(&b.colour, 0, 0, 0, HALF - 2, SIZE, &surface, &surface_variance);
     assert_true(surface_variance * 5 <= surface_variance_before);
@@ -545,7 +547,9 @@ static void test_denoise_keeps_a_highlight_its_variance_vouches_for(void **state
     free_buffers(&b);
     /* Measured around each pixel, the noise looks as large as the highlight itself and the
      * highlight is spread into the surface. */
-    b = make_highlight(&(rt_image){0});
+    rt_image unused_variance;
+    b = make_highlight(&unused_variance);
+    image_free(&unused_variance);
     guides.variance = NULL;
     assert_int_equal(postprocess_denoise(&b.colour, &guides, NULL, NULL), RT_OK);
     region_statistics(&b.colour, 0, HALF, HALF, HALF + 2, HALF + 2, &highlight, &unused);
@@ -554,7 +558,8 @@ static void test_denoise_keeps_a_highlight_its_variance_vouches_for(void **state
     /* A variance of -1 means "unknown": the noise is then measured around the pixel, the
      * same image as without the guide. */
     rt_image unknown = make_image(SIZE, SIZE, 1, -1.0f);
-    buffers again = make_highlight(&(rt_image){0});
+    buffers again = make_highlight(&unused_variance);
+    image_free(&unused_variance);
     guides.variance = &unknown;
     assert_int_equal(postprocess_denoise(&again.colour, &guides, NULL, NULL), RT_OK);
     assert_memory_equal(again.colour.pixels, b.colour.pixels, sizeof(float) * SIZE * SIZE * 3);
