@@ -235,6 +235,12 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
     if (metadata->spp <= 0)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "MERGE: '%s' has " METADATA_KEY_SPP " %lld; it must be at least 1", name, metadata->spp);
+    /* A denoised colour weighted and summed would be neither the raw merge nor its denoised
+     * image. */
+    if (image_channel_index(image, "noisy.R") >= 0)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "MERGE: '%s' is denoised (it has noisy.R/G/B); merge raw parts (rendered with --aovs "
+                            "rather than --denoise) and run `rtspheres denoise` on the merge", name);
 
     /* full_width 0 means the image is the full image. */
     int full_width = image->full_width > 0 ? image->full_width : image->width;

@@ -37,6 +37,8 @@
  *     E[L^2] = variance.Y + L^2 (L its mean luminance), to float rounding of the whole
  *     render's. Some parts without them: a warning, and no AOV layers. variance.R/G/B
  *     (--variance) are not merged.
+ *   - A denoised part (it has noisy.R/G/B: render --denoise, `rtspheres denoise`) is
+ *     RT_ERROR_INPUT: merge the raw parts and denoise the merge.
  *
  * Use: merger_create, merger_add once per part (it validates the part against the ones
  * added before and adds its pixels to running double sums, so the caller may free the

@@ -66,6 +66,9 @@ refuse "refuse-overlapping-samples" "s0.exr.*shard1.exr.*samples 4-5" "$scratch/
 refuse "refuse-missing-tile" "missing pieces: 432 pixels.*rows 9-17" "$scratch/tile0.exr" "$scratch/tile2.exr"
 refuse "refuse-overlapping-tiles" "overlap" "$scratch/tile0.exr" "$scratch/tile1.exr" "$scratch/s0.exr"
 refuse "refuse-unreadable-part" "nonexistent.exr" "$scratch/s0.exr" "$scratch/nonexistent.exr"
+render "$scratch/denoised-part.exr" --samples 6:10 --denoise
+refuse "refuse-denoised-part" "denoised-part.exr' is denoised.*rtspheres denoise" "$scratch/s0.exr" \
+    "$scratch/denoised-part.exr"
 # A PPM written by hand: an image, but with no samples channel and no metadata.
 printf 'P6\n48 27\n255\n' >"$scratch/plain.ppm"
 head -c 3888 /dev/zero >>"$scratch/plain.ppm"
