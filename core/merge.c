@@ -219,6 +219,52 @@ static rt_status find_light_groups(const merger *m, const char *name, const rt_i
     return RT_OK;
 }
 
+/* Finds the AOV layers of a part, in aov_names' order, into aov; returns how many of
+ * them it has before the first missing one (AOV_CHANNELS: the layers but the emission). */
+static int find_aov_channels(const rt_image *image, int aov[AOV_ALL_CHANNELS])
+{
+    int found = 0;
+    while (found < AOV_ALL_CHANNELS && (aov[found] = image_channel_index(image, aov_names[found])) >= 0)
+        found++;
+    return found;
+}
+
+/* Makes the merger's AOV arrays for an image of full_pixels, once (merger's comment says
+ * what they hold). False when memory runs out. */
+static bool reserve_aov_sums(merger *m, size_t full_pixels)
+{
+    if (m->guides != NULL)
+        return true;
+    m->guides = calloc(full_pixels * GUIDE_CHANNELS, sizeof *m->guides);
+    m->guide_start = malloc(full_pixels * sizeof *m->guide_start);
+    m->aov_sums = calloc(full_pixels * 4, sizeof *m->aov_sums);
+    if (m->guides == NULL || m->guide_start == NULL || m->aov_sums == NULL)
+        return false;
+    for (size_t i = 0; i < full_pixels; i++)
+        m->guide_start[i] = ULLONG_MAX;
+    return true;
+}
+
+/* Adds the AOV layers of one pixel of a part (channel: its R, G, B, samples; aov:
+ * find_aov_channels'; n its samples there) at pixel at of the full image. */
+static void add_aov_pixel(merger *m, size_t at, const float *pixel, const int channel[4], const int *aov,
+                          bool has_emission, unsigned long long sample_start, double n)
+{
+    /* A render's guides come from its first samples' camera rays: the part that starts
+     * lowest has them. */
+    if (sample_start < m->guide_start[at]) {
+        m->guide_start[at] = sample_start;
+        for (int k = 0; k < GUIDE_CHANNELS; k++)
+            m->guides[at * GUIDE_CHANNELS + k] = pixel[aov[k]];
+    }
+    /* As render.c makes variance.Y: E[L^2] - E[L]^2 of float luminances. */
+    float luminance = 0.2126f * pixel[channel[0]] + 0.7152f * pixel[channel[1]] + 0.0722f * pixel[channel[2]];
+    double *aov_sum = &m->aov_sums[at * 4];
+    aov_sum[3] += n * ((double)pixel[aov[7]] + (double)luminance * luminance);
+    for (int c = 0; has_emission && c < 3; c++)
+        aov_sum[c] += (double)pixel[aov[8 + c]] * n;
+}
+
 rt_status merger_add(merger *m, const char *name, const rt_image *image, const merge_metadata *metadata,
                      rt_error *error)
 {
@@ -296,22 +342,11 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
         m->full_height = full_height;
     }
     int aov[AOV_ALL_CHANNELS];
-    int aov_found = 0;
-    while (aov_found < AOV_ALL_CHANNELS && (aov[aov_found] = image_channel_index(image, aov_names[aov_found])) >= 0)
-        aov_found++;
+    int aov_found = find_aov_channels(image, aov);
     bool has_aovs = aov_found >= AOV_CHANNELS, has_emission = aov_found == AOV_ALL_CHANNELS;
-    if (has_aovs && m->guides == NULL) {
-        size_t full_pixels = (size_t)full_width * full_height;
-        m->guides = malloc(full_pixels * GUIDE_CHANNELS * sizeof *m->guides);
-        m->guide_start = malloc(full_pixels * sizeof *m->guide_start);
-        m->aov_sums = calloc(full_pixels * 4, sizeof *m->aov_sums);
-        if (m->guides == NULL || m->guide_start == NULL || m->aov_sums == NULL) {
-            free(name_copy);
-            return rt_error_set(error, RT_ERROR_RUNTIME, "MERGE: out of memory for the AOV layers");
-        }
-        memset(m->guides, 0, full_pixels * GUIDE_CHANNELS * sizeof *m->guides);
-        for (size_t i = 0; i < full_pixels; i++)
-            m->guide_start[i] = ULLONG_MAX;
+    if (has_aovs && !reserve_aov_sums(m, (size_t)full_width * full_height)) {
+        free(name_copy);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "MERGE: out of memory for the AOV layers");
     }
     if (m->layer_sums == NULL && layers.count > 0) {
         size_t full_values = (size_t)full_width * full_height * 3 * (size_t)layers.count;
@@ -346,21 +381,8 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
             for (int g = 0; g < layers.count; g++)
                 for (int c = 0; c < 3; c++)
                     layer_sum[3 * g + c] += (double)pixel[layers.channels[g][c]] * n;
-            if (!has_aovs)
-                continue;
-            /* A render's guides come from its first samples' camera rays: the part that
-             * starts lowest has them. */
-            if (metadata->sample_start < m->guide_start[at]) {
-                m->guide_start[at] = metadata->sample_start;
-                for (int k = 0; k < GUIDE_CHANNELS; k++)
-                    m->guides[at * GUIDE_CHANNELS + k] = pixel[aov[k]];
-            }
-            /* As render.c makes variance.Y: E[L^2] - E[L]^2 of float luminances. */
-            float luminance = 0.2126f * pixel[channel[0]] + 0.7152f * pixel[channel[1]] + 0.0722f * pixel[channel[2]];
-            double *aov_sum = &m->aov_sums[at * 4];
-            aov_sum[3] += n * ((double)pixel[aov[7]] + (double)luminance * luminance);
-            for (int c = 0; has_emission && c < 3; c++)
-                aov_sum[c] += (double)pixel[aov[8 + c]] * n;
+            if (has_aovs)
+                add_aov_pixel(m, at, pixel, channel, aov, has_emission, metadata->sample_start, n);
         }
     return RT_OK;
 }

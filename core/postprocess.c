@@ -397,6 +397,39 @@ static void run_rows(const stage *s, void (*rows)(const stage *, int, int))
             pthread_join(threads[t], NULL);
 }
 
+/* Checks that the first three channels of image (named which in messages) are finite. */
+static rt_status check_finite(const rt_image *image, const char *which, rt_error *error)
+{
+    size_t count = pixel_count(image);
+    for (size_t i = 0; i < count; i++)
+        for (int c = 0; c < 3; c++)
+            if (!isfinite(image->pixels[i * image->channels + c]))
+                return rt_error_set(error, RT_ERROR_INPUT,
+                                    "POSTPROCESS: the %s image has %s at pixel (%d, %d), channel %d", which, isnan(image->pixels[i * image->channels + c]) ? "NaN" : "an infinity",
+                                    (int)(i % image->width), (int)(i / image->width), c);
+    return RT_OK;
+}
+
+/* Fills variance (count pixels) with the variance guide's value where it has one (>= 0), in
+ * the demodulated signal's units (divided by the squared divisor, averaged over the
+ * channels), and -1 (unknown: estimate_rows measures it) elsewhere. */
+static void noise_from_guide(const rt_image *mean_variance, const guide_pixel *guides, bool demodulate,
+                             float albedo_epsilon, size_t count, float *variance)
+{
+    for (size_t i = 0; i < count; i++) {
+        float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
+        variance[i] = -1.0f;
+        if (!(v >= 0.0f) || !isfinite(v))
+            continue;
+        double total = 0.0;
+        for (int c = 0; c < 3; c++) {
+            float divisor = demodulate ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
+            total += v / ((double)divisor * divisor);
+        }
+        variance[i] = (float)(total / 3.0);
+    }
+}
+
 /* Checks a guide image against the colour image: same size, at least needed channels. */
 static rt_status check_guide(const rt_image *guide, const char *which, const rt_image *colour, int needed,
                              rt_error *error)
@@ -463,18 +496,9 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
 
     size_t count = pixel_count(colour);
     int channels = colour->channels;
-    const rt_image *checked_images[2] = {colour, emission};
-    for (int k = 0; k < 2; k++) {
-        const rt_image *image = checked_images[k];
-        for (size_t i = 0; image != NULL && i < count; i++)
-            for (int c = 0; c < 3; c++)
-                if (!isfinite(image->pixels[i * image->channels + c]))
-                    return rt_error_set(error, RT_ERROR_INPUT,
-                                        "POSTPROCESS: the %s image has %s at pixel (%d, %d), channel %d",
-                                        k == 0 ? "colour" : "emission",
-                                        isnan(image->pixels[i * image->channels + c]) ? "NaN" : "an infinity",
-                                        (int)(i % colour->width), (int)(i / colour->width), c);
-    }
+    if ((status = check_finite(colour, "colour", error)) != RT_OK
+        || (emission != NULL && (status = check_finite(emission, "emission", error)) != RT_OK))
+        return status;
 
     int iterations = given.iterations != 0 ? given.iterations : DEFAULT_ITERATIONS;
     float sigma_normal = or_default(given.sigma_normal, DEFAULT_SIGMA_NORMAL);
@@ -515,20 +539,8 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
             float direct = emission != NULL ? emission->pixels[i * emission->channels + c] : 0.0f;
             signal[3 * i + c] = (colour->pixels[i * channels + c] - direct) / divisor;
         }
-    /* The noise: the render's own estimate where it has one, in the demodulated signal's
-     * units, else (-1 until then) measured around the pixel. */
-    for (size_t i = 0; i < count; i++) {
-        float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
-        variance[i] = -1.0f;
-        if (!(v >= 0.0f) || !isfinite(v))
-            continue;
-        double total = 0.0;
-        for (int c = 0; c < 3; c++) {
-            float divisor = albedo != NULL ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
-            total += v / ((double)divisor * divisor);
-        }
-        variance[i] = (float)(total / 3.0);
-    }
+    /* The noise: the render's own estimate where it has one, else measured around the pixel. */
+    noise_from_guide(mean_variance, guides, albedo != NULL, albedo_epsilon, count, variance);
     run_rows(&(stage){.d = &d, .signal = signal, .variance_out = variance}, estimate_rows);
     for (int i = 0; i < iterations; i++) {
         run_rows(&(stage){.d = &d, .variance = variance, .blurred = blurred_variance}, blur_rows);
