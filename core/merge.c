@@ -92,15 +92,6 @@ void merger_free(merger *m)
     free(m);
 }
 
-/* Returns the index of the channel called name in image, or -1. */
-static int find_channel(const rt_image *image, const char *name)
-{
-    for (int c = 0; c < image->channels; c++)
-        if (strncmp(image->channel_names[c], name, IMAGE_CHANNEL_NAME_MAX) == 0)
-            return c;
-    return -1;
-}
-
 /* Describes a window as inclusive columns and rows into text (size bytes), the way a
  * person reads "rows 12-23"; returns text. */
 static const char *describe_window(int x, int y, int width, int height, char *text, size_t size)
@@ -265,13 +256,17 @@ static void add_aov_pixel(merger *m, size_t at, const float *pixel, const int ch
         aov_sum[c] += (double)pixel[aov[8 + c]] * n;
 }
 
-rt_status merger_add(merger *m, const char *name, const rt_image *image, const merge_metadata *metadata,
-                     rt_error *error)
+/* Checks a part on its own: pixels, its R, G, B and samples channels (their indices into
+ * channel), its spp, not denoised, its data window within its full image (whose size goes
+ * to *full_width, *full_height), finite sample counts. RT_ERROR_INPUT naming the part. */
+static rt_status check_part(const char *name, const rt_image *image, const merge_metadata *metadata, int channel[4],
+                            int *full_width, int *full_height, rt_error *error)
 {
     if (image == NULL || image->pixels == NULL || image->width <= 0 || image->height <= 0)
         return rt_error_set(error, RT_ERROR_INPUT, "MERGE: '%s' has no pixels", name);
-    int channel[4] = {find_channel(image, "R"), find_channel(image, "G"), find_channel(image, "B"),
-                      find_channel(image, "samples")};
+    static const char *const channel_names[4] = {"R", "G", "B", "samples"};
+    for (int c = 0; c < 4; c++)
+        channel[c] = image_channel_index(image, channel_names[c]);
     if (channel[0] < 0 || channel[1] < 0 || channel[2] < 0)
         return rt_error_set(error, RT_ERROR_INPUT, "MERGE: '%s' lacks an R, G or B channel", name);
     if (channel[3] < 0)
@@ -289,15 +284,15 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
                             "rather than --denoise) and run `rtspheres denoise` on the merge", name);
 
     /* full_width 0 means the image is the full image. */
-    int full_width = image->full_width > 0 ? image->full_width : image->width;
-    int full_height = image->full_width > 0 ? image->full_height : image->height;
+    *full_width = image->full_width > 0 ? image->full_width : image->width;
+    *full_height = image->full_width > 0 ? image->full_height : image->height;
     /* In long long: a malformed file's window must not overflow the check itself. */
-    if (image->x < 0 || image->y < 0 || (long long)image->x + image->width > full_width
-        || (long long)image->y + image->height > full_height) {
+    if (image->x < 0 || image->y < 0 || (long long)image->x + image->width > *full_width
+        || (long long)image->y + image->height > *full_height) {
         char window[96];
         return rt_error_set(error, RT_ERROR_INPUT, "MERGE: the data window of '%s' (%s) lies outside its %dx%d image",
                             name, describe_window(image->x, image->y, image->width, image->height, window,
-                                                  sizeof window), full_width, full_height);
+                                                  sizeof window), *full_width, *full_height);
     }
     size_t pixel_count = (size_t)image->width * image->height;
     for (size_t i = 0; i < pixel_count; i++) {
@@ -306,8 +301,16 @@ rt_status merger_add(merger *m, const char *name, const rt_image *image, const m
             return rt_error_set(error, RT_ERROR_INPUT, "MERGE: '%s' has a sample count of %g at pixel (%d, %d)",
                                 name, n, image->x + (int)(i % image->width), image->y + (int)(i / image->width));
     }
+    return RT_OK;
+}
 
-    rt_status status;
+rt_status merger_add(merger *m, const char *name, const rt_image *image, const merge_metadata *metadata,
+                     rt_error *error)
+{
+    int channel[4], full_width = 0, full_height = 0;
+    rt_status status = check_part(name, image, metadata, channel, &full_width, &full_height, error);
+    if (status != RT_OK)
+        return status;
     int region_index = 0;
     if (m->part_count > 0) {
         status = check_same_render(m, name, full_width, full_height, metadata, error);
@@ -696,7 +699,7 @@ rt_status merge_read_part(const char *path, rt_image *image, merge_metadata *met
     rt_status status = image_read(path, image, error);
     if (status != RT_OK)
         return status;
-    if (find_channel(image, "samples") < 0) {
+    if (image_channel_index(image, "samples") < 0) {
         image_free(image);
         return rt_error_set(error, RT_ERROR_INPUT,
                             "MERGE: '%s' has no 'samples' channel, so its pixels cannot be weighted; merge EXR "
