@@ -12,8 +12,10 @@
 
 #include "commands.h"
 #include "image_io.h"
+#include "metadata_keys.h"
 #include "postprocess.h"
 #include "render_denoise.h"
+#include "render_output.h"
 
 static void print_help(FILE *stream)
 {
@@ -82,9 +84,11 @@ static rt_status denoise_image(const char *input, const rt_image *image, rt_imag
     for (int c = 0; c < 3; c++)
         if ((colour_channels[c] = image_channel_index(image, colour_names[c])) < 0)
             return rt_error_set(error, RT_ERROR_INPUT, "'%s' has no %s channel", input, colour_names[c]);
-    if (image_channel_index(image, "noisy.R") >= 0)
-        return rt_error_set(error, RT_ERROR_INPUT,
-                            "'%s' is denoised already (it has noisy.R/G/B); denoise the render it came from", input);
+    char steps[256] = "";
+    image_read_attribute(input, METADATA_KEY_POSTPROCESS, steps, sizeof steps, NULL);
+    if (image_channel_index(image, "noisy.R") >= 0 || steps[0] != '\0')
+        return rt_error_set(error, RT_ERROR_INPUT, "'%s' is post-processed already (%s); denoise the render it came from",
+                            input, steps[0] != '\0' ? steps : "it has noisy.R/G/B");
     rt_image noisy = {0};
     rt_status status = image_create(colour, image->width, image->height, 3, error);
     size_t pixels = (size_t)image->width * image->height;
@@ -127,10 +131,17 @@ int command_denoise(int argc, char **argv)
     if (status == RT_OK)
         status = denoise_image(input, &image, &denoised, &colour, &error);
     image_free(&image);
+    image_attribute_set metadata = {0};
+    if (status == RT_OK)
+        status = render_output_derived_metadata(input, "denoise", &metadata, &error);
+    image_write_options options = image_write_options_defaults();
+    options.attributes = metadata.attributes;
+    options.attribute_count = metadata.count;
     if (status == RT_OK && image_format_of(output) == IMAGE_FORMAT_EXR)
-        status = image_write(output, &denoised, NULL, &error);
+        status = image_write(output, &denoised, &options, &error);
     else if (status == RT_OK)
-        status = command_write_colour(output, &colour, tonemap, exposure, &error);
+        status = command_write_colour(output, &colour, tonemap, exposure, &metadata, &error);
+    image_attribute_set_free(&metadata);
     image_free(&denoised);
     image_free(&colour);
     if (status != RT_OK) {

@@ -16,6 +16,7 @@
 #include "paths.h"
 #include "postprocess.h"
 #include "relight.h"
+#include "render_output.h"
 
 static void print_help(FILE *stream)
 {
@@ -40,23 +41,27 @@ static void print_help(FILE *stream)
             "group layers, a group the file does not have)\n");
 }
 
-/* Writes the relit image to output: an EXR with its layers and their names, other
- * formats R, G, B only, 8-bit ones exposed and tone-mapped. */
+/* Writes the relit image to output with metadata (the input's, render_output.h
+ * render_output_derived_metadata): an EXR with its layers and their names, other formats
+ * R, G, B only, 8-bit ones exposed and tone-mapped. */
 static rt_status write_relit(const char *output, rt_image *relit, const relight_layers *layers,
-                             postprocess_tonemap_operator tonemap, double exposure, rt_error *error)
+                             image_attribute_set *metadata, postprocess_tonemap_operator tonemap, double exposure,
+                             rt_error *error)
 {
     image_format format = image_format_of(output);
-    if (format == IMAGE_FORMAT_EXR) {
-        char groups[SCENE_LIGHT_GROUP_MAX * SCENE_NAME_MAX];
-        relight_group_list(layers, groups, sizeof groups);
-        image_attribute attribute = {.name = METADATA_KEY_LIGHT_GROUPS, .type = IMAGE_ATTRIBUTE_STRING,
-                                     .string_value = groups};
-        image_write_options options = image_write_options_defaults();
-        options.attributes = &attribute;
-        options.attribute_count = 1;
-        return image_write(output, relit, &options, error);
+    if (format != IMAGE_FORMAT_EXR) {
+        image_attribute_set_remove(metadata, METADATA_KEY_LIGHT_GROUPS);   /* no layers there */
+        return command_write_colour(output, relit, tonemap, exposure, metadata, error);
     }
-    return command_write_colour(output, relit, tonemap, exposure, error);
+    char groups[SCENE_LIGHT_GROUP_MAX * SCENE_NAME_MAX];
+    relight_group_list(layers, groups, sizeof groups);
+    image_attribute attribute = {.name = METADATA_KEY_LIGHT_GROUPS, .type = IMAGE_ATTRIBUTE_STRING,
+                                 .string_value = groups};
+    rt_status status = image_attribute_set_put(metadata, &attribute, error);
+    image_write_options options = image_write_options_defaults();
+    options.attributes = metadata->attributes;
+    options.attribute_count = metadata->count;
+    return status == RT_OK ? image_write(output, relit, &options, error) : status;
 }
 
 /* Parses the options into the outputs; returns EXIT_OK or an exit code after saying why. */
@@ -131,8 +136,14 @@ int command_relight(int argc, char **argv)
     if (status == RT_OK)
         status = relight_apply(&image, &layers, weights, weight_count, &relit, &error);
     image_free(&image);
+    image_attribute_set metadata = {0};
+    char step[SCENE_LIGHT_GROUP_MAX * (SCENE_NAME_MAX + 48) + 16];
+    relight_describe(weights, weight_count, step, sizeof step);
     if (status == RT_OK)
-        status = write_relit(output, &relit, &layers, tonemap, exposure, &error);
+        status = render_output_derived_metadata(input, step, &metadata, &error);
+    if (status == RT_OK)
+        status = write_relit(output, &relit, &layers, &metadata, tonemap, exposure, &error);
+    image_attribute_set_free(&metadata);
     image_free(&relit);
     if (status != RT_OK) {
         fprintf(stderr, "rtspheres relight: %s\n", error.message);

@@ -68,7 +68,7 @@ int command_parse_tonemap(const char *command, const char *text, postprocess_ton
 }
 
 rt_status command_write_colour(const char *output, const rt_image *image, postprocess_tonemap_operator tonemap,
-                               double exposure, rt_error *error)
+                               double exposure, const image_attribute_set *metadata, rt_error *error)
 {
     rt_image colour = {0};
     rt_status status = image_create(&colour, image->width, image->height, 3, error);
@@ -79,6 +79,10 @@ rt_status command_write_colour(const char *output, const rt_image *image, postpr
         memcpy(colour.pixels + 3 * i, image->pixels + i * (size_t)image->channels, 3 * sizeof(float));
     image_write_options options = image_write_options_defaults();
     options.exposure = (float)exposure;
+    if (metadata != NULL) {
+        options.attributes = metadata->attributes;
+        options.attribute_count = metadata->count;
+    }
     if (image_format_of(output) == IMAGE_FORMAT_EIGHT_BIT && tonemap != TONEMAP_CLAMP) {
         /* The writer's exposure would apply a second time after tone mapping. */
         status = postprocess_tonemap(&colour, tonemap, (float)exposure, error);

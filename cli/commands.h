@@ -56,8 +56,9 @@ int command_image_to_image(const char *command, int argc, char **argv, const cha
                            const char **input);
 
 /* Writes the first three channels of image (R, G, B) to output, a format other than EXR:
- * 8-bit ones exposed by 2^exposure and tone-mapped as renders are. */
+ * 8-bit ones exposed by 2^exposure and tone-mapped as renders are; with metadata's
+ * attributes (NULL: none), as renders write theirs into every format. */
 rt_status command_write_colour(const char *output, const rt_image *image, postprocess_tonemap_operator tonemap,
-                               double exposure, rt_error *error);
+                               double exposure, const image_attribute_set *metadata, rt_error *error);
 
 #endif

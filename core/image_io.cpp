@@ -657,6 +657,37 @@ rt_status image_read_attribute_impl(const char *path, const char *name, char *va
     return RT_OK;
 }
 
+/* Reads path's attributes named prefix... into *out; see image_read_attributes(). */
+rt_status read_attributes_impl(const char *path, const char *prefix, image_attribute_set *out, rt_error *error)
+{
+    auto input = open_input(path, error);
+    if (!input)
+        return RT_ERROR_INPUT;
+    size_t prefix_length = strlen(prefix);
+    for (const OIIO::ParamValue &parameter : input->spec().extra_attribs) {
+        std::string name = parameter.name().string();
+        if (name.compare(0, prefix_length, prefix) != 0)
+            continue;
+        OIIO::TypeDesc type = parameter.type();
+        bool scalar = parameter.nvalues() == 1 && type.aggregate == OIIO::TypeDesc::SCALAR && type.arraylen == 0;
+        std::string text = attribute_text(parameter);
+        image_attribute attribute = {name.c_str(), IMAGE_ATTRIBUTE_STRING, text.c_str(), 0, 0.0};
+        if (scalar && type.basetype == OIIO::TypeDesc::INT32) {
+            attribute = {name.c_str(), IMAGE_ATTRIBUTE_INT, nullptr, parameter.get_int(), 0.0};
+        } else if (scalar && type.basetype == OIIO::TypeDesc::DOUBLE) {
+            attribute = {name.c_str(), IMAGE_ATTRIBUTE_FLOAT, nullptr, 0, *(const double *)parameter.data()};
+        } else if (scalar && (type.basetype == OIIO::TypeDesc::FLOAT || type.basetype == OIIO::TypeDesc::HALF)) {
+            attribute = {name.c_str(), IMAGE_ATTRIBUTE_FLOAT, nullptr, 0, (double)parameter.get_float()};
+        }
+        rt_status status = image_attribute_set_put(out, &attribute, error);
+        if (status != RT_OK) {
+            image_attribute_set_free(out);
+            return status;
+        }
+    }
+    return RT_OK;
+}
+
 /* image_read() and image_read_linear(): reads path with image_read_impl(), turning every C++
  * exception into a status; on failure out is freed and zeroed. */
 rt_status image_read_guarded(const char *path, int max_side, bool linear, rt_image *out,
@@ -1002,6 +1033,85 @@ rt_status image_read_attribute(const char *path, const char *name, char *value, 
     } catch (...) {
         return read_failed(error, path, "unexpected C++ exception");
     }
+}
+
+rt_status image_read_attributes(const char *path, const char *prefix, image_attribute_set *out, rt_error *error)
+{
+    image_attribute_set_free(out);
+    if (path == nullptr)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no path to read attributes from");
+    try {
+        return read_attributes_impl(path, prefix ? prefix : "", out, error);
+    } catch (const std::bad_alloc &) {
+        image_attribute_set_free(out);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: cannot read '%s': out of memory", path);
+    } catch (const std::exception &e) {
+        image_attribute_set_free(out);
+        return read_failed(error, path, one_line(e.what()));
+    } catch (...) {
+        image_attribute_set_free(out);
+        return read_failed(error, path, "unexpected C++ exception");
+    }
+}
+
+rt_status image_attribute_set_put(image_attribute_set *set, const image_attribute *attribute, rt_error *error)
+{
+    image_attribute copy = *attribute;
+    copy.name = strdup(attribute->name ? attribute->name : "");
+    copy.string_value = attribute->string_value ? strdup(attribute->string_value) : nullptr;
+    image_attribute *grown = nullptr;
+    const image_attribute *existing = image_attribute_set_find(set, copy.name ? copy.name : "");
+    if (existing == nullptr && copy.name != nullptr)
+        grown = (image_attribute *)realloc(set->attributes, ((size_t)set->count + 1) * sizeof *grown);
+    if (copy.name == nullptr || (attribute->string_value && copy.string_value == nullptr)
+        || (existing == nullptr && grown == nullptr)) {
+        free((void *)copy.name);
+        free((void *)copy.string_value);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "IMAGE: out of memory for metadata '%s'",
+                            attribute->name ? attribute->name : "");
+    }
+    if (existing != nullptr) {
+        image_attribute *slot = set->attributes + (existing - set->attributes);
+        free((void *)slot->name);
+        free((void *)slot->string_value);
+        *slot = copy;
+        return RT_OK;
+    }
+    set->attributes = grown;
+    set->attributes[set->count++] = copy;
+    return RT_OK;
+}
+
+const image_attribute *image_attribute_set_find(const image_attribute_set *set, const char *name)
+{
+    for (int i = 0; i < set->count; i++)
+        if (strcmp(set->attributes[i].name, name) == 0)
+            return &set->attributes[i];
+    return nullptr;
+}
+
+void image_attribute_set_remove(image_attribute_set *set, const char *name)
+{
+    const image_attribute *found = image_attribute_set_find(set, name);
+    if (found == nullptr)
+        return;
+    int index = (int)(found - set->attributes);
+    free((void *)set->attributes[index].name);
+    free((void *)set->attributes[index].string_value);
+    memmove(set->attributes + index, set->attributes + index + 1,
+            (size_t)(set->count - index - 1) * sizeof *set->attributes);
+    set->count--;
+}
+
+void image_attribute_set_free(image_attribute_set *set)
+{
+    for (int i = 0; i < set->count; i++) {
+        free((void *)set->attributes[i].name);
+        free((void *)set->attributes[i].string_value);
+    }
+    free(set->attributes);
+    set->attributes = nullptr;
+    set->count = 0;
 }
 
 }  // extern "C"

@@ -161,6 +161,34 @@ float image_srgb_decode(float value);
 rt_status image_read_attribute(const char *path, const char *name, char *value, int value_size,
                                rt_error *error);
 
+/* A file's metadata, for passing on what it says into a file made from it (rtspheres
+ * denoise and relight, core/render_output.h). Owns its entries' names and strings;
+ * an empty set is all zero. Free with image_attribute_set_free(). */
+typedef struct image_attribute_set {
+    image_attribute *attributes;
+    int count;
+} image_attribute_set;
+
+/* Reads every attribute of the file at path whose name starts with prefix ("" for all)
+ * into *out (emptied first; the caller frees it), in the file's order: strings as
+ * STRING, 32-bit integers as INT, float and double scalars as FLOAT, anything else as
+ * the text image_read_attribute() gives. Missing or unreadable file: RT_ERROR_INPUT, *out
+ * empty; out of memory: RT_ERROR_RUNTIME, *out empty. */
+rt_status image_read_attributes(const char *path, const char *prefix, image_attribute_set *out, rt_error *error);
+
+/* Puts a copy of attribute into set: replaces the entry of the same name in place, or
+ * appends it. Out of memory: RT_ERROR_RUNTIME, set as it was. */
+rt_status image_attribute_set_put(image_attribute_set *set, const image_attribute *attribute, rt_error *error);
+
+/* Returns set's entry named name, or NULL. */
+const image_attribute *image_attribute_set_find(const image_attribute_set *set, const char *name);
+
+/* Removes set's entry named name, if there is one; the others keep their order. */
+void image_attribute_set_remove(image_attribute_set *set, const char *name);
+
+/* Frees what set owns and empties it. */
+void image_attribute_set_free(image_attribute_set *set);
+
 #ifdef __cplusplus
 }
 #endif

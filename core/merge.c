@@ -257,7 +257,7 @@ static void add_aov_pixel(merger *m, size_t at, const float *pixel, const int ch
 }
 
 /* Checks a part on its own: pixels, its R, G, B and samples channels (their indices into
- * channel), its spp, not denoised, its data window within its full image (whose size goes
+ * channel), its spp, not post-processed, its data window within its full image (whose size goes
  * to *full_width, *full_height), finite sample counts. RT_ERROR_INPUT naming the part. */
 static rt_status check_part(const char *name, const rt_image *image, const merge_metadata *metadata, int channel[4],
                             int *full_width, int *full_height, rt_error *error)
@@ -276,8 +276,13 @@ static rt_status check_part(const char *name, const rt_image *image, const merge
     if (metadata->spp <= 0)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "MERGE: '%s' has " METADATA_KEY_SPP " %lld; it must be at least 1", name, metadata->spp);
-    /* A denoised colour weighted and summed would be neither the raw merge nor its denoised
-     * image. */
+    /* A denoised (blurred, relit) colour weighted and summed would be neither the raw merge
+     * nor its post-processed image. noisy.R: a --denoise render of before the postprocess key. */
+    if (metadata->postprocess[0] != '\0')
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "MERGE: '%s' is post-processed (" METADATA_KEY_POSTPROCESS " \"%s\"): its colour is no "
+                            "longer the render's means; merge the raw parts (rendered with --aovs for `rtspheres "
+                            "denoise`, --light-groups for `rtspheres relight`) and post-process the merge", name, metadata->postprocess);
     if (image_channel_index(image, "noisy.R") >= 0)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "MERGE: '%s' is denoised (it has noisy.R/G/B); merge raw parts (rendered with --aovs "
@@ -738,6 +743,7 @@ rt_status merge_read_part(const char *path, rt_image *image, merge_metadata *met
     read_text(path, METADATA_KEY_PATH_SEGMENTS, false, text, sizeof text, NULL);
     metadata->path_segments = text[0] ? strtod(text, NULL) : 0;
     read_text(path, METADATA_KEY_LIGHT_GROUPS, false, metadata->light_groups, MERGE_LIGHT_GROUPS_MAX, NULL);
+    read_text(path, METADATA_KEY_POSTPROCESS, false, metadata->postprocess, MERGE_TEXT_MAX, NULL);
     return RT_OK;
 
 failed:

@@ -73,6 +73,7 @@ typedef struct merge_metadata {
     double render_seconds;               /* rtspheres:render_seconds, 0 when absent */
     double path_segments;                /* rtspheres:path_segments, 0 when absent */
     char light_groups[MERGE_LIGHT_GROUPS_MAX];   /* rtspheres:light_groups, "" when absent */
+    char postprocess[MERGE_TEXT_MAX];    /* rtspheres:postprocess, "" when absent (a raw part) */
 } merge_metadata;
 
 typedef struct merge_options {

@@ -1,7 +1,8 @@
 /* metadata_keys.h: the names of the rtspheres:* metadata in the EXR files rtspheres writes,
  * spelled once. The writer is core/render_output.c (for renders, their partial files and
  * merges); the readers are core/merge.c (merge_read_part), core/render_output.c (resuming
- * a partial), core/relight.c and cli/command_stats.c.
+ * a partial), core/relight.c, cli/command_stats.c and render_output_derived_metadata()
+ * (core/render_output.c, which copies them into what denoise and relight make).
  *
  *   key               type      what it says
  *   version           string    the rtspheres version that wrote the file
@@ -30,6 +31,14 @@
  *   light_groups      string    only with light group layers (--light-groups, relight): the
  *                               groups' names, comma-separated; group NAME's layer is the
  *                               channels NAME.R, NAME.G, NAME.B
+ *   postprocess       string    only in an image whose colour is no longer the render's
+ *                               means: what changed it, in order, "; "-separated: "denoise"
+ *                               (render --denoise, rtspheres denoise), "blur sigma=S passes=N"
+ *                               (render --blur), "relight NAME=W ..." (rtspheres relight,
+ *                               each --group as given, normalised). Such a file is refused
+ *                               as a merge part. rtspheres denoise and relight carry every
+ *                               other key of their input into their output but
+ *                               options_hash (render_output.h render_output_derived_metadata)
  * "text" values are whole numbers stored as decimal text, since an OpenEXR int attribute
  * holds 32 bits only.
  */
@@ -54,10 +63,11 @@
 #define METADATA_KEY_MIN_SPP "rtspheres:min_spp"
 #define METADATA_KEY_LIGHT_GROUPS "rtspheres:light_groups"
 #define METADATA_KEY_OPTIONS_HASH "rtspheres:options_hash"
+#define METADATA_KEY_POSTPROCESS "rtspheres:postprocess"
 
 /* Every key, in the order `rtspheres stats` prints them: an initializer for an array of
  * METADATA_KEY_COUNT strings. */
-#define METADATA_KEY_COUNT 18
+#define METADATA_KEY_COUNT 19
 #define METADATA_KEYS_IN_STATS_ORDER                                                                         \
     {                                                                                                        \
         METADATA_KEY_VERSION, METADATA_KEY_SCENE, METADATA_KEY_SCENE_HASH, METADATA_KEY_OPTIONS_HASH,          \
@@ -65,7 +75,7 @@
             METADATA_KEY_SEED, METADATA_KEY_MAX_DEPTH, METADATA_KEY_SAMPLE_START, METADATA_KEY_SAMPLES_FINISHED, \
             METADATA_KEY_PATH_SEGMENTS, METADATA_KEY_COMPLETE, METADATA_KEY_STOP_REASON,                      \
             METADATA_KEY_NOISE_THRESHOLD, METADATA_KEY_MIN_SPP, METADATA_KEY_RENDER_SECONDS,                 \
-            METADATA_KEY_MERGED_PARTS, METADATA_KEY_LIGHT_GROUPS,                                            \
+            METADATA_KEY_MERGED_PARTS, METADATA_KEY_LIGHT_GROUPS, METADATA_KEY_POSTPROCESS,                  \
     }
 
 #endif

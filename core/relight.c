@@ -57,6 +57,21 @@ void relight_group_list(const relight_layers *layers, char *text, size_t size)
     }
 }
 
+void relight_describe(const relight_weight *weights, int count, char *text, size_t size)
+{
+    if (size == 0)
+        return;
+    snprintf(text, size, "relight");
+    for (int w = 0; w < count; w++) {
+        const float *rgb = weights[w].rgb;
+        size_t used = strlen(text);
+        if (rgb[0] == rgb[1] && rgb[1] == rgb[2])
+            snprintf(text + used, size - used, " %s=%g", weights[w].group, rgb[0]);
+        else
+            snprintf(text + used, size - used, " %s=%g,%g,%g", weights[w].group, rgb[0], rgb[1], rgb[2]);
+    }
+}
+
 /* Parses all of text as a finite number into *value. */
 static bool parse_finite(const char *text, float *value)
 {

@@ -42,6 +42,11 @@ rt_status relight_parse_weight(const char *text, relight_weight *weight, rt_erro
 /* Writes the comma-separated names of layers into text (size bytes). */
 void relight_group_list(const relight_layers *layers, char *text, size_t size);
 
+/* Writes what relight_apply() does with weights (count of them) into text (size bytes),
+ * as rtspheres:postprocess records it (metadata_keys.h): "relight", then NAME=SCALE or
+ * NAME=R,G,B for each weight in order ("relight key=2 fill=1,0.5,0.2"). */
+void relight_describe(const relight_weight *weights, int count, char *text, size_t size);
+
 /* Makes the relit image *out (allocated; free with image_free()) from image and its
  * layers: every group weighs 1 unless weights (count of them) say otherwise (a later
  * weight of the same group wins). A weight naming a group the image has not:

@@ -76,6 +76,14 @@ void job_image_metadata(const job_image *image, const char *path, uint64_t sampl
     for (int g = 0; layers && g < image->scene.light_group_count; g++)
         snprintf(texts->groups + strlen(texts->groups), sizeof texts->groups - strlen(texts->groups), "%s%s",
                  g > 0 ? "," : "", image->scene.light_groups[g]);
+    /* What --denoise and --blur did to the output's colour (postprocess_result below). */
+    texts->postprocess[0] = '\0';
+    bool output = strcmp(path, image->plan.output) == 0 && !checkpoint;
+    if (output && job->denoise)
+        snprintf(texts->postprocess, sizeof texts->postprocess, "denoise");
+    if (output && job->blur_sigma > 0)
+        snprintf(texts->postprocess + strlen(texts->postprocess), sizeof texts->postprocess - strlen(texts->postprocess),
+                 "%sblur sigma=%g passes=%d", job->denoise ? "; " : "", job->blur_sigma, job->blur_passes > 0 ? job->blur_passes : 1);
     *metadata = (render_output_metadata){
         .scene = job->scene_path,
         .scene_hash = texts->hash,
@@ -90,6 +98,7 @@ void job_image_metadata(const job_image *image, const char *path, uint64_t sampl
         .complete = complete,
         .render_seconds = result->seconds,
         .light_groups = texts->groups[0] != '\0' ? texts->groups : NULL,
+        .postprocess = texts->postprocess[0] != '\0' ? texts->postprocess : NULL,
     };
     if (!checkpoint) {
         bool adaptive = job->tracer.noise_threshold > 0;

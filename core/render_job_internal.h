@@ -34,10 +34,12 @@ typedef struct job_metadata_texts {
     char hash[24];
     char options_hash[24];
     char groups[SCENE_LIGHT_GROUP_MAX * (SCENE_LIGHT_GROUP_NAME_MAX + 1) + 1];
+    char postprocess[64];
 } job_metadata_texts;
 
 /* Fills *metadata (pointing into *texts) for image's file at path (the output lists its
- * light groups; the partial file keeps no layers): samples finished, complete (the render
+ * light groups and the post-processing of its colour; the partial file keeps no layers and
+ * raw colour): samples finished, complete (the render
  * ended by its own rule), checkpoint (a checkpoint's file: no stop reason); result gives
  * the scene hash, path segments, time and stop reason. */
 void job_image_metadata(const job_image *image, const char *path, uint64_t samples, bool complete,

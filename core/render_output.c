@@ -38,7 +38,7 @@ static const rt_image *image_for_format(const char *path, const rt_image *image,
 
 /* The image attributes of metadata (metadata_keys.h), with the texts they point into. */
 typedef struct output_attributes {
-    image_attribute list[18];
+    image_attribute list[METADATA_KEY_COUNT];
     int count;
     char seed[24], sample_start[24], samples[24], segments[32];
 } output_attributes;
@@ -85,6 +85,9 @@ static void make_attributes(const render_output_metadata *metadata, output_attri
     if (metadata->light_groups != NULL)
         attributes->list[count++] = (image_attribute){
             .name = METADATA_KEY_LIGHT_GROUPS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->light_groups};
+    if (metadata->postprocess != NULL)
+        attributes->list[count++] = (image_attribute){
+            .name = METADATA_KEY_POSTPROCESS, .type = IMAGE_ATTRIBUTE_STRING, .string_value = metadata->postprocess};
     attributes->count = count;
 }
 
@@ -172,6 +175,32 @@ void render_output_stream_abandon(render_output_stream *stream)
         return;
     image_stream_abandon(stream->stream);
     free(stream);
+}
+
+rt_status render_output_derived_metadata(const char *input, const char *step, image_attribute_set *out,
+                                         rt_error *error)
+{
+    rt_status status = image_read_attributes(input, "rtspheres:", out, error);
+    if (status != RT_OK)
+        return status;
+    image_attribute_set_remove(out, METADATA_KEY_OPTIONS_HASH);
+    const image_attribute *before = image_attribute_set_find(out, METADATA_KEY_POSTPROCESS);
+    const char *earlier = before != NULL && before->string_value != NULL ? before->string_value : "";
+    size_t size = strlen(earlier) + strlen(step) + 3;
+    char *steps = malloc(size);
+    if (steps == NULL) {
+        image_attribute_set_free(out);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "out of memory for the metadata of an image made from '%s'",
+                            input);
+    }
+    snprintf(steps, size, "%s%s%s", earlier, earlier[0] != '\0' ? "; " : "", step);
+    image_attribute postprocess = {.name = METADATA_KEY_POSTPROCESS, .type = IMAGE_ATTRIBUTE_STRING,
+                                   .string_value = steps};
+    status = image_attribute_set_put(out, &postprocess, error);
+    free(steps);
+    if (status != RT_OK)
+        image_attribute_set_free(out);
+    return status;
 }
 
 void render_output_partial_path(const char *output, char *path, size_t size)

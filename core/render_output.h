@@ -42,6 +42,8 @@ typedef struct render_output_metadata {
     int min_spp;
     const char *light_groups;            /* NULL: no rtspheres:light_groups key; else the
                                           * layers' group names, comma-separated */
+    const char *postprocess;             /* NULL: no rtspheres:postprocess key; else what
+                                          * changed the colour (metadata_keys.h) */
 } render_output_metadata;
 
 /* What a partial file must match to continue a render: its seed, first sample, samples
@@ -80,6 +82,17 @@ rt_status render_output_stream_close(render_output_stream *stream, rt_error *err
 
 /* Drops the file (its path stays as it was) and frees stream. NULL is ignored. */
 void render_output_stream_abandon(render_output_stream *stream);
+
+/* The metadata of an image made from the rtspheres image at input by a step (rtspheres
+ * denoise, relight), into *out (emptied first; the caller frees it with
+ * image_attribute_set_free()): every rtspheres:* key of input (metadata_keys.h) but
+ * options_hash, since the file is no longer what those options render (so --skip-existing
+ * renders over it instead of taking it for done), and step appended to
+ * rtspheres:postprocess after what it held ("denoise; relight key=2"). An input without
+ * rtspheres keys gives the postprocess key alone. Errors: image_read_attributes()'s,
+ * image_attribute_set_put()'s; *out empty then. */
+rt_status render_output_derived_metadata(const char *input, const char *step, image_attribute_set *out,
+                                         rt_error *error);
 
 /* Writes the partial file name of output into path (size bytes): output without its
  * extension, then ".partial.exr" ("out/frame-7.png" -> "out/frame-7.partial.exr"). */

@@ -128,7 +128,24 @@ twice=$(channel_mean "$scratch/key2.exr" R)
 if within "$twice" "$(awk -v k="$key" 'BEGIN { print 2 * k }')" 1e-5; then pass "a relit EXR relights again"
 else fail "a relit EXR relights again" "R mean $twice, expected 2 x $key"; fi
 
+# The relit files say what their render said and what was done to it, in order; a relit
+# file is no merge part (its colour is no longer the render's means).
+stats_of "$scratch/key2.exr"
+steps="relight default=0 sky=0 panel=0 fill=0 sun=0; relight key=2"
+if [ "$(stat_metadata postprocess)" = "$steps" ] &&
+    [ "$(stat_metadata scene_hash)" = "$(metadata "$scratch/groups.exr" scene_hash)" ] &&
+    [ "$(stat_metadata spp)" = "$(metadata "$scratch/groups.exr" spp)" ] && [ -z "$(stat_metadata options_hash)" ] &&
+    [ "$(stat_metadata light_groups)" = "default,sky,panel,key,fill,sun" ]; then
+    pass "a relit file carries its render's metadata and the relight steps"
+else fail "relit metadata" "postprocess '$(stat_metadata postprocess)', scene_hash '$(stat_metadata scene_hash)'"; fi
+if [ "$(metadata "$scratch/relit.png" postprocess)" = relight ] && [ -z "$(metadata "$scratch/relit.png" light_groups)" ]
+then pass "a relit PNG records the relight, and no layers it does not have"
+else fail "relit PNG metadata" "postprocess '$(metadata "$scratch/relit.png" postprocess)'"; fi
+
 # Bad input: exit 2 with a message, nothing written.
+mkdir -p "$scratch/out"
+expect_refusal "a relit file as a merge part" "is post-processed .rtspheres:postprocess \"relight default=0 .*; relight key=2\"." "$scratch/out" \
+    "$program" merge "$scratch/groups.exr" "$scratch/key2.exr" -o "$scratch/out/x.exr"
 "$program" render "$scene" -o "$scratch/plain.exr" --quiet
 mkdir -p "$scratch/out"
 expect_refusal "relight of a file without layers" "has no light group layers" "$scratch/out" \

@@ -67,7 +67,7 @@ refuse "refuse-missing-tile" "missing pieces: 432 pixels.*rows 9-17" "$scratch/t
 refuse "refuse-overlapping-tiles" "overlap" "$scratch/tile0.exr" "$scratch/tile1.exr" "$scratch/s0.exr"
 refuse "refuse-unreadable-part" "nonexistent.exr" "$scratch/s0.exr" "$scratch/nonexistent.exr"
 render "$scratch/denoised-part.exr" --samples 6:10 --denoise
-refuse "refuse-denoised-part" "denoised-part.exr' is denoised.*rtspheres denoise" "$scratch/s0.exr" \
+refuse "refuse-denoised-part" "denoised-part.exr' is post-processed .rtspheres:postprocess \"denoise\".*rtspheres denoise" "$scratch/s0.exr" \
     "$scratch/denoised-part.exr"
 # A PPM written by hand: an image, but with no samples channel and no metadata.
 printf 'P6\n48 27\n255\n' >"$scratch/plain.ppm"

@@ -141,10 +141,44 @@ if "$program" denoise "$scratch/c-aovs.exr" -o "$scratch/c-aovs.png" --tonemap a
     [ "$(channels_of "$scratch/c-aovs.png")" = "B G R" ]; then
     pass "rtspheres denoise writes a tone-mapped PNG"
 else fail "rtspheres denoise to a PNG" "channels '$(channels_of "$scratch/c-aovs.png")'"; fi
+# The denoised file says what its render said (scene, hash, samples, seed, ...), less the
+# options hash (it is not what those options render: --skip-existing renders over it), and
+# that it was denoised; so do --denoise's and --blur's renders, and the PNG.
+stats_of "$scratch/c-aovs.exr"
+cp "$scratch/stats" "$scratch/stats-aovs"
+stats_of "$scratch/c-aovs-denoised.exr"
+name="rtspheres denoise carries the render's metadata"
+problem=""
+for key in scene scene_hash spp seed max_depth samples_finished path_segments complete stop_reason render_seconds; do
+    [ "$(stat_metadata $key)" = "$(stat_metadata $key "$scratch/stats-aovs")" ] && [ -n "$(stat_metadata $key)" ] ||
+        problem="$problem $key '$(stat_metadata $key)' against '$(stat_metadata $key "$scratch/stats-aovs")';"
+done
+[ -z "$(stat_metadata options_hash)" ] || problem="$problem an options_hash;"
+[ "$(stat_metadata postprocess)" = denoise ] || problem="$problem postprocess '$(stat_metadata postprocess)';"
+if [ -z "$problem" ]; then pass "$name"; else fail "$name" "$problem"; fi
+if [ "$(metadata "$scratch/c-aovs.png" postprocess)" = denoise ] &&
+    [ "$(metadata "$scratch/c-aovs.png" scene_hash)" = "$(stat_metadata scene_hash "$scratch/stats-aovs")" ]; then
+    pass "rtspheres denoise's PNG carries the metadata too"
+else fail "rtspheres denoise's PNG metadata" "postprocess '$(metadata "$scratch/c-aovs.png" postprocess)'"; fi
+"$program" render $cornell -o "$scratch/c-blurred.exr" --size 32x24 --spp 4 --quiet --denoise --blur 1.5
+stats_of "$scratch/c-blurred.exr"
+if [ "$(stat_metadata postprocess)" = "denoise; blur sigma=1.5 passes=1" ] && [ -n "$(stat_metadata options_hash)" ]; then
+    pass "render --denoise --blur records both in rtspheres:postprocess"
+else fail "render's postprocess metadata" "'$(stat_metadata postprocess)', options hash '$(stat_metadata options_hash)'"; fi
+if [ -z "$(metadata "$scratch/c-aovs.exr" postprocess)" ]; then pass "a raw render has no postprocess key"
+else fail "a raw render's metadata" "postprocess '$(metadata "$scratch/c-aovs.exr" postprocess)'"; fi
+cp "$scratch/c-aovs-denoised.exr" "$scratch/c-skip.exr"
+name="--skip-existing renders over a denoised file, not taking it for the --aovs render"
+if "$program" render $cornell -o "$scratch/c-skip.exr" --size 64x48 --spp 16 --seed 3 --aovs --skip-existing \
+        >"$scratch/skip.log" 2>&1 && grep -q 'rendering afresh' "$scratch/skip.log" &&
+    [ -z "$(metadata "$scratch/c-skip.exr" postprocess)" ]; then
+    pass "$name"
+else fail "$name" "$(head -c 300 "$scratch/skip.log")"; fi
+
 "$program" render $cornell -o "$scratch/c-plain.exr" --size 64x48 --spp 4 --quiet
 expect_refusal "rtspheres denoise of an EXR without AOVs is refused" "no albedo.R/G/B layer.*--aovs" \
     "$scratch/refused" "$program" denoise "$scratch/c-plain.exr" -o "$scratch/refused/x.exr"
-expect_refusal "rtspheres denoise of a denoised EXR is refused" "is denoised already" \
+expect_refusal "rtspheres denoise of a denoised EXR is refused" "is post-processed already .denoise." \
     "$scratch/refused" "$program" denoise "$scratch/c-denoised.exr" -o "$scratch/refused/x.exr"
 expect_refusal "rtspheres denoise without -o is refused" "no output" \
     "$scratch/refused" "$program" denoise "$scratch/c-aovs.exr"

@@ -111,6 +111,7 @@ static inline void support_check_merge_metadata(const merge_metadata *actual, co
     _assert_int_equal(actual->complete, expected->complete, file, line);
     _assert_true(actual->render_seconds == expected->render_seconds, "render_seconds", file, line);
     _assert_true(actual->path_segments == expected->path_segments, "path_segments", file, line);
+    _assert_string_equal(actual->postprocess, expected->postprocess, file, line);
 }
 
 #define assert_merge_metadata_equal(actual, expected) \

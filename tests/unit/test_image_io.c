@@ -285,6 +285,82 @@ static void test_exr_channel_names_and_attributes(void **state)
     image_free(&image);
 }
 
+/* image_read_attributes() gives back a file's attributes of a prefix with their types, in
+ * a set that can be changed and written again: what rtspheres denoise and relight do to
+ * carry a render's metadata on (render_output_derived_metadata). */
+static void test_read_all_attributes(void **state)
+{
+    scratch *s = *state;
+    rt_image image = noise_image(3, 2, 3);
+    const image_attribute attributes[] = {
+        {.name = "rtspheres:scene", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "a.txt"},
+        {.name = "rtspheres:spp", .type = IMAGE_ATTRIBUTE_INT, .int_value = 64},
+        {.name = "rtspheres:seed", .type = IMAGE_ATTRIBUTE_INT, .int_value = 5000000000LL},
+        {.name = "rtspheres:seconds", .type = IMAGE_ATTRIBUTE_FLOAT, .float_value = 12.345},
+        {.name = "other:thing", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "x"},
+    };
+    image_write_options options = image_write_options_defaults();
+    options.attributes = attributes;
+    options.attribute_count = 5;
+    write_ok(in_scratch(s, "attributes.exr"), &image, &options);
+
+    rt_error error = {{0}};
+    image_attribute_set set = {0};
+    assert_int_equal(image_read_attributes(in_scratch(s, "attributes.exr"), "rtspheres:", &set, &error), RT_OK);
+    assert_int_equal(set.count, 4);   /* not other:thing, nor OpenEXR's own */
+    const image_attribute *scene = image_attribute_set_find(&set, "rtspheres:scene");
+    assert_non_null(scene);
+    assert_int_equal(scene->type, IMAGE_ATTRIBUTE_STRING);
+    assert_string_equal(scene->string_value, "a.txt");
+    const image_attribute *spp = image_attribute_set_find(&set, "rtspheres:spp");
+    assert_non_null(spp);
+    assert_int_equal(spp->type, IMAGE_ATTRIBUTE_INT);
+    assert_int_equal(spp->int_value, 64);
+    const image_attribute *seed = image_attribute_set_find(&set, "rtspheres:seed");
+    assert_non_null(seed);   /* written as text: beyond OpenEXR's int */
+    assert_int_equal(seed->type, IMAGE_ATTRIBUTE_STRING);
+    assert_string_equal(seed->string_value, "5000000000");
+    const image_attribute *seconds = image_attribute_set_find(&set, "rtspheres:seconds");
+    assert_non_null(seconds);
+    assert_int_equal(seconds->type, IMAGE_ATTRIBUTE_FLOAT);
+    assert_true(seconds->float_value == 12.345);
+    assert_null(image_attribute_set_find(&set, "other:thing"));
+
+    /* Put replaces in place or appends; remove keeps the rest in order. */
+    image_attribute spp_now = {.name = "rtspheres:spp", .type = IMAGE_ATTRIBUTE_INT, .int_value = 8};
+    image_attribute added = {.name = "rtspheres:added", .type = IMAGE_ATTRIBUTE_STRING, .string_value = "yes"};
+    assert_int_equal(image_attribute_set_put(&set, &spp_now, &error), RT_OK);
+    assert_int_equal(image_attribute_set_put(&set, &added, &error), RT_OK);
+    assert_int_equal(set.count, 5);
+    assert_int_equal(image_attribute_set_find(&set, "rtspheres:spp")->int_value, 8);
+    image_attribute_set_remove(&set, "rtspheres:scene");
+    image_attribute_set_remove(&set, "rtspheres:absent");
+    assert_int_equal(set.count, 4);
+    assert_string_equal(set.attributes[3].name, "rtspheres:added");
+
+    /* What the set holds writes as it reads: a derived file says what its input said. */
+    options.attributes = set.attributes;
+    options.attribute_count = set.count;
+    write_ok(in_scratch(s, "again.exr"), &image, &options);
+    image_attribute_set again = {0};
+    assert_int_equal(image_read_attributes(in_scratch(s, "again.exr"), "", &again, &error), RT_OK);
+    assert_true(again.count > 4);   /* with OpenEXR's own */
+    assert_int_equal(image_attribute_set_find(&again, "rtspheres:spp")->int_value, 8);
+    assert_string_equal(image_attribute_set_find(&again, "rtspheres:added")->string_value, "yes");
+    assert_true(image_attribute_set_find(&again, "rtspheres:seconds")->float_value == 12.345);
+    assert_null(image_attribute_set_find(&again, "rtspheres:scene"));
+    image_attribute_set_free(&again);
+    image_attribute_set_free(&set);
+    assert_int_equal(set.count, 0);
+    assert_null(set.attributes);
+
+    /* A missing file: bad input naming it, the set empty. */
+    assert_int_equal(image_read_attributes(in_scratch(s, "missing.exr"), "rtspheres:", &set, &error), RT_ERROR_INPUT);
+    assert_contains(error.message, in_scratch(s, "missing.exr"));
+    assert_int_equal(set.count, 0);
+    image_free(&image);
+}
+
 /* The sRGB transfer function, written out independently of the code under test. */
 static double srgb(double linear)
 {
@@ -659,6 +735,7 @@ int main(void)
         cmocka_unit_test(test_append_channels),
         scratch_test(test_exr_round_trip_exact),
         scratch_test(test_exr_channel_names_and_attributes),
+        scratch_test(test_read_all_attributes),
         scratch_test(test_png_exposure_clamp_srgb),
         scratch_test(test_eight_bit_default_and_negative_exposure),
         scratch_test(test_jpeg_and_hdr),

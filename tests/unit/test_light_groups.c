@@ -164,6 +164,16 @@ static void weights_parse(void **state)
     const char *bad[] = {"key", "=2", "key=", "key=x", "key=1,2", "key=1,2,3,4", "key=inf"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
         assert_int_equal(relight_parse_weight(bad[i], &weight, &error), RT_ERROR_INPUT);
+
+    /* What the relit file's rtspheres:postprocess records of the weights. */
+    relight_weight weights[2];
+    assert_int_equal(relight_parse_weight("key=2.50", &weights[0], &error), RT_OK);
+    assert_int_equal(relight_parse_weight("fill=1,0.5,0", &weights[1], &error), RT_OK);
+    char text[128];
+    relight_describe(weights, 2, text, sizeof text);
+    assert_string_equal(text, "relight key=2.5 fill=1,0.5,0");
+    relight_describe(weights, 0, text, sizeof text);
+    assert_string_equal(text, "relight");
 }
 
 /* On the device: the layers sum to the beauty (float rounding), each light's layer is the

@@ -549,6 +549,70 @@ static void metadata_round_trip(void **state)
     image_free(&part);
 }
 
+/* A file made from a render (rtspheres denoise, relight) says what the render said, less
+ * the options hash (it is no longer what those options render), and what was done to it. */
+static void derived_metadata(void **state)
+{
+    (void)state;
+    rt_image part;
+    make_part(&part);
+    render_output_metadata metadata = {
+        .scene = "scenes/x.txt", .scene_hash = "00000000deadbeef", .options_hash = "0123456789abcdef", .spp = 4,
+        .seed = 4294967295ULL, .max_depth = 8, .frame = -1, .samples_finished = 24, .complete = true,
+        .render_seconds = 1.5, .stop_reason = "spp",
+    };
+    const char *path = job_path("render.exr");
+    assert_int_equal(render_output_write(path, &part, NULL, &metadata, 0, NULL), RT_OK);
+    image_attribute_set derived = {0};
+    rt_error error = {{0}};
+    assert_int_equal(render_output_derived_metadata(path, "denoise", &derived, &error), RT_OK);
+    assert_null(image_attribute_set_find(&derived, METADATA_KEY_OPTIONS_HASH));
+    assert_string_equal(image_attribute_set_find(&derived, METADATA_KEY_POSTPROCESS)->string_value, "denoise");
+    assert_string_equal(image_attribute_set_find(&derived, METADATA_KEY_SCENE_HASH)->string_value, "00000000deadbeef");
+    assert_int_equal(image_attribute_set_find(&derived, METADATA_KEY_SPP)->int_value, 4);
+    assert_string_equal(image_attribute_set_find(&derived, METADATA_KEY_SEED)->string_value, "4294967295");
+    assert_string_equal(image_attribute_set_find(&derived, METADATA_KEY_STOP_REASON)->string_value, "spp");
+    assert_true(image_attribute_set_find(&derived, METADATA_KEY_RENDER_SECONDS)->float_value == 1.5);
+
+    /* Written and derived again, the steps add up in order. */
+    image_write_options options = image_write_options_defaults();
+    options.attributes = derived.attributes;
+    options.attribute_count = derived.count;
+    const char *denoised = job_path("denoised.exr");
+    assert_int_equal(image_write(denoised, &part, &options, NULL), RT_OK);
+    image_attribute_set_free(&derived);
+    assert_int_equal(render_output_derived_metadata(denoised, "relight key=2", &derived, &error), RT_OK);
+    assert_string_equal(image_attribute_set_find(&derived, METADATA_KEY_POSTPROCESS)->string_value,
+                        "denoise; relight key=2");
+    image_attribute_set_free(&derived);
+
+    /* A file without rtspheres metadata: the step alone. A missing one: bad input. */
+    const char *bare = job_path("bare.exr");
+    assert_int_equal(image_write(bare, &part, NULL, NULL), RT_OK);
+    assert_int_equal(render_output_derived_metadata(bare, "denoise", &derived, &error), RT_OK);
+    assert_int_equal(derived.count, 1);
+    assert_string_equal(derived.attributes[0].name, METADATA_KEY_POSTPROCESS);
+    image_attribute_set_free(&derived);
+    assert_int_equal(render_output_derived_metadata(job_path("absent.exr"), "denoise", &derived, &error),
+                     RT_ERROR_INPUT);
+    assert_contains(error.message, "absent.exr");
+    assert_int_equal(derived.count, 0);
+
+    /* The post-processed file is refused as a merge part, by the key. */
+    rt_image read;
+    merge_metadata back;
+    assert_int_equal(merge_read_part(denoised, &read, &back, NULL), RT_OK);
+    assert_string_equal(back.postprocess, "denoise");
+    merger *m = NULL;
+    assert_int_equal(merger_create(&m, &error), RT_OK);
+    assert_int_equal(merger_add(m, denoised, &read, &back, &error), RT_ERROR_INPUT);
+    assert_contains(error.message, "post-processed");
+    assert_contains(error.message, "rtspheres:postprocess \"denoise\"");
+    merger_free(m);
+    image_free(&read);
+    image_free(&part);
+}
+
 static void partials(void **state)
 {
     (void)state;
@@ -745,6 +809,7 @@ int main(void)
         cmocka_unit_test(overrides_and_variables),
         cmocka_unit_test(options_hash),
         cmocka_unit_test(metadata_round_trip),
+        cmocka_unit_test(derived_metadata),
         cmocka_unit_test(partials),
         cmocka_unit_test(runs_that_stop_early),
         cmocka_unit_test(a_job_renders),
