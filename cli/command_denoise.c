@@ -1,7 +1,7 @@
 /* command_denoise.c: `rtspheres denoise IN.exr -o OUT`: denoises an EXR rendered with
  * --aovs (core/render_denoise.h) as `render --denoise` would have, for the renders that
- * cannot denoise themselves (tiled: the denoiser needs the whole image at once) or whose
- * denoised image is wanted beside the raw one. Exit codes: 0 ok, 1 runtime failure (write
+ * cannot denoise themselves (a farm's parts, merged) or whose denoised image is wanted
+ * beside the raw one. Exit codes: 0 ok, 1 runtime failure (write
  * failed, out of memory), 2 bad input (usage, a file without the AOV layers, one already
  * denoised, the output being the input). */
 #include <getopt.h>
@@ -24,8 +24,8 @@ static void print_help(FILE *stream)
             "\n"
             "Denoises a render made with --aovs (an .exr with albedo.R/G/B, normal.X/Y/Z and\n"
             "depth.Z; variance.Y, samples and emission.R/G/B when it has them), as\n"
-            "`rtspheres render --denoise` would have. For renders in tiles, which cannot\n"
-            "denoise themselves.\n"
+            "`rtspheres render --denoise` would have: for a farm's parts after\n"
+            "`rtspheres merge`, or to keep the raw render beside the denoised one.\n"
             "\n"
             "options:\n"
             "  -o, --output FILE    the denoised image (.exr keeps every layer of the input and\n"

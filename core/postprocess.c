@@ -571,6 +571,19 @@ done:
     return status;
 }
 
+int postprocess_blur_reach(float sigma_pixels, int passes)
+{
+    if (!(sigma_pixels > 0.0f) || passes <= 0)
+        return 0;
+    return passes * (int)ceilf(3.0f * sigma_pixels);
+}
+
+int postprocess_denoise_reach(const postprocess_denoise_options *options)
+{
+    int iterations = options != NULL && options->iterations != 0 ? options->iterations : DEFAULT_ITERATIONS;
+    return 2 * ((1 << iterations) - 1) + VARIANCE_RADIUS + 1;
+}
+
 /* ---------------------------------------------------------------------------------- */
 /* Tone mapping                                                                         */
 

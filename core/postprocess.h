@@ -162,6 +162,18 @@ rt_status postprocess_gaussian_blur(rt_image *image, float sigma_pixels, int pas
 rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides *guides,
                               const postprocess_denoise_options *options, rt_error *error);
 
+/* The reach of the blur and the denoiser: how many pixels away from a pixel they read to
+ * compute it (rows or columns). A band of rows taken with this many more rows on each side
+ * (or up to the image's edge) and filtered alone gives its own rows exactly, bit for bit,
+ * as the whole image does: how a render in tiles is post-processed band by band
+ * (core/render_job_tiles.c; tests/unit/test_postprocess.c checks it). Chained filters add
+ * their reaches. The blur's: passes x ceil(3 sigma) (0 when it changes nothing); the
+ * denoiser's, with options (NULL: defaults): 2 (2^iterations - 1) for the iterations'
+ * taps (the 3x3 variance blur stays within them), + 3 for the 7x7 noise estimate, + 1
+ * for the depth gradient: 66 with the defaults. */
+int postprocess_blur_reach(float sigma_pixels, int passes);
+int postprocess_denoise_reach(const postprocess_denoise_options *options);
+
 /* Exposes and tone-maps the colour channels of image in place for an 8-bit output (see
  * above). An unknown operator, a non-finite exposure or an empty image are
  * RT_ERROR_INPUT. */

@@ -75,3 +75,8 @@ rt_status render_denoise(rt_image *colour, const rt_image *beauty, const rt_imag
     image_free(&mean_variance);
     return status;
 }
+
+int render_denoise_reach(void)
+{
+    return postprocess_denoise_reach(NULL);   /* render_denoise() runs the defaults */
+}

@@ -35,4 +35,7 @@
  * caller. */
 rt_status render_denoise(rt_image *colour, const rt_image *beauty, const rt_image *layers, rt_error *error);
 
+/* How many rows away render_denoise() reads (postprocess.h postprocess_denoise_reach()). */
+int render_denoise_reach(void);
+
 #endif

@@ -14,6 +14,8 @@
 #include "clock.h"
 #include "image_io.h"
 #include "pack.h"
+#include "postprocess.h"
+#include "render_denoise.h"
 #include "render_job_internal.h"
 
 /* Tiles of fewer rows than this are avoided while narrower tiles can have them: each
@@ -60,13 +62,6 @@ static const char *unsupported_under_tiles(const render_job *job, const render_o
                                            const char **instead)
 {
     *instead = "raise --memory-budget if the machine has the memory, or render a smaller image";
-    if (job->denoise) {
-        *instead = "render it with --aovs to an .exr and run `rtspheres denoise` on that, or raise "
-                   "--memory-budget if the machine has the memory";
-        return "--denoise needs the whole image at once";
-    }
-    if (job->blur_sigma > 0)
-        return "--blur needs the whole image at once";
     if (job->checkpoint_seconds > 0 || job->resume_path != NULL) {
         *instead = "split the work with --tile i/n or --shard (each part its own file, joined by `rtspheres "
                    "merge`), or raise --memory-budget";
@@ -307,6 +302,48 @@ static void add_tile(tile_run *run, const render_result *result, int tile)
     run->passes_before = total->passes;
 }
 
+/* --denoise and --blur of the output, band by band. They read rows beyond a pixel's own
+ * (postprocess.h, "reach"), so a band is read from the spool with halo more rows on each
+ * side (within the image) and only its own rows are kept: the untiled image's pixels bit
+ * for bit, in the order postprocess_result() (render_job.c) applies them. */
+typedef struct band_postprocess {
+    bool denoise;
+    float blur_sigma;            /* 0: no blur */
+    int blur_passes;
+    int halo;                    /* the rows read beyond a band on each side */
+    rt_image source;             /* a band and its halo, as spooled */
+    rt_image colour;             /* its R, G, B, filtered */
+} band_postprocess;
+
+/* Filters source's colour into colour and writes rows first .. first + band->height - 1
+ * of source into band (the output's channels): source's channels with the filtered R, G,
+ * B, and with --denoise the noisy colour after them as noisy.R/G/B, as render_job.c's
+ * denoise() appends it. */
+static rt_status postprocess_band(band_postprocess *post, int first, rt_image *band, rt_error *error)
+{
+    const rt_image *source = &post->source;
+    rt_image *colour = &post->colour;
+    colour->height = source->height;
+    size_t pixels = (size_t)source->width * source->height;
+    for (size_t i = 0; i < pixels; i++)
+        memcpy(colour->pixels + 3 * i, source->pixels + i * source->channels, 3 * sizeof(float));
+    rt_status status = RT_OK;
+    if (post->denoise)
+        status = render_denoise(colour, source, source, error);
+    if (status == RT_OK && post->blur_sigma > 0)
+        status = postprocess_gaussian_blur(colour, post->blur_sigma, post->blur_passes, error);
+    size_t kept = (size_t)band->width * band->height, offset = (size_t)first * source->width;
+    for (size_t i = 0; i < kept && status == RT_OK; i++) {
+        float *out = band->pixels + i * band->channels;
+        const float *in = source->pixels + (offset + i) * source->channels;
+        memcpy(out, in, source->channels * sizeof *out);
+        memcpy(out, colour->pixels + 3 * (offset + i), 3 * sizeof *out);
+        if (post->denoise)
+            memcpy(out + source->channels, in, 3 * sizeof *out);
+    }
+    return status;
+}
+
 /* Streams the spool into the output (and the samples map), band by band, with the
  * final metadata. */
 static rt_status write_from_spool(tile_run *run, rt_error *error)
@@ -315,9 +352,19 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     const render_job *job = image->run->job;
     const int *window = image->plan.window;
     int width = window[2] - window[0], height = window[3] - window[1];
-    rt_image layout = {.width = width, .height = height, .channels = run->channels, .x = window[0], .y = window[1],
-                       .full_width = image->scene.render.width, .full_height = image->scene.render.height};
+    band_postprocess post = {.denoise = job->denoise, .blur_sigma = job->blur_sigma > 0 ? job->blur_sigma : 0,
+                             .blur_passes = job->blur_passes > 0 ? job->blur_passes : 1};
+    post.halo = (post.denoise ? render_denoise_reach() : 0) + postprocess_blur_reach(post.blur_sigma, post.blur_passes);
+    bool filtered = post.denoise || post.blur_sigma > 0;
+    rt_image layout = {.width = width, .height = height, .channels = run->channels + (post.denoise ? 3 : 0),
+                       .x = window[0], .y = window[1], .full_width = image->scene.render.width,
+                       .full_height = image->scene.render.height};
     memcpy(layout.channel_names, run->names, sizeof layout.channel_names);
+    if (layout.channels > IMAGE_MAX_CHANNELS)
+        return rt_error_set(error, RT_ERROR_INPUT, "an image of %d channels is more than the %d an output holds",
+                            layout.channels, IMAGE_MAX_CHANNELS);
+    for (int c = 0; post.denoise && c < 3; c++)
+        snprintf(layout.channel_names[run->channels + c], IMAGE_CHANNEL_NAME_MAX, "noisy.%c", "RGB"[c]);
     render_output_metadata metadata;
     job_metadata_texts texts;
     job_image_metadata(image, image->plan.output, run->total.samples, run->total.stop_reason != RENDER_STOP_TIME, false, &run->total,
@@ -331,14 +378,26 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
         status = image_stream_open(job->samples_map, &map_layout, NULL, &map, error);
     }
     bool tonemap = image_format_of(image->plan.output) == IMAGE_FORMAT_EIGHT_BIT && job->tonemap != TONEMAP_CLAMP;
-    /* A band: an eighth of the budget, with room for the writer's converted copy. */
-    size_t row_bytes = (size_t)width * run->channels * sizeof(float);
+    /* A band: an eighth of the budget, with room for the writer's converted copy; when it
+     * is filtered, at least twice its halo, so that the halo's rows are not most of the
+     * work. */
+    size_t row_bytes = (size_t)width * layout.channels * sizeof(float);
+    size_t spool_row_bytes = (size_t)width * run->channels * sizeof(float);
     uint64_t budget = job->memory_budget ? job->memory_budget : render_job_default_memory_budget();
     int band_rows = (int)(budget / 8 / row_bytes);
+    if (filtered && band_rows < 2 * post.halo)
+        band_rows = 2 * post.halo;
     band_rows = band_rows < 1 ? 1 : band_rows > height ? height : band_rows;
+    int source_rows = band_rows + 2 * post.halo < height ? band_rows + 2 * post.halo : height;
     rt_image band = {0}, colour = {0}, grey = {0};
     if (status == RT_OK)
-        status = image_create(&band, width, band_rows, run->channels, error);
+        status = image_create(&band, width, band_rows, layout.channels, error);
+    if (status == RT_OK && filtered)
+        status = image_create(&post.source, width, source_rows, run->channels, error);
+    if (status == RT_OK && filtered)
+        status = image_create(&post.colour, width, source_rows, 3, error);
+    if (status == RT_OK && filtered)
+        memcpy(post.source.channel_names, run->names, sizeof post.source.channel_names);
     if (status == RT_OK && tonemap)
         status = image_create(&colour, width, band_rows, 3, error);
     if (status == RT_OK && map != NULL)
@@ -346,27 +405,40 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     for (int y = 0; y < height && status == RT_OK; y += band_rows) {
         int rows = height - y < band_rows ? height - y : band_rows;
         band.height = colour.height = grey.height = rows;
-        status = spool_io(run, false, band.pixels, rows * row_bytes, (off_t)((size_t)y * row_bytes), error);
+        if (filtered) {
+            int y0 = y - post.halo > 0 ? y - post.halo : 0;
+            int y1 = y + rows + post.halo < height ? y + rows + post.halo : height;
+            post.source.height = y1 - y0;
+            status = spool_io(run, false, post.source.pixels, (size_t)(y1 - y0) * spool_row_bytes,
+                              (off_t)((size_t)y0 * spool_row_bytes), error);
+            if (status == RT_OK)
+                status = postprocess_band(&post, y - y0, &band, error);
+        } else {
+            status = spool_io(run, false, band.pixels, rows * spool_row_bytes, (off_t)((size_t)y * spool_row_bytes),
+                              error);
+        }
         size_t pixels = (size_t)width * rows;
         if (status == RT_OK && tonemap) {
             for (size_t i = 0; i < pixels; i++)
-                memcpy(colour.pixels + 3 * i, band.pixels + i * run->channels, 3 * sizeof(float));
+                memcpy(colour.pixels + 3 * i, band.pixels + i * layout.channels, 3 * sizeof(float));
             status = postprocess_tonemap(&colour, job->tonemap, (float)job->exposure, error);
             for (size_t i = 0; i < pixels && status == RT_OK; i++)
-                memcpy(band.pixels + i * run->channels, colour.pixels + 3 * i, 3 * sizeof(float));
+                memcpy(band.pixels + i * layout.channels, colour.pixels + 3 * i, 3 * sizeof(float));
         }
         if (status == RT_OK)
             status = render_output_stream_rows(output, &band, error);
         if (status == RT_OK && map != NULL) {
             for (size_t i = 0; i < pixels; i++)
                 for (int c = 0; c < 3; c++)
-                    grey.pixels[3 * i + c] = band.pixels[i * run->channels + 3] / (float)image->plan.samples_per_pixel;
+                    grey.pixels[3 * i + c] = band.pixels[i * layout.channels + 3] / (float)image->plan.samples_per_pixel;
             status = image_stream_write_rows(map, &grey, error);
         }
     }
     image_free(&band);
     image_free(&colour);
     image_free(&grey);
+    image_free(&post.source);
+    image_free(&post.colour);
     if (status == RT_OK) {
         status = render_output_stream_close(output, error);
         output = NULL;

@@ -137,6 +137,35 @@ if "$program" render $cornell -o "$scratch/c-tiled-check.exr" --size 64x48 --spp
         --memory-budget 700K 2>&1 | grep -q 'tiles'; then
     pass "the 700K budget renders the 64x48 Cornell box in tiles"
 else fail "the tiled case of rtspheres denoise" "the 700K budget did not tile the render"; fi
+# --denoise and --blur of a render in tiles: the output filtered band by band, each band
+# read with the filters' reach (postprocess.h) more rows on each side, is the untiled
+# image bit for bit, layers and all; the image is tall enough (400 rows against the
+# denoiser's reach of 66) that the bands are several.
+for options in "--denoise" "--blur 1.5:2" "--denoise --blur 1"; do
+    name="$options of a render in tiles is the untiled image"
+    # shellcheck disable=SC2086
+    "$program" render $cornell -o "$scratch/tall.exr" --size 48x400 --spp 8 --seed 5 --quiet $options
+    # shellcheck disable=SC2086
+    if ! "$program" render $cornell -o "$scratch/tall-tiled.exr" --size 48x400 --spp 8 --seed 5 $options \
+            --memory-budget 700K >"$scratch/tall.log" 2>&1; then
+        fail "$name" "$(head -c 300 "$scratch/tall.log")"
+    elif ! grep -q 'tiles' "$scratch/tall.log"; then
+        fail "$name" "the 700K budget did not tile it: $(head -c 300 "$scratch/tall.log")"
+    elif ! "$program" diff "$scratch/tall-tiled.exr" "$scratch/tall.exr" --fail 0 --failpercent 0 >/dev/null; then
+        fail "$name" "$("$program" diff "$scratch/tall-tiled.exr" "$scratch/tall.exr" | grep 'max error')"
+    elif [ "$(channels_of "$scratch/tall-tiled.exr")" != "$(channels_of "$scratch/tall.exr")" ]; then
+        fail "$name" "layers '$(channels_of "$scratch/tall-tiled.exr")' against '$(channels_of "$scratch/tall.exr")'"
+    elif [ "$(metadata "$scratch/tall-tiled.exr" postprocess)" != "$(metadata "$scratch/tall.exr" postprocess)" ]; then
+        fail "$name" "postprocess '$(metadata "$scratch/tall-tiled.exr" postprocess)'"
+    else pass "$name"; fi
+done
+# Each layer too, not only R, G, B: the noisy colour and the AOVs as the untiled file has them.
+name="a tiled --denoise render's layers are the untiled render's"
+stats_of "$scratch/tall-tiled.exr"
+cp "$scratch/stats" "$scratch/stats-tiled"
+stats_of "$scratch/tall.exr"
+if [ "$(grep '^channel' "$scratch/stats-tiled")" = "$(grep '^channel' "$scratch/stats")" ]; then pass "$name"
+else fail "$name" "$(diff "$scratch/stats-tiled" "$scratch/stats" | grep '^[<>] channel' | head -n 4 | tr '\n' ' ')"; fi
 if "$program" denoise "$scratch/c-aovs.exr" -o "$scratch/c-aovs.png" --tonemap aces --quiet &&
     [ "$(channels_of "$scratch/c-aovs.png")" = "B G R" ]; then
     pass "rtspheres denoise writes a tone-mapped PNG"

@@ -93,8 +93,7 @@ fi
 # (f) What tiles cannot do: refused, naming the tiling and what to do.
 printf 'partial' >"$scratch/some.partial.exr"
 # --display: refused before it connects (nothing listens on port 1 anyway).
-for options in "--denoise" "--blur 1" "--checkpoint 10" "--resume $scratch/some.partial.exr" \
-    "--display 127.0.0.1:1"; do
+for options in "--checkpoint 10" "--resume $scratch/some.partial.exr" "--display 127.0.0.1:1"; do
     word=${options%% *}
     # shellcheck disable=SC2086
     expect_refusal "$word under tiles is refused" "^rtspheres render: $word .*rendered in [0-9]+ tiles .*: " \

@@ -569,6 +569,96 @@ static void test_denoise_keeps_a_highlight_its_variance_vouches_for(void **state
     free_buffers(&b);
 }
 
+/* Rows y0 .. y1-1 of image, as an image of their own. */
+static rt_image rows_of(const rt_image *image, int y0, int y1)
+{
+    rt_image band;
+    assert_int_equal(image_create(&band, image->width, y1 - y0, image->channels, NULL), RT_OK);
+    size_t row = (size_t)image->width * image->channels;
+    memcpy(band.pixels, image->pixels + (size_t)y0 * row, (size_t)(y1 - y0) * row * sizeof(float));
+    return band;
+}
+
+/* Denoises (blur false) or blurs rows core0 .. core1-1 of the inputs taken with halo more
+ * rows each side (within the image), and returns how many of the core rows' values differ
+ * from whole's (the whole image done at once). */
+static int band_differences(const rt_image inputs[6], const rt_image *whole, int core0, int core1, int halo,
+                            bool blur)
+{
+    int height = inputs[0].height;
+    int y0 = core0 - halo > 0 ? core0 - halo : 0, y1 = core1 + halo < height ? core1 + halo : height;
+    rt_image band[6];
+    for (int i = 0; i < 6; i++)
+        band[i] = rows_of(&inputs[i], y0, y1);
+    postprocess_denoise_guides guides = {.albedo = &band[1], .normal = &band[2], .depth = &band[3],
+                                         .emission = &band[4], .variance = &band[5]};
+    if (blur)
+        assert_int_equal(postprocess_gaussian_blur(&band[0], 2.5f, 2, NULL), RT_OK);
+    else
+        assert_int_equal(postprocess_denoise(&band[0], &guides, NULL, NULL), RT_OK);
+    int differences = 0;
+    for (int y = core0; y < core1; y++)
+        for (int x = 0; x < whole->width; x++)
+            for (int c = 0; c < 3; c++)
+                differences += memcmp(at(&band[0], x, y - y0, c), at(whole, x, y, c), sizeof(float)) != 0;
+    for (int i = 0; i < 6; i++)
+        image_free(&band[i]);
+    return differences;
+}
+
+/* A band of rows denoised (or blurred) with postprocess_*_reach() more rows on each side
+ * is the whole image's rows bit for bit: what a render in tiles relies on to denoise its
+ * output band by band (core/render_job_tiles.c). An image with all the denoiser meets:
+ * noise, normal and depth edges, sky, texture, emission, and the variance known at some
+ * pixels only (the rest measured around them). With a halo too short the rows differ, so
+ * the comparison can see a wrong reach. */
+static void test_bands_with_the_reach_are_exact(void **state)
+{
+    (void)state;
+    enum { WIDTH = 24, HEIGHT = 260 };
+    rt_image inputs[6] = {
+        make_image(WIDTH, HEIGHT, 3, 0.0f), make_image(WIDTH, HEIGHT, 3, 0.0f), make_image(WIDTH, HEIGHT, 3, 0.0f),
+        make_image(WIDTH, HEIGHT, 1, 0.0f), make_image(WIDTH, HEIGHT, 3, 0.0f), make_image(WIDTH, HEIGHT, 1, 0.0f),
+    };
+    random_state random = {0x9e3779b97f4a7c15ULL};
+    for (int y = 0; y < HEIGHT; y++)
+        for (int x = 0; x < WIDTH; x++) {
+            bool sky = (y / 37 + x / 9) % 5 == 0;
+            int patch = (y / 23 + x / 7) % 3;
+            for (int c = 0; c < 3; c++) {
+                *at(&inputs[0], x, y, c) = (float)(0.5 + 0.1 * patch + 0.2 * random_normal(&random));
+                *at(&inputs[1], x, y, c) = (x + y) % 4 == 0 ? 0.2f : 0.8f;
+                *at(&inputs[4], x, y, c) = (y % 31 == 0 && x % 5 == 0) ? 3.0f : 0.0f;
+            }
+            *at(&inputs[2], x, y, patch) = 1.0f;
+            *at(&inputs[3], x, y, 0) = sky ? 0.0f : (float)(2.0 + 0.01 * y + (patch == 2 ? 1.0 : 0.0));
+            *at(&inputs[5], x, y, 0) = (x + 3 * y) % 7 == 0 ? -1.0f : (float)(0.01 * (1 + patch));
+        }
+    rt_image denoised = rows_of(&inputs[0], 0, HEIGHT), blurred = rows_of(&inputs[0], 0, HEIGHT);
+    postprocess_denoise_guides guides = {.albedo = &inputs[1], .normal = &inputs[2], .depth = &inputs[3],
+                                         .emission = &inputs[4], .variance = &inputs[5]};
+    assert_int_equal(postprocess_denoise(&denoised, &guides, NULL, NULL), RT_OK);
+    assert_int_equal(postprocess_gaussian_blur(&blurred, 2.5f, 2, NULL), RT_OK);
+    int reach = postprocess_denoise_reach(NULL), blur_reach = postprocess_blur_reach(2.5f, 2);
+    assert_int_equal(reach, 66);
+    assert_int_equal(blur_reach, 16);
+    assert_int_equal(postprocess_blur_reach(0.0f, 3), 0);
+    assert_int_equal(postprocess_denoise_reach(&(postprocess_denoise_options){.iterations = 2}), 10);
+    const int cores[][2] = {{100, 130}, {0, 20}, {230, HEIGHT}, {70, 71}};
+    for (size_t i = 0; i < sizeof cores / sizeof cores[0]; i++) {
+        assert_int_equal(band_differences(inputs, &denoised, cores[i][0], cores[i][1], reach, false), 0);
+        assert_int_equal(band_differences(inputs, &blurred, cores[i][0], cores[i][1], blur_reach, true), 0);
+    }
+    int short_denoise = band_differences(inputs, &denoised, 100, 130, 20, false);
+    int short_blur = band_differences(inputs, &blurred, 100, 130, 4, true);
+    print_message("bands with a short halo: %d denoised and %d blurred values differ\n", short_denoise, short_blur);
+    assert_true(short_denoise > 0 && short_blur > 0);
+    for (int i = 0; i < 6; i++)
+        image_free(&inputs[i]);
+    image_free(&denoised);
+    image_free(&blurred);
+}
+
 static void test_denoise_rejects_bad_input(void **state)
 {
     (void)state;
@@ -887,6 +977,7 @@ int main(void)
         cmocka_unit_test(test_denoise_keeps_other_channels),
         cmocka_unit_test(test_denoise_leaves_the_emission_seen_at_once),
         cmocka_unit_test(test_denoise_keeps_a_highlight_its_variance_vouches_for),
+        cmocka_unit_test(test_bands_with_the_reach_are_exact),
         cmocka_unit_test(test_denoise_rejects_bad_input),
         cmocka_unit_test(test_tonemap_reinhard_of_one_is_a_half),
         cmocka_unit_test(test_tonemap_curves_are_monotonic_and_bounded),
