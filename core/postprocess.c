@@ -143,6 +143,7 @@ typedef struct guide_pixel {
     float depth;
     float gradient[2];           /* d depth / dx, d depth / dy */
     bool hit;                    /* false: the ray hit nothing (sky) */
+    bool noise_measured;         /* its noise measured around it: no variance guide there */
 } guide_pixel;
 
 /* Everything the filter iterations share. */
@@ -150,7 +151,9 @@ typedef struct denoiser {
     int width, height;
     const guide_pixel *guides;
     bool use_normal, use_depth, use_albedo;
-    float inverse_normal_sigma2, inverse_albedo_sigma2, sigma_depth, sigma_colour;
+    float inverse_normal_sigma2, inverse_albedo_sigma2, sigma_depth;
+    float sigma_colour;          /* this iteration's, for pixels with the render's variance */
+    float sigma_colour_measured; /* every iteration's, for pixels whose noise was measured */
 } denoiser;
 
 static float finite_or_zero(float value)
@@ -327,7 +330,8 @@ static void atrous_rows(const stage *s, int y0, int y1)
             /* The noise floor keeps the weight finite on a noise-free image: differences
              * of a thousandth of the pixel's own level count as equal. */
             float level = glm_vec3_norm_one((float *)cp) / 3.0f;
-            float colour_scale = d->sigma_colour * sqrtf(blurred_variance[p]) + 1e-3f * level + 1e-8f;
+            float sigma = d->guides[p].noise_measured ? d->sigma_colour_measured : d->sigma_colour;
+            float colour_scale = sigma * sqrtf(blurred_variance[p]) + 1e-3f * level + 1e-8f;
             float inverse_colour_scale = 1.0f / colour_scale;
             double sum[3] = {0, 0, 0}, weight_sum = 0.0, variance_sum = 0.0;
             for (int j = -2; j <= 2; j++)
@@ -541,8 +545,13 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
         }
     /* The noise: the render's own estimate where it has one, else measured around the pixel. */
     noise_from_guide(mean_variance, guides, albedo != NULL, albedo_epsilon, count, variance);
+    for (size_t i = 0; i < count; i++)
+        guides[i].noise_measured = variance[i] < 0.0f;
     run_rows(&(stage){.d = &d, .signal = signal, .variance_out = variance}, estimate_rows);
+    d.sigma_colour_measured = d.sigma_colour;
     for (int i = 0; i < iterations; i++) {
+        /* 4, 4, 2, 1, 0.5 where the render's variance says the noise (postprocess.h). */
+        d.sigma_colour = ldexpf(d.sigma_colour_measured, i > 1 ? 1 - i : 0);
         run_rows(&(stage){.d = &d, .variance = variance, .blurred = blurred_variance}, blur_rows);
         run_rows(&(stage){.d = &d, .step = 1 << i, .signal = signal, .variance = variance,
                           .blurred = blurred_variance, .filtered = filtered, .variance_out = filtered_variance},

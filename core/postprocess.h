@@ -33,11 +33,19 @@
  *      (1/16, 1/4, 3/8, 1/4, 1/16 in each direction) whose taps are 2^i pixels apart
  *      (steps 1, 2, 4, 8, 16: a 125-pixel footprint after 5 iterations for 25 taps a
  *      pixel each), every tap q of pixel p multiplied by
- *        colour  exp(-rms(c_q - c_p) / (sigma_colour * sd_p))
+ *        colour  exp(-rms(c_q - c_p) / (s_i * sd_p))
  *                rms over the three channels; sd_p the estimated noise standard
  *                deviation of p (below), so the weight measures a difference in units
- *                of the noise. This stands in for Dammertz's fixed sigma halved each
- *                iteration: one default works at any brightness and sample count.
+ *                of the noise, and one default works at any brightness and sample
+ *                count. Where the variance guide gives p's noise, s_i is sigma_colour
+ *                in the first two iterations and halved in each later one (4, 4, 2, 1,
+ *                0.5), as Dammertz et al. halve their fixed sigma; where the noise was
+ *                measured around p (no variance guide there, or under 4 samples in a
+ *                render), sigma_colour in every iteration. Chosen by the RMSE of
+ *                renders against references (docs/sampling.md, "Denoising": 5 to 20%
+ *                lower on four scenes at 4 to 64 spp, with no more visible grain; a
+ *                schedule halved from the first iteration on was better still by
+ *                RMSE but left speckles).
  *        normal  exp(-|n_q - n_p|^2 / sigma_normal^2)
  *        depth   exp(-|z_q - (z_p + grad z_p . (q - p))| / (sigma_depth * z_p))
  *                the distance from the plane through p (grad z from the one-sided
@@ -63,8 +71,9 @@
  *
  * Defaults of postprocess_denoise_options (zero means default):
  *   iterations 5           steps 1, 2, 4, 8, 16 (at most 12)
- *   sigma_colour 4         noise standard deviations (SVGF's sigma_l): noise of 1 sd
- *                          keeps weight 0.78, a 4 sd step 0.37, a 12 sd step 0.05
+ *   sigma_colour 4         noise standard deviations (SVGF's sigma_l) of the first two
+ *                          iterations: noise of 1 sd keeps weight 0.78, a 4 sd step
+ *                          0.37, a 12 sd step 0.05; half that in the third, and so on
  *   sigma_normal 0.3       a 10 degree crease keeps 0.71, 30 degrees 0.05, 90 degrees 2e-10
  *   sigma_depth 0.02       2% of the distance off the plane through p keeps 0.37; a step
  *                          from depth 2 to 3 keeps 1e-11
@@ -119,7 +128,7 @@ extern "C" {
 
 typedef struct postprocess_denoise_options {
     int iterations;              /* à-trous iterations, step 2^i; default 5 */
-    float sigma_colour;          /* in noise standard deviations; default 4 */
+    float sigma_colour;          /* in noise standard deviations, first two iterations; default 4 */
     float sigma_normal;          /* on |n_q - n_p|; default 0.3 */
     float sigma_depth;           /* relative distance off p's plane; default 0.02 */
     float sigma_albedo;          /* on |a_q - a_p|; default 0.1 */
