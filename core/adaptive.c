@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "luminance.h"
+
 struct adaptive_sampler {
     int width, height;
     float threshold;
@@ -116,7 +118,7 @@ int adaptive_check(adaptive_sampler *sampler, const float *rgba, const float *lu
     int checked = 0, unconverged = 0;
     for (size_t i = 0; i < pixels; i++) {
         const float *pixel = rgba + 4 * i;
-        float luminance = 0.2126f * pixel[0] + 0.7152f * pixel[1] + 0.0722f * pixel[2];
+        float luminance = luminance_float(pixel[0], pixel[1], pixel[2]);
         float error = sampler->going[i] ? adaptive_pixel_error(luminance, luminance_squares[i], (uint32_t)pixel[3]) : 0;
         sampler->unconverged[i] = sampler->going[i] && error >= sampler->threshold;
         if (sampler->going[i] && isfinite(error)) {

@@ -5,7 +5,7 @@
  *
  * ## The estimator
  * A pixel's error after n samples is the relative standard error of its mean luminance
- * (Y = 0.2126 R + 0.7152 G + 0.0722 B, as glsl/path_state.glsl finish_sample squares it):
+ * (Y with Rec. 709's weights, core/luminance.h, as glsl/path_state.glsl finish_sample squares it):
  *     s^2   = (sum Y^2 - n * mean^2) / (n - 1)          (the sample variance)
  *     error = sqrt(s^2 / n) / max(mean, ADAPTIVE_LUMINANCE_FLOOR)
  * so above the floor the threshold is relative (LuxCore's halt threshold is, and Cycles'

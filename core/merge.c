@@ -2,6 +2,7 @@
 #include "merge.h"
 
 #include "array.h"
+#include "luminance.h"
 #include "metadata_keys.h"
 
 #include <errno.h>
@@ -249,7 +250,7 @@ static void add_aov_pixel(merger *m, size_t at, const float *pixel, const int ch
             m->guides[at * GUIDE_CHANNELS + k] = pixel[aov[k]];
     }
     /* As render.c makes variance.Y: E[L^2] - E[L]^2 of float luminances. */
-    float luminance = 0.2126f * pixel[channel[0]] + 0.7152f * pixel[channel[1]] + 0.0722f * pixel[channel[2]];
+    float luminance = luminance_float(pixel[channel[0]], pixel[channel[1]], pixel[channel[2]]);
     double *aov_sum = &m->aov_sums[at * 4];
     aov_sum[3] += n * ((double)pixel[aov[7]] + (double)luminance * luminance);
     for (int c = 0; has_emission && c < 3; c++)
@@ -647,7 +648,7 @@ rt_status merger_aovs(const merger *m, rt_image *aovs, rt_error *error)
         float mean[3];
         for (int c = 0; c < 3; c++)
             mean[c] = (float)(m->sums[i * 4 + c] / n);
-        float luminance = 0.2126f * mean[0] + 0.7152f * mean[1] + 0.0722f * mean[2];
+        float luminance = luminance_float(mean[0], mean[1], mean[2]);
         out[7] = (float)fmax(0.0, m->aov_sums[i * 4 + 3] / n - (double)luminance * luminance);
         for (int c = 0; c < channels - AOV_CHANNELS; c++)
             out[AOV_CHANNELS + c] = (float)(m->aov_sums[i * 4 + c] / n);

@@ -10,6 +10,7 @@
 #include <cglm/cglm.h>
 
 #include "light_tree.h"
+#include "luminance.h"
 #include "pack_internal.h"
 
 /* Whether a world primitive is an area light: a sphere, quad or triangle whose material
@@ -43,7 +44,7 @@ static void write_area_lights(packer *p, double *power, light_bounds *bounds)
         if (!is_area_light(s, item))
             continue;
         const float *e = s->materials[item->material].emission;
-        double luminance = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
+        double luminance = luminance_double(e[0], e[1], e[2]);
         double area;
         uint32_t type;
         vec3 centre, normal = {0, 0, 0};
@@ -131,7 +132,7 @@ static void write_scene_lights(packer *p, uint32_t first, double radius, double 
     for (int k = 0; k < s->light_count; k++, light++) {
         const scene_light *source = &s->lights[k];
         const float *c = source->color;
-        double luminance = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+        double luminance = luminance_double(c[0], c[1], c[2]);
         uint32_t type = source->type == SCENE_LIGHT_POINT ? LIGHT_POINT
                         : source->type == SCENE_LIGHT_SPOT ? LIGHT_SPOT : LIGHT_SUN;
         double cos_outer = cos(source->spot_outer_degrees * M_PI / 180);
@@ -200,7 +201,7 @@ static rt_status write_environment(packer *p, uint32_t light, double radius, dou
     double mean = 0;
     for (size_t i = 0; i < (size_t)width * height; i++) {
         const float *c = environment->pixels + 4 * i;
-        mean += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+        mean += luminance_double(c[0], c[1], c[2]);
     }
     mean /= (double)width * height;
     double floor_weight = 1e-3 * mean + 1e-12, total_weight = 0;
@@ -209,7 +210,7 @@ static rt_status write_environment(packer *p, uint32_t light, double radius, dou
         uint64_t row_base = offset + height + (uint64_t)y * width;
         for (int x = 0; x < width; x++) {
             const float *c = environment->pixels + 4 * ((size_t)y * width + x);
-            row += (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2] + floor_weight) * sine;
+            row += (luminance_double(c[0], c[1], c[2]) + floor_weight) * sine;
             put_texel(texels, row_base + x, float_bits((float)row), 0, 0, 0);
         }
         for (int x = 0; x < width; x++) {

@@ -10,6 +10,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "luminance.h"
+
 #define DEFAULT_ITERATIONS 5
 #define DEFAULT_SIGMA_COLOUR 4.0f
 #define DEFAULT_SIGMA_NORMAL 0.3f
@@ -620,8 +622,7 @@ static void reinhard_pixel(float *rgb)
             rgb[c] = isinf(rgb[c]) ? 1.0f : 0.0f;
         return;
     }
-    vec3 rec709_luminance = {0.2126f, 0.7152f, 0.0722f};
-    float luminance = glm_vec3_dot(rec709_luminance, rgb);
+    float luminance = luminance_float(rgb[0], rgb[1], rgb[2]);
     if (luminance <= 0.0f) {
         glm_vec3_zero(rgb);
         return;

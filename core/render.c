@@ -10,6 +10,7 @@
 #include "camera.h"
 #include "clock.h"
 #include "hash.h"
+#include "luminance.h"
 #include "pack.h"
 #include "packed_traverse.h"
 #include "render_internal.h"
@@ -336,7 +337,7 @@ static rt_status render_aovs(gpu_tracer *tracer, int width, int height, const rt
             out[6] = albedo_depth[4 * i + 3];
             const float *pixel = colour->pixels + 4 * i;
             float count = pixel[3];
-            float mean = 0.2126f * pixel[0] + 0.7152f * pixel[1] + 0.0722f * pixel[2];
+            float mean = luminance_float(pixel[0], pixel[1], pixel[2]);
             out[7] = count > 0 ? fmaxf(0.0f, luminance_squares[i] / count - mean * mean) : 0.0f;
         }
     }

@@ -5,7 +5,7 @@
  * Like packed_layout.h, this file is included by C (core/gpu.h, core/render.h,
  * core/scene.h) and prepended, byte for byte, to the tracer's GLSL (the module table in
  * core/shader_sources.S). It must stay valid in both languages: only comments, include
- * guards and #define of plain integers and of the parameter list below.
+ * guards and #define of plain numbers and of the parameter list below.
  *
  * The parameter list is expanded twice: into the C struct tracer_parameter_block
  * (core/gpu.h) and into the GLSL uniform block of the same name (glsl/parameters.glsl),
@@ -37,6 +37,14 @@
 #define SAMPLER_SOBOL 0              /* padded, shuffled, Owen-scrambled Sobol pairs (default) */
 #define SAMPLER_INDEPENDENT 1        /* independent hashed numbers */
 #define SAMPLER_COUNT 2
+
+/* ---- luminance: Rec. 709's weights of R, G and B, the one measure of brightness:
+ * variance.Y (glsl/path_state.glsl, core/render.c), adaptive sampling's error
+ * (core/adaptive.c), light powers (core/pack_lights.c, glsl/lights.glsl), a merge's
+ * recombined variance, Reinhard's tone mapping. C reads them through core/luminance.h */
+#define LUMINANCE_R 0.2126
+#define LUMINANCE_G 0.7152
+#define LUMINANCE_B 0.0722
 
 /* ---- light choice (glsl/lights.glsl): scenes of 2 to this many lights choose a light by its
  * estimated irradiance at the point; more by the light tree (or by power alone, with the

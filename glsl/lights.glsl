@@ -21,7 +21,7 @@
 // memo, which the path carries to its next hit (choose_light_at, light_choice_probability).
 const uint LOCAL_CHOICE_MAX = uint(LIGHT_LOCAL_CHOICE_MAX);
 const float POWER_SHARE = 0.25;
-const vec3 LUMINANCE = vec3(0.2126, 0.7152, 0.0722);   // Rec. 709, as the packer's powers
+const vec3 LUMINANCE = vec3(LUMINANCE_R, LUMINANCE_G, LUMINANCE_B);   // as the packer's powers
 
 // The probability that choose_light() picks light.
 float light_power_probability(uint light)

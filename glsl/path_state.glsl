@@ -67,7 +67,7 @@ bool begin_segment(inout PixelState s, bool busy, bool may_start, out bool trace
 void finish_sample(inout PixelState s, vec3 radiance)
 {
     s.accumulated += vec4(radiance, 1.0);
-    float luminance = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
+    float luminance = dot(radiance, vec3(LUMINANCE_R, LUMINANCE_G, LUMINANCE_B));
     s.statistics.z += luminance * luminance;
     s.squares.rgb += radiance * radiance;
     s.finished_here++;
