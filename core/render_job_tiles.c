@@ -344,6 +344,22 @@ static rt_status postprocess_band(band_postprocess *post, int first, rt_image *b
     return status;
 }
 
+/* Reads the output's rows y .. y + band->height - 1 (of height) from the spool into band:
+ * as spooled, or (post not NULL) with their halo and filtered by postprocess_band(). */
+static rt_status read_output_band(tile_run *run, band_postprocess *post, int y, int height, rt_image *band,
+                                  rt_error *error)
+{
+    size_t row_bytes = (size_t)band->width * run->channels * sizeof(float);
+    if (post == NULL)
+        return spool_io(run, false, band->pixels, band->height * row_bytes, (off_t)((size_t)y * row_bytes), error);
+    int y0 = y - post->halo > 0 ? y - post->halo : 0;
+    int y1 = y + band->height + post->halo < height ? y + band->height + post->halo : height;
+    post->source.height = y1 - y0;
+    rt_status status = spool_io(run, false, post->source.pixels, (size_t)(y1 - y0) * row_bytes,
+                                (off_t)((size_t)y0 * row_bytes), error);
+    return status == RT_OK ? postprocess_band(post, y - y0, band, error) : status;
+}
+
 /* Streams the spool into the output (and the samples map), band by band, with the
  * final metadata. */
 static rt_status write_from_spool(tile_run *run, rt_error *error)
@@ -382,7 +398,6 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
      * is filtered, at least twice its halo, so that the halo's rows are not most of the
      * work. */
     size_t row_bytes = (size_t)width * layout.channels * sizeof(float);
-    size_t spool_row_bytes = (size_t)width * run->channels * sizeof(float);
     uint64_t budget = job->memory_budget ? job->memory_budget : render_job_default_memory_budget();
     int band_rows = (int)(budget / 8 / row_bytes);
     if (filtered && band_rows < 2 * post.halo)
@@ -405,18 +420,7 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     for (int y = 0; y < height && status == RT_OK; y += band_rows) {
         int rows = height - y < band_rows ? height - y : band_rows;
         band.height = colour.height = grey.height = rows;
-        if (filtered) {
-            int y0 = y - post.halo > 0 ? y - post.halo : 0;
-            int y1 = y + rows + post.halo < height ? y + rows + post.halo : height;
-            post.source.height = y1 - y0;
-            status = spool_io(run, false, post.source.pixels, (size_t)(y1 - y0) * spool_row_bytes,
-                              (off_t)((size_t)y0 * spool_row_bytes), error);
-            if (status == RT_OK)
-                status = postprocess_band(&post, y - y0, &band, error);
-        } else {
-            status = spool_io(run, false, band.pixels, rows * spool_row_bytes, (off_t)((size_t)y * spool_row_bytes),
-                              error);
-        }
+        status = read_output_band(run, filtered ? &post : NULL, y, height, &band, error);
         size_t pixels = (size_t)width * rows;
         if (status == RT_OK && tonemap) {
             for (size_t i = 0; i < pixels; i++)
