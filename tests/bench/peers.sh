@@ -38,6 +38,10 @@
 #                                each: the steps near 64 spp's RMSE (T 0.15 to 0.2) are what
 #                                the interpolation of the adaptive target reads), run
 #                                only when `rtspheres render --help` lists the option
+#   BENCH_QUALITY_DENOISE_SPP    the --denoise ladder (default "4 8 16 32 64"): rtspheres'
+#                                time by wall s (the denoiser runs after the passes, which
+#                                render s leaves out) to its own RMSE at BENCH_QUALITY_POINT
+#                                fixed spp, against the fixed render's wall s
 #   BENCH_PEER_THREADS           threads of Cycles and POV-Ray (default: the cores,
 #                                as llvmpipe uses)
 # shellcheck shell=sh disable=SC2154 # work, program, rows, CXX ...: run.sh's variables
@@ -48,6 +52,7 @@ quality_point=$(scaled "${BENCH_QUALITY_POINT:-64}")
 quality_reference_spp=$(scaled "${BENCH_QUALITY_REFERENCE_SPP:-2048}")
 noise_thresholds=${BENCH_NOISE_THRESHOLDS:-0.4 0.3 0.2 0.15 0.1 0.05 0.025}
 adaptive_max_spp=$(scaled 1024)
+denoise_spp=$(for s in ${BENCH_QUALITY_DENOISE_SPP:-4 8 16 32 64}; do scaled "$s"; done | sort -n -u | tr '\n' ' ' | sed 's/ $//')
 peer_threads=${BENCH_PEER_THREADS:-$(nproc 2>/dev/null || echo 2)}
 quality=$work/quality.tsv      # this run's time-to-quality results: label, key, value
 quality_reference=             # set while a ladder runs: image_rmse's reference
@@ -194,6 +199,9 @@ quality_scene() {
     for spp in $quality_spp; do
         bench "$label@$spp" "$scene" "$size" "$spp" "" --max-depth "$depth" --seed 1
     done
+    for spp in $denoise_spp; do
+        bench "$label@dn$spp" "$scene" "$size" "$spp" "denoised" --max-depth "$depth" --seed 1 --denoise
+    done
     if "$program" render --help 2>&1 | grep -q -- '--noise-threshold'; then
         for threshold in $noise_thresholds; do
             bench "$label@nt$threshold" "$scene" "$size" "$adaptive_max_spp" "adaptive" --max-depth "$depth" \
@@ -265,6 +273,19 @@ quality_compare() {
         print $19, $7 }' "$rows" | loglog_at "$own_rmse")
     quality_fact "$label" adaptive_seconds_for_point_rmse "$adaptive_time"
     quality_fact "$label" adaptive_time_ratio "$(ratio "$adaptive_time" "$own_time")"
+    # --denoise against the same renders undenoised, by wall s (the denoiser is not in
+    # render s): the RMSE at the fixed ladder's $quality_point-spp time, and the time for
+    # its RMSE (extrapolated past the ladder's end when the denoised images never reach it).
+    own_wall=$(value "$label@$quality_point" 6)
+    denoised_at_time=$(ladder_points "$label@dn" 6 | loglog_at "$own_wall")
+    denoised_time=$(ladder_points "$label@dn" 6 | awk '{ print $2, $1 }' | loglog_at "$own_rmse")
+    quality_fact "$label" denoised_rmse_at_point_wall_time "$denoised_at_time"
+    quality_fact "$label" denoised_rmse_ratio_equal_wall_time "$(ratio "$denoised_at_time" "$own_rmse")"
+    quality_fact "$label" denoised_wall_seconds_for_point_rmse "$denoised_time"
+    quality_fact "$label" denoised_time_ratio_wall "$(ratio "$denoised_time" "$own_wall")"
+    echo "  $label with --denoise, wall s: rtspheres $quality_point spp ${own_wall} s, RMSE $own_rmse; denoised at" \
+        "that time RMSE $denoised_at_time ($(ratio "$denoised_at_time" "$own_rmse")x), for that RMSE" \
+        "$denoised_time s ($(ratio "$denoised_time" "$own_wall")x)"
 }
 
 # Renders SCENE (spheres only) in POV-Ray as NAME at SIZE, the counterpart of rtspheres'
