@@ -21,6 +21,12 @@
 
 /* Half-width of the window the initial noise variance is measured over (7x7). */
 #define VARIANCE_RADIUS 3
+/* The bias check (postprocess.h, step 4): the neighbourhood of (2 BIAS_RADIUS + 1)^2
+ * pixels whose mean residual is weighed, and the z-scores of that mean from which some
+ * of it is added back and from which all of it is. */
+#define BIAS_RADIUS 1
+#define BIAS_Z_FROM 1.0
+#define BIAS_Z_ALL 3.0
 /* The denoiser's threads: at most this many, and each with at least this many rows. */
 #define DENOISE_THREADS_MAX 64
 #define DENOISE_ROWS_PER_THREAD_MIN 16
@@ -247,6 +253,8 @@ typedef struct stage {
     float *variance_out;         /* estimate_rows, atrous_rows */
     float *blurred;              /* blur_rows's output, atrous_rows's input */
     float *filtered;             /* atrous_rows */
+    float *colour;               /* correct_bias_rows's output: the caller's colour image, */
+    int channels;                /* channels floats a pixel */
 } stage;
 
 /* Measures the noise variance (mean over the three channels) of each pixel of rows y0 ..
@@ -356,6 +364,46 @@ static void atrous_rows(const stage *s, int y0, int y1)
             for (int c = 0; c < 3; c++)
                 filtered[3 * p + c] = (float)(sum[c] / weight_sum);
             filtered_variance[p] = (float)(variance_sum / (weight_sum * weight_sum));
+        }
+}
+
+/* Step 4 of postprocess.h, for rows y0 .. y1-1: writes each pixel's denoised colour
+ * (signal) into colour, plus as much of the mean residual (filtered: the input colour
+ * less the denoised one) of its neighbourhood as that mean's z-score against its standard
+ * error asks for, the standard error from the variance of each pixel's mean luminance
+ * (variance: < 0 where the render did not give it; such a neighbourhood is left alone). */
+static void correct_bias_rows(const stage *s, int y0, int y1)
+{
+    const denoiser *d = s->d;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < d->width; x++) {
+            size_t p = (size_t)y * d->width + x;
+            float *out = s->colour + p * s->channels;
+            memcpy(out, &s->signal[3 * p], 3 * sizeof *out);
+            double residual[3] = {0, 0, 0}, variance_sum = 0.0;
+            int n = 0;
+            bool known = true;
+            for (int dy = -BIAS_RADIUS; dy <= BIAS_RADIUS; dy++)
+                for (int dx = -BIAS_RADIUS; dx <= BIAS_RADIUS; dx++) {
+                    int qx = x + dx, qy = y + dy;
+                    if (qx < 0 || qx >= d->width || qy < 0 || qy >= d->height)
+                        continue;
+                    size_t q = (size_t)qy * d->width + qx;
+                    known = known && s->variance[q] >= 0.0f;
+                    variance_sum += s->variance[q];
+                    for (int c = 0; c < 3; c++)
+                        residual[c] += s->filtered[3 * q + c];
+                    n++;
+                }
+            if (!known)
+                continue;
+            for (int c = 0; c < 3; c++)
+                residual[c] /= n;
+            double standard_error = sqrt(variance_sum) / n;
+            double z = fabs(luminance_double(residual[0], residual[1], residual[2])) / (standard_error + 1e-20);
+            double share = z <= BIAS_Z_FROM ? 0.0 : z >= BIAS_Z_ALL ? 1.0 : (z - BIAS_Z_FROM) / (BIAS_Z_ALL - BIAS_Z_FROM);
+            for (int c = 0; c < 3; c++)
+                out[c] = (float)(out[c] + share * residual[c]);
         }
 }
 
@@ -565,12 +613,21 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
         variance = filtered_variance;
         filtered_variance = swap;
     }
-    for (size_t i = 0; i < count; i++)
+    /* The denoised colour into signal, what it took from the input into filtered, and the
+     * render's variance of each pixel's mean luminance into blurred_variance, for step 4. */
+    for (size_t i = 0; i < count; i++) {
         for (int c = 0; c < 3; c++) {
             float factor = albedo != NULL ? fmaxf(guides[i].albedo[c], albedo_epsilon) : 1.0f;
             float direct = emission != NULL ? emission->pixels[i * emission->channels + c] : 0.0f;
-            colour->pixels[i * channels + c] = signal[3 * i + c] * factor + direct;
+            signal[3 * i + c] = signal[3 * i + c] * factor + direct;
+            filtered[3 * i + c] = colour->pixels[i * channels + c] - signal[3 * i + c];
         }
+        float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
+        blurred_variance[i] = v >= 0.0f && isfinite(v) ? v : -1.0f;
+    }
+    run_rows(&(stage){.d = &d, .signal = signal, .filtered = filtered, .variance = blurred_variance,
+                      .colour = colour->pixels, .channels = channels},
+             correct_bias_rows);
 
 done:
     free(guides);
@@ -592,7 +649,7 @@ int postprocess_blur_reach(float sigma_pixels, int passes)
 int postprocess_denoise_reach(const postprocess_denoise_options *options)
 {
     int iterations = options != NULL && options->iterations != 0 ? options->iterations : DEFAULT_ITERATIONS;
-    return 2 * ((1 << iterations) - 1) + VARIANCE_RADIUS + 1;
+    return 2 * ((1 << iterations) - 1) + VARIANCE_RADIUS + 1 + BIAS_RADIUS;
 }
 
 /* ---------------------------------------------------------------------------------- */

@@ -62,7 +62,16 @@
  *      shows counts as noise there, and is spread out); each iteration carries it along
  *      as the variance of the weighted mean (sum (h w)^2 var_q / (sum h w)^2), and the
  *      colour weight reads it blurred over 3x3.
- * Each stage (the noise estimate, each iteration's variance blur and filter) runs in bands
+ *   4. Bias check, where the variance guide covers a pixel's 3x3 neighbourhood: the mean
+ *      over it of the residual (input colour less denoised) against that mean's standard
+ *      error (the root of the summed variances over 9): at a z-score of its luminance
+ *      under 1 nothing, over 3 all of the mean residual is added back, in between a
+ *      linear share. Noise leaves residuals that average out; a feature the guides do not
+ *      show (a strip lit from close by, a reflection) leaves the same residual on every
+ *      side and gets back what the filter took, where its samples say so. docs/sampling.md,
+ *      "Denoising", has what it gives.
+ * Each stage (the noise estimate, each iteration's variance blur and filter, the bias
+ * check) runs in bands
  * of rows on as many threads as the machine has cores (pthreads; at most 64, each with at
  * least 16 rows); every pixel is computed alone, so the image does not depend on them.
  * Depth is a distance; a pixel whose depth is 0, negative, infinite or NaN hit nothing
@@ -179,7 +188,7 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
  * their reaches. The blur's: passes x ceil(3 sigma) (0 when it changes nothing); the
  * denoiser's, with options (NULL: defaults): 2 (2^iterations - 1) for the iterations'
  * taps (the 3x3 variance blur stays within them), + 3 for the 7x7 noise estimate, + 1
- * for the depth gradient: 66 with the defaults. */
+ * for the depth gradient, + 1 for the bias check's 3x3: 67 with the defaults. */
 int postprocess_blur_reach(float sigma_pixels, int passes);
 int postprocess_denoise_reach(const postprocess_denoise_options *options);
 
