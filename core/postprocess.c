@@ -511,6 +511,43 @@ static rt_status check_option(float value, const char *name, rt_error *error)
     return RT_OK;
 }
 
+/* Checks postprocess_denoise()'s arguments (postprocess.h says what it refuses). */
+static rt_status check_denoise_arguments(const rt_image *colour, const postprocess_denoise_guides *g,
+                                         const postprocess_denoise_options *given, rt_error *error)
+{
+    rt_status status = check_image(colour, "colour", error);
+    if (status == RT_OK && colour->channels < 3)
+        status = rt_error_set(error, RT_ERROR_INPUT, "POSTPROCESS: the colour image has %d channel%s, 3 needed",
+                              colour->channels, colour->channels == 1 ? "" : "s");
+    if (status == RT_OK)
+        status = check_guide(g->albedo, "albedo", colour, 3, error);
+    if (status == RT_OK)
+        status = check_guide(g->normal, "normal", colour, 3, error);
+    if (status == RT_OK)
+        status = check_guide(g->depth, "depth", colour, 1, error);
+    if (status == RT_OK)
+        status = check_guide(g->emission, "emission", colour, 3, error);
+    if (status == RT_OK)
+        status = check_guide(g->variance, "variance", colour, 1, error);
+    if (status != RT_OK)
+        return status;
+    if (given->iterations < 0 || given->iterations > POSTPROCESS_MAX_DENOISE_ITERATIONS)
+        return rt_error_set(error, RT_ERROR_INPUT, "POSTPROCESS: denoise iterations %d is not between 0 and %d",
+                            given->iterations, POSTPROCESS_MAX_DENOISE_ITERATIONS);
+    const struct { float value; const char *name; } checked[] = {
+        {given->sigma_colour, "sigma_colour"}, {given->sigma_normal, "sigma_normal"},
+        {given->sigma_depth, "sigma_depth"}, {given->sigma_albedo, "sigma_albedo"},
+        {given->albedo_epsilon, "albedo_epsilon"},
+    };
+    for (size_t i = 0; i < sizeof checked / sizeof checked[0]; i++)
+        if ((status = check_option(checked[i].value, checked[i].name, error)) != RT_OK)
+            return status;
+    if ((status = check_finite(colour, "colour", error)) != RT_OK
+        || (g->emission != NULL && (status = check_finite(g->emission, "emission", error)) != RT_OK))
+        return status;
+    return RT_OK;
+}
+
 rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides *given_guides,
                               const postprocess_denoise_options *options, rt_error *error)
 {
@@ -518,41 +555,12 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
     const postprocess_denoise_guides *g = given_guides != NULL ? given_guides : &none;
     const rt_image *albedo = g->albedo, *normal = g->normal, *depth = g->depth, *emission = g->emission,
                    *mean_variance = g->variance;
-    rt_status status = check_image(colour, "colour", error);
-    if (status == RT_OK && colour->channels < 3)
-        status = rt_error_set(error, RT_ERROR_INPUT, "POSTPROCESS: the colour image has %d channel%s, 3 needed",
-                              colour->channels, colour->channels == 1 ? "" : "s");
-    if (status == RT_OK)
-        status = check_guide(albedo, "albedo", colour, 3, error);
-    if (status == RT_OK)
-        status = check_guide(normal, "normal", colour, 3, error);
-    if (status == RT_OK)
-        status = check_guide(depth, "depth", colour, 1, error);
-    if (status == RT_OK)
-        status = check_guide(emission, "emission", colour, 3, error);
-    if (status == RT_OK)
-        status = check_guide(mean_variance, "variance", colour, 1, error);
+    postprocess_denoise_options given = options != NULL ? *options : postprocess_denoise_options_defaults();
+    rt_status status = check_denoise_arguments(colour, g, &given, error);
     if (status != RT_OK)
         return status;
-
-    postprocess_denoise_options given = options != NULL ? *options : postprocess_denoise_options_defaults();
-    if (given.iterations < 0 || given.iterations > POSTPROCESS_MAX_DENOISE_ITERATIONS)
-        return rt_error_set(error, RT_ERROR_INPUT, "POSTPROCESS: denoise iterations %d is not between 0 and %d",
-                            given.iterations, POSTPROCESS_MAX_DENOISE_ITERATIONS);
-    const struct { float value; const char *name; } checked[] = {
-        {given.sigma_colour, "sigma_colour"}, {given.sigma_normal, "sigma_normal"},
-        {given.sigma_depth, "sigma_depth"}, {given.sigma_albedo, "sigma_albedo"},
-        {given.albedo_epsilon, "albedo_epsilon"},
-    };
-    for (size_t i = 0; i < sizeof checked / sizeof checked[0]; i++)
-        if ((status = check_option(checked[i].value, checked[i].name, error)) != RT_OK)
-            return status;
-
     size_t count = pixel_count(colour);
     int channels = colour->channels;
-    if ((status = check_finite(colour, "colour", error)) != RT_OK
-        || (emission != NULL && (status = check_finite(emission, "emission", error)) != RT_OK))
-        return status;
 
     int iterations = given.iterations != 0 ? given.iterations : DEFAULT_ITERATIONS;
     float sigma_normal = or_default(given.sigma_normal, DEFAULT_SIGMA_NORMAL);
