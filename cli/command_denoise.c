@@ -12,7 +12,6 @@
 
 #include "commands.h"
 #include "image_io.h"
-#include "metadata_keys.h"
 #include "postprocess.h"
 #include "render_denoise.h"
 #include "render_output.h"
@@ -84,13 +83,11 @@ static rt_status denoise_image(const char *input, const rt_image *image, rt_imag
     for (int c = 0; c < 3; c++)
         if ((colour_channels[c] = image_channel_index(image, colour_names[c])) < 0)
             return rt_error_set(error, RT_ERROR_INPUT, "'%s' has no %s channel", input, colour_names[c]);
-    char steps[256] = "";
-    image_read_attribute(input, METADATA_KEY_POSTPROCESS, steps, sizeof steps, NULL);
-    if (image_channel_index(image, "noisy.R") >= 0 || steps[0] != '\0')
-        return rt_error_set(error, RT_ERROR_INPUT, "'%s' is post-processed already (%s); denoise the render it came from",
-                            input, steps[0] != '\0' ? steps : "it has noisy.R/G/B");
+    rt_status status = render_denoise_check_raw(input, image, error);
+    if (status != RT_OK)
+        return status;
     rt_image noisy = {0};
-    rt_status status = image_create(colour, image->width, image->height, 3, error);
+    status = image_create(colour, image->width, image->height, 3, error);
     size_t pixels = (size_t)image->width * image->height;
     for (size_t i = 0; status == RT_OK && i < pixels; i++)
         for (int c = 0; c < 3; c++)

@@ -283,7 +283,8 @@ static rt_status check_part(const char *name, const rt_image *image, const merge
         return rt_error_set(error, RT_ERROR_INPUT,
                             "MERGE: '%s' is post-processed (" METADATA_KEY_POSTPROCESS " \"%s\"): its colour is no "
                             "longer the render's means; merge the raw parts (rendered with --aovs for `rtspheres "
-                            "denoise`, --light-groups for `rtspheres relight`) and post-process the merge", name, metadata->postprocess);
+                            "denoise`, --light-groups for `rtspheres relight`) and post-process the merge",
+                            name, metadata->postprocess);
     if (image_channel_index(image, "noisy.R") >= 0)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "MERGE: '%s' is denoised (it has noisy.R/G/B); merge raw parts (rendered with --aovs "

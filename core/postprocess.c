@@ -401,7 +401,9 @@ static void correct_bias_rows(const stage *s, int y0, int y1)
                 residual[c] /= n;
             double standard_error = sqrt(variance_sum) / n;
             double z = fabs(luminance_double(residual[0], residual[1], residual[2])) / (standard_error + 1e-20);
-            double share = z <= BIAS_Z_FROM ? 0.0 : z >= BIAS_Z_ALL ? 1.0 : (z - BIAS_Z_FROM) / (BIAS_Z_ALL - BIAS_Z_FROM);
+            double share = z <= BIAS_Z_FROM ? 0.0
+                           : z >= BIAS_Z_ALL ? 1.0
+                                             : (z - BIAS_Z_FROM) / (BIAS_Z_ALL - BIAS_Z_FROM);
             for (int c = 0; c < 3; c++)
                 out[c] = (float)(out[c] + share * residual[c]);
         }
@@ -459,7 +461,8 @@ static rt_status check_finite(const rt_image *image, const char *which, rt_error
         for (int c = 0; c < 3; c++)
             if (!isfinite(image->pixels[i * image->channels + c]))
                 return rt_error_set(error, RT_ERROR_INPUT,
-                                    "POSTPROCESS: the %s image has %s at pixel (%d, %d), channel %d", which, isnan(image->pixels[i * image->channels + c]) ? "NaN" : "an infinity",
+                                    "POSTPROCESS: the %s image has %s at pixel (%d, %d), channel %d", which,
+                                    isnan(image->pixels[i * image->channels + c]) ? "NaN" : "an infinity",
                                     (int)(i % image->width), (int)(i / image->width), c);
     return RT_OK;
 }

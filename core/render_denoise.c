@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "metadata_keys.h"
 #include "postprocess.h"
 
 /* Copies the channels named names[0 .. count-1] of image into a new image (*out; the
@@ -79,4 +80,14 @@ rt_status render_denoise(rt_image *colour, const rt_image *beauty, const rt_imag
 int render_denoise_reach(void)
 {
     return postprocess_denoise_reach(NULL);   /* render_denoise() runs the defaults */
+}
+
+rt_status render_denoise_check_raw(const char *path, const rt_image *image, rt_error *error)
+{
+    char steps[256] = "";
+    image_read_attribute(path, METADATA_KEY_POSTPROCESS, steps, sizeof steps, NULL);
+    if (image_channel_index(image, "noisy.R") < 0 && steps[0] == '\0')
+        return RT_OK;
+    return rt_error_set(error, RT_ERROR_INPUT, "'%s' is post-processed already (%s); denoise the render it came from",
+                        path, steps[0] != '\0' ? steps : "it has noisy.R/G/B");
 }

@@ -35,6 +35,12 @@
  * caller. */
 rt_status render_denoise(rt_image *colour, const rt_image *beauty, const rt_image *layers, rt_error *error);
 
+/* Checks that image, read from path, is a render's raw colour to denoise: not
+ * post-processed (no rtspheres:postprocess key, metadata_keys.h; nor the noisy.R layer
+ * of a --denoise render written before that key). RT_ERROR_INPUT naming path and what
+ * was done to it otherwise. */
+rt_status render_denoise_check_raw(const char *path, const rt_image *image, rt_error *error);
+
 /* How many rows away render_denoise() reads (postprocess.h postprocess_denoise_reach()). */
 int render_denoise_reach(void);
 

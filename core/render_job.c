@@ -83,7 +83,8 @@ void job_image_metadata(const job_image *image, const char *path, uint64_t sampl
         snprintf(texts->postprocess, sizeof texts->postprocess, "denoise");
     if (output && job->blur_sigma > 0)
         snprintf(texts->postprocess + strlen(texts->postprocess), sizeof texts->postprocess - strlen(texts->postprocess),
-                 "%sblur sigma=%g passes=%d", job->denoise ? "; " : "", job->blur_sigma, job->blur_passes > 0 ? job->blur_passes : 1);
+                 "%sblur sigma=%g passes=%d", job->denoise ? "; " : "", job->blur_sigma,
+                 job->blur_passes > 0 ? job->blur_passes : 1);
     *metadata = (render_output_metadata){
         .scene = job->scene_path,
         .scene_hash = texts->hash,
