@@ -93,9 +93,10 @@
  * end); then the output is streamed from it band by band (render_output_stream) with the
  * final metadata, atomically as always; neither the device nor the process holds more
  * than one tile and one band. Under tiling: AOVs, variance, light groups, adaptive
- * sampling, tone mapping and the samples map work as untiled; denoise and blur too, band
- * by band, each band read with the filters' reach (postprocess.h) more rows on each side
- * so that its pixels are the untiled ones; a time limit is shared out over the tiles
+ * sampling, tone mapping and the samples map work as untiled; denoise and blur too, in
+ * square blocks read from the spool with the filters' reach (postprocess.h) more pixels
+ * on every side, the filtered colour spooled to a second file for the output's bands, so
+ * that the pixels are the untiled ones; a time limit is shared out over the tiles
  * (tile k of n ends by start + limit * (k + 1) / n: unused time passes on, and every tile
  * gets its first pass); --checkpoint, --resume and --display are refused (RT_ERROR_INPUT naming the tiling and what to do), and an
  * interrupted tiled render writes no partial file (the output stays as it was).

@@ -5,6 +5,7 @@
  * comes first, so the output cannot be written while the tiles are still rendering. */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -154,6 +155,8 @@ typedef struct tile_run {
     job_image *image;
     int fd;                      /* the spool: window-sized, channels floats per pixel */
     char spool[RENDER_JOB_PATH_MAX];
+    int filtered_fd;             /* --denoise, --blur: the filtered R, G, B, 3 floats a pixel */
+    char filtered_spool[RENDER_JOB_PATH_MAX];
     int channels;                /* R, G, B, samples, the AOV/variance layers, the light groups */
     char names[IMAGE_MAX_CHANNELS][IMAGE_CHANNEL_NAME_MAX];
     render_result total;         /* the tiles' figures summed (no pixels) */
@@ -182,25 +185,26 @@ static void tile_progress(void *context, const render_progress *progress)
 
 /* Opens the spool file beside output: created, then unlinked at once, so that nothing is
  * left behind whatever ends the process. */
-static rt_status open_spool(tile_run *run, const char *output, rt_error *error)
+static rt_status open_spool(const char *output, char path[RENDER_JOB_PATH_MAX], int *fd, rt_error *error)
 {
     const char *slash = strrchr(output, '/');
     int directory = slash != NULL ? (int)(slash - output + 1) : 0;
-    snprintf(run->spool, sizeof run->spool, "%.*s.%s.tiles-XXXXXX", directory, output, output + directory);
-    run->fd = mkstemp(run->spool);
-    if (run->fd < 0)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "cannot create the tile spool file '%s': %s", run->spool,
+    snprintf(path, RENDER_JOB_PATH_MAX, "%.*s.%s.tiles-XXXXXX", directory, output, output + directory);
+    *fd = mkstemp(path);
+    if (*fd < 0)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "cannot create the tile spool file '%s': %s", path,
                             strerror(errno));
-    unlink(run->spool);
+    unlink(path);
     return RT_OK;
 }
 
-/* Writes or reads (write false) bytes at offset of the spool, all of them. */
-static rt_status spool_io(tile_run *run, bool write, void *bytes, size_t size, off_t offset, rt_error *error)
+/* Writes or reads (write false) bytes at offset of the spool fd (run->fd or
+ * run->filtered_fd), all of them. */
+static rt_status spool_io(tile_run *run, int fd, bool write, void *bytes, size_t size, off_t offset, rt_error *error)
 {
     char *at = bytes;
     while (size > 0) {
-        ssize_t n = write ? pwrite(run->fd, at, size, offset) : pread(run->fd, at, size, offset);
+        ssize_t n = write ? pwrite(fd, at, size, offset) : pread(fd, at, size, offset);
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0) {
@@ -273,7 +277,7 @@ static rt_status spool_tile(tile_run *run, const render_result *result, rt_error
             }
         }
         size_t first = (size_t)(result->region[1] + y - window[1]) * window_width + (result->region[0] - window[0]);
-        status = spool_io(run, true, row, (size_t)width * run->channels * sizeof *row,
+        status = spool_io(run, run->fd, true, row, (size_t)width * run->channels * sizeof *row,
                           (off_t)(first * run->channels * sizeof *row), error);
     }
     free(row);
@@ -302,62 +306,96 @@ static void add_tile(tile_run *run, const render_result *result, int tile)
     run->passes_before = total->passes;
 }
 
-/* --denoise and --blur of the output, band by band. They read rows beyond a pixel's own
- * (postprocess.h, "reach"), so a band is read from the spool with halo more rows on each
- * side (within the image) and only its own rows are kept: the untiled image's pixels bit
- * for bit, in the order postprocess_result() (render_job.c) applies them. */
+/* --denoise and --blur of the output. They read pixels beyond a pixel's own
+ * (postprocess.h, "reach"), so the image is filtered in square blocks, each read from the
+ * spool with halo more pixels on every side (within the image), and each block's own
+ * pixels of the filtered colour go to a second spool (filter_blocks); the output's bands
+ * then take their R, G, B from it: the untiled image's pixels bit for bit, in the order
+ * postprocess_result() (render_job.c) applies them, with memory for one block and one
+ * band whatever the image's width. */
 typedef struct band_postprocess {
     bool denoise;
     float blur_sigma;            /* 0: no blur */
     int blur_passes;
-    int halo;                    /* the rows read beyond a band on each side */
-    rt_image source;             /* a band and its halo, as spooled */
-    rt_image colour;             /* its R, G, B, filtered */
+    int halo;                    /* the pixels read beyond a block on each side */
+    int block;                   /* a block's side */
+    rt_image source;             /* a block and its halo, as spooled */
+    rt_image colour;             /* its R, G, B, filtered; then a band's */
+    rt_image raw;                /* a band as spooled */
 } band_postprocess;
 
-/* Filters source's colour into colour and writes rows first .. first + band->height - 1
- * of source into band (the output's channels): source's channels with the filtered R, G,
- * B, and with --denoise the noisy colour after them as noisy.R/G/B, as render_job.c's
- * denoise() appends it. */
-static rt_status postprocess_band(band_postprocess *post, int first, rt_image *band, rt_error *error)
+/* The side of the filter's blocks: the largest whose block and halo take about a
+ * quarter of budget at bytes_per_pixel (the spooled channels, the filtered colour and
+ * the denoiser's own arrays; the tiles' device memory is free by then), at least 64 and at
+ * most 1024 pixels. The larger the block, the less of the work is its halo's: (side + 2
+ * halo)^2 / side^2 of the image's, 1.4x at the default budget and 67 pixels of halo. */
+static int filter_block_side(uint64_t budget, size_t bytes_per_pixel, int halo)
 {
-    const rt_image *source = &post->source;
-    rt_image *colour = &post->colour;
-    colour->height = source->height;
-    size_t pixels = (size_t)source->width * source->height;
-    for (size_t i = 0; i < pixels; i++)
-        memcpy(colour->pixels + 3 * i, source->pixels + i * source->channels, 3 * sizeof(float));
+    double side = sqrt((double)budget / 4.0 / (double)bytes_per_pixel) - 2.0 * halo;
+    return side < 64 ? 64 : side > 1024 ? 1024 : (int)side;
+}
+
+/* Filters the spooled image (width x height) block by block into run->filtered_fd (see
+ * band_postprocess). */
+static rt_status filter_blocks(tile_run *run, band_postprocess *post, int width, int height, rt_error *error)
+{
+    size_t channels = (size_t)run->channels, spool_row = (size_t)width * channels * sizeof(float);
     rt_status status = RT_OK;
-    if (post->denoise)
-        status = render_denoise(colour, source, source, error);
-    if (status == RT_OK && post->blur_sigma > 0)
-        status = postprocess_gaussian_blur(colour, post->blur_sigma, post->blur_passes, error);
-    size_t kept = (size_t)band->width * band->height, offset = (size_t)first * source->width;
-    for (size_t i = 0; i < kept && status == RT_OK; i++) {
-        float *out = band->pixels + i * band->channels;
-        const float *in = source->pixels + (offset + i) * source->channels;
-        memcpy(out, in, source->channels * sizeof *out);
-        memcpy(out, colour->pixels + 3 * (offset + i), 3 * sizeof *out);
-        if (post->denoise)
-            memcpy(out + source->channels, in, 3 * sizeof *out);
-    }
+    for (int by = 0; by < height && status == RT_OK; by += post->block)
+        for (int bx = 0; bx < width && status == RT_OK; bx += post->block) {
+            int x1 = bx + post->block < width ? bx + post->block : width;
+            int y1 = by + post->block < height ? by + post->block : height;
+            int sx0 = bx - post->halo > 0 ? bx - post->halo : 0, sy0 = by - post->halo > 0 ? by - post->halo : 0;
+            int sx1 = x1 + post->halo < width ? x1 + post->halo : width;
+            int sy1 = y1 + post->halo < height ? y1 + post->halo : height;
+            rt_image *source = &post->source, *colour = &post->colour;
+            source->width = colour->width = sx1 - sx0;
+            source->height = colour->height = sy1 - sy0;
+            for (int y = sy0; y < sy1 && status == RT_OK; y++)
+                status = spool_io(run, run->fd, false, source->pixels + (size_t)(y - sy0) * source->width * channels,
+                                  (size_t)source->width * channels * sizeof(float),
+                                  (off_t)((size_t)y * spool_row + (size_t)sx0 * channels * sizeof(float)), error);
+            size_t pixels = (size_t)source->width * source->height;
+            for (size_t i = 0; status == RT_OK && i < pixels; i++)
+                memcpy(colour->pixels + 3 * i, source->pixels + i * channels, 3 * sizeof(float));
+            if (status == RT_OK && post->denoise)
+                status = render_denoise(colour, source, source, error);
+            if (status == RT_OK && post->blur_sigma > 0)
+                status = postprocess_gaussian_blur(colour, post->blur_sigma, post->blur_passes, error);
+            for (int y = by; y < y1 && status == RT_OK; y++)
+                status = spool_io(run, run->filtered_fd, true,
+                                  colour->pixels + ((size_t)(y - sy0) * colour->width + (size_t)(bx - sx0)) * 3,
+                                  (size_t)(x1 - bx) * 3 * sizeof(float),
+                                  (off_t)(((size_t)y * width + (size_t)bx) * 3 * sizeof(float)), error);
+        }
     return status;
 }
 
-/* Reads the output's rows y .. y + band->height - 1 (of height) from the spool into band:
- * as spooled, or (post not NULL) with their halo and filtered by postprocess_band(). */
-static rt_status read_output_band(tile_run *run, band_postprocess *post, int y, int height, rt_image *band,
-                                  rt_error *error)
+/* Reads the output's rows y .. y + band->height - 1 into band (the output's channels): as
+ * spooled, or (post not NULL) with the filtered R, G, B of filter_blocks() and, with
+ * --denoise, the spooled R, G, B after the spooled channels as noisy.R/G/B, as
+ * render_job.c's denoise() appends them. */
+static rt_status read_output_band(tile_run *run, band_postprocess *post, int y, rt_image *band, rt_error *error)
 {
     size_t row_bytes = (size_t)band->width * run->channels * sizeof(float);
     if (post == NULL)
-        return spool_io(run, false, band->pixels, band->height * row_bytes, (off_t)((size_t)y * row_bytes), error);
-    int y0 = y - post->halo > 0 ? y - post->halo : 0;
-    int y1 = y + band->height + post->halo < height ? y + band->height + post->halo : height;
-    post->source.height = y1 - y0;
-    rt_status status = spool_io(run, false, post->source.pixels, (size_t)(y1 - y0) * row_bytes,
-                                (off_t)((size_t)y0 * row_bytes), error);
-    return status == RT_OK ? postprocess_band(post, y - y0, band, error) : status;
+        return spool_io(run, run->fd, false, band->pixels, band->height * row_bytes, (off_t)((size_t)y * row_bytes),
+                        error);
+    size_t pixels = (size_t)band->width * band->height, colour_row = (size_t)band->width * 3 * sizeof(float);
+    rt_status status = spool_io(run, run->fd, false, post->raw.pixels, band->height * row_bytes,
+                                (off_t)((size_t)y * row_bytes), error);
+    if (status == RT_OK)
+        status = spool_io(run, run->filtered_fd, false, post->colour.pixels, band->height * colour_row,
+                          (off_t)((size_t)y * colour_row), error);
+    for (size_t i = 0; status == RT_OK && i < pixels; i++) {
+        float *out = band->pixels + i * band->channels;
+        const float *in = post->raw.pixels + i * run->channels;
+        memcpy(out, in, run->channels * sizeof *out);
+        memcpy(out, post->colour.pixels + 3 * i, 3 * sizeof *out);
+        if (post->denoise)
+            memcpy(out + run->channels, in, 3 * sizeof *out);
+    }
+    return status;
 }
 
 /* Streams the spool into the output (and the samples map), band by band, with the
@@ -394,25 +432,34 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
         status = image_stream_open(job->samples_map, &map_layout, NULL, &map, error);
     }
     bool tonemap = image_format_of(image->plan.output) == IMAGE_FORMAT_EIGHT_BIT && job->tonemap != TONEMAP_CLAMP;
-    /* A band: an eighth of the budget, with room for the writer's converted copy; when it
-     * is filtered, at least twice its halo, so that the halo's rows are not most of the
-     * work. */
+    /* A band: an eighth of the budget, with room for the writer's converted copy. */
     size_t row_bytes = (size_t)width * layout.channels * sizeof(float);
     uint64_t budget = job->memory_budget ? job->memory_budget : render_job_default_memory_budget();
     int band_rows = (int)(budget / 8 / row_bytes);
-    if (filtered && band_rows < 2 * post.halo)
-        band_rows = 2 * post.halo;
     band_rows = band_rows < 1 ? 1 : band_rows > height ? height : band_rows;
-    int source_rows = band_rows + 2 * post.halo < height ? band_rows + 2 * post.halo : height;
     rt_image band = {0}, colour = {0}, grey = {0};
     if (status == RT_OK)
         status = image_create(&band, width, band_rows, layout.channels, error);
-    if (status == RT_OK && filtered)
-        status = image_create(&post.source, width, source_rows, run->channels, error);
-    if (status == RT_OK && filtered)
-        status = image_create(&post.colour, width, source_rows, 3, error);
-    if (status == RT_OK && filtered)
-        memcpy(post.source.channel_names, run->names, sizeof post.source.channel_names);
+    if (status == RT_OK && filtered) {
+        /* Per pixel of a block: the spooled channels, the filtered colour and about 24
+         * floats of the denoiser's arrays. */
+        post.block = filter_block_side(budget, (size_t)run->channels * 4 + 12 + 96, post.halo);
+        int block_width = post.block + 2 * post.halo < width ? post.block + 2 * post.halo : width;
+        int block_height = post.block + 2 * post.halo < height ? post.block + 2 * post.halo : height;
+        size_t block_pixels = (size_t)block_width * block_height, band_pixels = (size_t)width * band_rows;
+        status = image_create(&post.source, block_width, block_height, run->channels, error);
+        if (status == RT_OK)
+            status = image_create(&post.colour, (int)(block_pixels > band_pixels ? block_pixels : band_pixels), 1, 3,
+                                  error);
+        if (status == RT_OK)
+            status = image_create(&post.raw, width, band_rows, run->channels, error);
+        if (status == RT_OK) {
+            memcpy(post.source.channel_names, run->names, sizeof post.source.channel_names);
+            status = open_spool(image->plan.output, run->filtered_spool, &run->filtered_fd, error);
+        }
+        if (status == RT_OK)
+            status = filter_blocks(run, &post, width, height, error);
+    }
     if (status == RT_OK && tonemap)
         status = image_create(&colour, width, band_rows, 3, error);
     if (status == RT_OK && map != NULL)
@@ -420,7 +467,7 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     for (int y = 0; y < height && status == RT_OK; y += band_rows) {
         int rows = height - y < band_rows ? height - y : band_rows;
         band.height = colour.height = grey.height = rows;
-        status = read_output_band(run, filtered ? &post : NULL, y, height, &band, error);
+        status = read_output_band(run, filtered ? &post : NULL, y, &band, error);
         size_t pixels = (size_t)width * rows;
         if (status == RT_OK && tonemap) {
             for (size_t i = 0; i < pixels; i++)
@@ -443,6 +490,7 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     image_free(&grey);
     image_free(&post.source);
     image_free(&post.colour);
+    image_free(&post.raw);
     if (status == RT_OK) {
         status = render_output_stream_close(output, error);
         output = NULL;
@@ -463,9 +511,9 @@ rt_status job_render_tiles(job_image *image, const render_options *options, cons
     const render_job *job = owner->job;
     const render_job_callbacks *callbacks = &owner->callbacks;
     const int *window = image->plan.window;
-    tile_run run = {.image = image, .fd = -1, .start = clock_seconds()};
+    tile_run run = {.image = image, .fd = -1, .filtered_fd = -1, .start = clock_seconds()};
     run.samples_total = (uint64_t)(window[2] - window[0]) * (window[3] - window[1]) * image->plan.samples_per_pixel;
-    rt_status status = open_spool(&run, image->plan.output, error);
+    rt_status status = open_spool(image->plan.output, run.spool, &run.fd, error);
     if (status != RT_OK)
         return status;
     if (callbacks->tiles_planned != NULL)
@@ -527,6 +575,8 @@ rt_status job_render_tiles(job_image *image, const render_options *options, cons
     if (status == RT_OK)
         status = write_from_spool(&run, error);
     close(run.fd);
+    if (run.filtered_fd >= 0)
+        close(run.filtered_fd);
     if (status != RT_OK)
         return status;
     /* A partial file of an earlier untiled run of this image is superseded too. */

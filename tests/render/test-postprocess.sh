@@ -137,16 +137,18 @@ if "$program" render $cornell -o "$scratch/c-tiled-check.exr" --size 64x48 --spp
         --memory-budget 700K 2>&1 | grep -q 'tiles'; then
     pass "the 700K budget renders the 64x48 Cornell box in tiles"
 else fail "the tiled case of rtspheres denoise" "the 700K budget did not tile the render"; fi
-# --denoise and --blur of a render in tiles: the output filtered band by band, each band
-# read with the filters' reach (postprocess.h) more rows on each side, is the untiled
-# image bit for bit, layers and all; the image is tall enough (400 rows against the
-# denoiser's reach of 66) that the bands are several.
-for options in "--denoise" "--blur 1.5:2" "--denoise --blur 1"; do
-    name="$options of a render in tiles is the untiled image"
+# --denoise and --blur of a render in tiles: the image filtered in blocks, each read with
+# the filters' reach (postprocess.h) more pixels on every side, is the untiled image bit
+# for bit, layers and all; at the 700K budget the blocks are 64 pixels a side, so a
+# 48x400 image has 7 of them in a column and a 300x160 one 5 x 3.
+for case in "48x400 --denoise" "48x400 --blur 1.5:2" "48x400 --denoise --blur 1" "300x160 --blur 1.5:2" \
+    "300x160 --denoise"; do
+    size=${case%% *} options=${case#* }
+    name="$options of a $size render in tiles is the untiled image"
     # shellcheck disable=SC2086
-    "$program" render $cornell -o "$scratch/tall.exr" --size 48x400 --spp 8 --seed 5 --quiet $options
+    "$program" render $cornell -o "$scratch/tall.exr" --size "$size" --spp 8 --seed 5 --quiet $options
     # shellcheck disable=SC2086
-    if ! "$program" render $cornell -o "$scratch/tall-tiled.exr" --size 48x400 --spp 8 --seed 5 $options \
+    if ! "$program" render $cornell -o "$scratch/tall-tiled.exr" --size "$size" --spp 8 --seed 5 $options \
             --memory-budget 700K >"$scratch/tall.log" 2>&1; then
         fail "$name" "$(head -c 300 "$scratch/tall.log")"
     elif ! grep -q 'tiles' "$scratch/tall.log"; then
