@@ -183,8 +183,10 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
 /* The reach of the blur and the denoiser: how many pixels away from a pixel they read to
  * compute it (rows or columns). A band of rows taken with this many more rows on each side
  * (or up to the image's edge) and filtered alone gives its own rows exactly, bit for bit,
- * as the whole image does: how a render in tiles is post-processed band by band
- * (core/render_job_tiles.c; tests/unit/test_postprocess.c checks it). Chained filters add
+ * as the whole image does (and so does a block of columns and rows taken with it on every
+ * side): how a render in tiles is post-processed block by block
+ * (core/render_job_tiles.c; tests/unit/test_postprocess.c checks bands, tests/render/
+ * test-postprocess.sh blocks). Chained filters add
  * their reaches. The blur's: passes x ceil(3 sigma) (0 when it changes nothing); the
  * denoiser's, with options (NULL: defaults): 2 (2^iterations - 1) for the iterations'
  * taps (the 3x3 variance blur stays within them), + 3 for the 7x7 noise estimate, + 1
