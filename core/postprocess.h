@@ -71,9 +71,13 @@
  *      side and gets back what the filter took, where its samples say so. docs/sampling.md,
  *      "Denoising", has what it gives.
  * Each stage (the noise estimate, each iteration's variance blur and filter, the bias
- * check) runs in bands
- * of rows on as many threads as the machine has cores (pthreads; at most 64, each with at
- * least 16 rows); every pixel is computed alone, so the image does not depend on them.
+ * check) runs in bands of rows on as many threads as the machine has cores (pthreads; at
+ * most 64, each with at least 16 rows), the noise estimate's and the filter's taps in
+ * vector loops over runs of 256 pixels (AVX-512, AVX2 or SSE2, picked for the CPU when the
+ * program starts; core/postprocess.c); every pixel is computed alone and alike in every
+ * lane and every clone, so the image depends on none of this. Sums are in float and the
+ * weights' exponential is the filter's own (a few ulps from libm's): the image is
+ * tests/unit/test_postprocess.c's plain double reference to within 2e-5.
  * Depth is a distance; a pixel whose depth is 0, negative, infinite or NaN hit nothing
  * (sky): such pixels form their own class and never mix with pixels that hit something.
  * Between two sky pixels only the colour weight counts.
@@ -185,8 +189,8 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
  * (or up to the image's edge) and filtered alone gives its own rows exactly, bit for bit,
  * as the whole image does (and so does a block of columns and rows taken with it on every
  * side): how a render in tiles is post-processed block by block
- * (core/render_job_tiles.c; tests/unit/test_postprocess.c checks bands, tests/render/
- * test-postprocess.sh blocks). Chained filters add
+ * (core/render_job_tiles.c; tests/unit/test_postprocess.c checks bands and blocks,
+ * tests/render/test-postprocess.sh blocks of a render). Chained filters add
  * their reaches. The blur's: passes x ceil(3 sigma) (0 when it changes nothing); the
  * denoiser's, with options (NULL: defaults): 2 (2^iterations - 1) for the iterations'
  * taps (the 3x3 variance blur stays within them), + 3 for the 7x7 noise estimate, + 1

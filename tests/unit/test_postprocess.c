@@ -11,8 +11,10 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "luminance.h"
 #include "postprocess.h"
 #include "support.h"
 
@@ -582,60 +584,55 @@ static void test_denoise_keeps_a_highlight_its_variance_vouches_for(void **state
     free_buffers(&b);
 }
 
-/* Rows y0 .. y1-1 of image, as an image of their own. */
-static rt_image rows_of(const rt_image *image, int y0, int y1)
+/* The region x0 <= x < x1, y0 <= y < y1 of image, as an image of its own. */
+static rt_image region_of(const rt_image *image, int x0, int y0, int x1, int y1)
 {
-    rt_image band;
-    assert_int_equal(image_create(&band, image->width, y1 - y0, image->channels, NULL), RT_OK);
-    size_t row = (size_t)image->width * image->channels;
-    memcpy(band.pixels, image->pixels + (size_t)y0 * row, (size_t)(y1 - y0) * row * sizeof(float));
-    return band;
+    rt_image block;
+    assert_int_equal(image_create(&block, x1 - x0, y1 - y0, image->channels, NULL), RT_OK);
+    size_t row = (size_t)(x1 - x0) * image->channels;
+    for (int y = y0; y < y1; y++)
+        memcpy(block.pixels + (size_t)(y - y0) * row, at(image, x0, y, 0), row * sizeof(float));
+    return block;
 }
 
-/* Denoises (blur false) or blurs rows core0 .. core1-1 of the inputs taken with halo more
- * rows each side (within the image), and returns how many of the core rows' values differ
- * from whole's (the whole image done at once). */
-static int band_differences(const rt_image inputs[6], const rt_image *whole, int core0, int core1, int halo,
-                            bool blur)
+/* Denoises (blur false) or blurs the core region [x0, x1) x [y0, y1) (core[4]) of the inputs
+ * taken with halo more pixels on every side (within the image), and returns how many of
+ * the core's values differ from whole's (the whole image done at once). */
+static int block_differences(const rt_image inputs[6], const rt_image *whole, const int core[4], int halo, bool blur)
 {
-    int height = inputs[0].height;
-    int y0 = core0 - halo > 0 ? core0 - halo : 0, y1 = core1 + halo < height ? core1 + halo : height;
-    rt_image band[6];
+    int width = inputs[0].width, height = inputs[0].height;
+    int x0 = core[0] - halo > 0 ? core[0] - halo : 0, x1 = core[2] + halo < width ? core[2] + halo : width;
+    int y0 = core[1] - halo > 0 ? core[1] - halo : 0, y1 = core[3] + halo < height ? core[3] + halo : height;
+    rt_image block[6];
     for (int i = 0; i < 6; i++)
-        band[i] = rows_of(&inputs[i], y0, y1);
-    postprocess_denoise_guides guides = {.albedo = &band[1], .normal = &band[2], .depth = &band[3],
-                                         .emission = &band[4], .variance = &band[5]};
+        block[i] = region_of(&inputs[i], x0, y0, x1, y1);
+    postprocess_denoise_guides guides = {.albedo = &block[1], .normal = &block[2], .depth = &block[3],
+                                         .emission = &block[4], .variance = &block[5]};
     if (blur)
-        assert_int_equal(postprocess_gaussian_blur(&band[0], 2.5f, 2, NULL), RT_OK);
+        assert_int_equal(postprocess_gaussian_blur(&block[0], 2.5f, 2, NULL), RT_OK);
     else
-        assert_int_equal(postprocess_denoise(&band[0], &guides, NULL, NULL), RT_OK);
+        assert_int_equal(postprocess_denoise(&block[0], &guides, NULL, NULL), RT_OK);
     int differences = 0;
-    for (int y = core0; y < core1; y++)
-        for (int x = 0; x < whole->width; x++)
+    for (int y = core[1]; y < core[3]; y++)
+        for (int x = core[0]; x < core[2]; x++)
             for (int c = 0; c < 3; c++)
-                differences += memcmp(at(&band[0], x, y - y0, c), at(whole, x, y, c), sizeof(float)) != 0;
+                differences += memcmp(at(&block[0], x - x0, y - y0, c), at(whole, x, y, c), sizeof(float)) != 0;
     for (int i = 0; i < 6; i++)
-        image_free(&band[i]);
+        image_free(&block[i]);
     return differences;
 }
 
-/* A band of rows denoised (or blurred) with postprocess_*_reach() more rows on each side
- * is the whole image's rows bit for bit: what a render in tiles relies on to denoise its
- * output band by band (core/render_job_tiles.c). An image with all the denoiser meets:
- * noise, normal and depth edges, sky, texture, emission, and the variance known at some
- * pixels only (the rest measured around them). With a halo too short the rows differ, so
- * the comparison can see a wrong reach. */
-static void test_bands_with_the_reach_are_exact(void **state)
+/* Fills the six inputs of the denoiser (colour, albedo, normal, depth, emission, variance;
+ * width x height) with all it meets: noise, normal and depth edges, sky, texture,
+ * emission, and the variance known at some pixels only (the rest measured around them). */
+static void make_denoiser_inputs(int width, int height, rt_image inputs[6])
 {
-    (void)state;
-    enum { WIDTH = 24, HEIGHT = 260 };
-    rt_image inputs[6] = {
-        make_image(WIDTH, HEIGHT, 3, 0.0f), make_image(WIDTH, HEIGHT, 3, 0.0f), make_image(WIDTH, HEIGHT, 3, 0.0f),
-        make_image(WIDTH, HEIGHT, 1, 0.0f), make_image(WIDTH, HEIGHT, 3, 0.0f), make_image(WIDTH, HEIGHT, 1, 0.0f),
-    };
+    const int channels[6] = {3, 3, 3, 1, 3, 1};
+    for (int i = 0; i < 6; i++)
+        inputs[i] = make_image(width, height, channels[i], 0.0f);
     random_state random = {0x9e3779b97f4a7c15ULL};
-    for (int y = 0; y < HEIGHT; y++)
-        for (int x = 0; x < WIDTH; x++) {
+    for (int y = 0; y < height; y++)
+        for (int x = 0; x < width; x++) {
             bool sky = (y / 37 + x / 9) % 5 == 0;
             int patch = (y / 23 + x / 7) % 3;
             for (int c = 0; c < 3; c++) {
@@ -647,7 +644,22 @@ static void test_bands_with_the_reach_are_exact(void **state)
             *at(&inputs[3], x, y, 0) = sky ? 0.0f : (float)(2.0 + 0.01 * y + (patch == 2 ? 1.0 : 0.0));
             *at(&inputs[5], x, y, 0) = (x + 3 * y) % 7 == 0 ? -1.0f : (float)(0.01 * (1 + patch));
         }
-    rt_image denoised = rows_of(&inputs[0], 0, HEIGHT), blurred = rows_of(&inputs[0], 0, HEIGHT);
+}
+
+/* A block of the image denoised (or blurred) with postprocess_*_reach() more pixels on
+ * every side is the whole image's pixels bit for bit: what a render in tiles relies on to
+ * post-process its output block by block (core/render_job_tiles.c). The image is wider
+ * than the denoiser's runs of 256 pixels (core/postprocess.c, DENOISE_RUN), and blocks
+ * start at other columns than the whole image, so a pixel is computed at another place in
+ * a run, in a vector lane or not. With a halo too short the pixels differ, so the
+ * comparison can see a wrong reach. */
+static void test_blocks_with_the_reach_are_exact(void **state)
+{
+    (void)state;
+    enum { WIDTH = 300, HEIGHT = 260 };
+    rt_image inputs[6];
+    make_denoiser_inputs(WIDTH, HEIGHT, inputs);
+    rt_image denoised = region_of(&inputs[0], 0, 0, WIDTH, HEIGHT), blurred = region_of(&inputs[0], 0, 0, WIDTH, HEIGHT);
     postprocess_denoise_guides guides = {.albedo = &inputs[1], .normal = &inputs[2], .depth = &inputs[3],
                                          .emission = &inputs[4], .variance = &inputs[5]};
     assert_int_equal(postprocess_denoise(&denoised, &guides, NULL, NULL), RT_OK);
@@ -657,19 +669,238 @@ static void test_bands_with_the_reach_are_exact(void **state)
     assert_int_equal(blur_reach, 16);
     assert_int_equal(postprocess_blur_reach(0.0f, 3), 0);
     assert_int_equal(postprocess_denoise_reach(&(postprocess_denoise_options){.iterations = 2}), 11);
-    const int cores[][2] = {{100, 130}, {0, 20}, {230, HEIGHT}, {70, 71}};
+    /* Bands of whole rows, and blocks: one across the second run's start (x 256), one at
+     * the right edge, one column in the middle. */
+    const int cores[][4] = {{0, 100, WIDTH, 130}, {0, 0, WIDTH, 20}, {0, 230, WIDTH, HEIGHT}, {0, 70, WIDTH, 71},
+                            {230, 40, 270, 90}, {280, 150, WIDTH, 200}, {131, 0, 132, HEIGHT}};
     for (size_t i = 0; i < sizeof cores / sizeof cores[0]; i++) {
-        assert_int_equal(band_differences(inputs, &denoised, cores[i][0], cores[i][1], reach, false), 0);
-        assert_int_equal(band_differences(inputs, &blurred, cores[i][0], cores[i][1], blur_reach, true), 0);
+        assert_int_equal(block_differences(inputs, &denoised, cores[i], reach, false), 0);
+        assert_int_equal(block_differences(inputs, &blurred, cores[i], blur_reach, true), 0);
     }
-    int short_denoise = band_differences(inputs, &denoised, 100, 130, 20, false);
-    int short_blur = band_differences(inputs, &blurred, 100, 130, 4, true);
-    print_message("bands with a short halo: %d denoised and %d blurred values differ\n", short_denoise, short_blur);
+    int short_denoise = block_differences(inputs, &denoised, cores[4], 20, false);
+    int short_blur = block_differences(inputs, &blurred, cores[4], 4, true);
+    print_message("blocks with a short halo: %d denoised and %d blurred values differ\n", short_denoise, short_blur);
     assert_true(short_denoise > 0 && short_blur > 0);
     for (int i = 0; i < 6; i++)
         image_free(&inputs[i]);
     image_free(&denoised);
     image_free(&blurred);
+}
+
+/* The denoiser of postprocess.h with its default options, written out pixel by pixel in
+ * doubles with libm's exp, as a reference for core/postprocess.c's vector loops (planes,
+ * runs of pixels, float sums, its own exponential). g's images may be NULL. */
+typedef struct reference_pixel {
+    double normal[3], albedo[3], depth, gradient[2];
+    bool hit;
+} reference_pixel;
+
+static double reference_guide_weight(const reference_pixel *p, const reference_pixel *q, int dx, int dy,
+                                     const postprocess_denoise_guides *g)
+{
+    if (p->hit != q->hit)
+        return 0.0;
+    if (!p->hit)
+        return 1.0;
+    double exponent = 0.0;
+    for (int c = 0; c < 3; c++) {
+        if (g->normal != NULL)
+            exponent += (q->normal[c] - p->normal[c]) * (q->normal[c] - p->normal[c]) / (0.3 * 0.3);
+        if (g->albedo != NULL)
+            exponent += (q->albedo[c] - p->albedo[c]) * (q->albedo[c] - p->albedo[c]) / (0.1 * 0.1);
+    }
+    if (g->depth != NULL)
+        exponent += fabs(q->depth - (p->depth + p->gradient[0] * dx + p->gradient[1] * dy)) / (0.02 * p->depth);
+    return exp(-exponent);
+}
+
+static void reference_denoise(rt_image *colour, const postprocess_denoise_guides *g)
+{
+    int width = colour->width, height = colour->height, n = width * height;
+    reference_pixel *pixels = calloc((size_t)n, sizeof *pixels);
+    double *signal = calloc((size_t)n * 3, sizeof(double)), *next = calloc((size_t)n * 3, sizeof(double));
+    double *variance = calloc((size_t)n, sizeof(double)), *next_variance = calloc((size_t)n, sizeof(double));
+    double *blurred = calloc((size_t)n, sizeof(double)), *divisor = calloc((size_t)n * 3, sizeof(double));
+    bool *measured = calloc((size_t)n, sizeof(bool));
+    assert_non_null(pixels);
+    assert_true(signal && next && variance && next_variance && blurred && divisor && measured);
+#define INSIDE(x, y) ((x) >= 0 && (x) < width && (y) >= 0 && (y) < height)
+    for (int i = 0; i < n; i++) {
+        float z = g->depth != NULL ? g->depth->pixels[i * g->depth->channels] : 1.0f;
+        pixels[i].hit = isfinite(z) && z > 0.0f;
+        pixels[i].depth = pixels[i].hit ? z : 0.0;
+        for (int c = 0; c < 3; c++) {
+            pixels[i].normal[c] = g->normal != NULL ? g->normal->pixels[i * g->normal->channels + c] : 0.0;
+            pixels[i].albedo[c] = g->albedo != NULL ? g->albedo->pixels[i * g->albedo->channels + c] : 0.0;
+            divisor[3 * i + c] = g->albedo != NULL ? fmax(pixels[i].albedo[c], 0.01f) : 1.0;
+            double direct = g->emission != NULL ? g->emission->pixels[i * g->emission->channels + c] : 0.0;
+            signal[3 * i + c] = (colour->pixels[i * colour->channels + c] - direct) / divisor[3 * i + c];
+        }
+        float v = g->variance != NULL ? g->variance->pixels[i * g->variance->channels] : -1.0f;
+        measured[i] = !(v >= 0.0f && isfinite(v));
+        for (int c = 0; c < 3 && !measured[i]; c++)
+            variance[i] += v / (divisor[3 * i + c] * divisor[3 * i + c]) / 3.0;
+    }
+    for (int y = 0; y < height; y++)
+        for (int x = 0; x < width; x++) {
+            reference_pixel *p = &pixels[y * width + x];
+            for (int axis = 0; axis < 2 && p->hit; axis++) {
+                int bx = x - (axis == 0), by = y - (axis == 1), ax = x + (axis == 0), ay = y + (axis == 1);
+                bool before = INSIDE(bx, by) && pixels[by * width + bx].hit;
+                bool after = INSIDE(ax, ay) && pixels[ay * width + ax].hit;
+                double backward = before ? p->depth - pixels[by * width + bx].depth : 0.0;
+                double forward = after ? pixels[ay * width + ax].depth - p->depth : 0.0;
+                p->gradient[axis] = before && after ? (fabs(backward) < fabs(forward) ? backward : forward)
+                                    : before        ? backward
+                                                    : forward;
+            }
+        }
+    for (int y = 0; y < height; y++)   /* the noise measured over 7x7 where the guide has none */
+        for (int x = 0; x < width; x++) {
+            int p = y * width + x;
+            double w_sum = 0, sum[3] = {0}, square[3] = {0};
+            for (int dy = -3; dy <= 3 && measured[p]; dy++)
+                for (int dx = -3; dx <= 3; dx++) {
+                    if (!INSIDE(x + dx, y + dy))
+                        continue;
+                    int q = p + dy * width + dx;
+                    double w = reference_guide_weight(&pixels[p], &pixels[q], dx, dy, g);
+                    w_sum += w;
+                    for (int c = 0; c < 3; c++) {
+                        sum[c] += w * signal[3 * q + c];
+                        square[c] += w * signal[3 * q + c] * signal[3 * q + c];
+                    }
+                }
+            for (int c = 0; c < 3 && measured[p]; c++)
+                variance[p] += fmax(0.0, square[c] / w_sum - (sum[c] / w_sum) * (sum[c] / w_sum)) / 3.0;
+        }
+    static const double b3[5] = {1.0 / 16, 1.0 / 4, 3.0 / 8, 1.0 / 4, 1.0 / 16};
+    for (int i = 0; i < 5; i++) {
+        int step = 1 << i;
+        for (int y = 0; y < height; y++)
+            for (int x = 0; x < width; x++) {
+                int p = y * width + x;
+                double sum = 0, w_sum = 0;
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++)
+                        if (INSIDE(x + dx, y + dy) && pixels[p + dy * width + dx].hit == pixels[p].hit) {
+                            double w = (dx == 0 ? 0.5 : 0.25) * (dy == 0 ? 0.5 : 0.25);
+                            sum += w * variance[p + dy * width + dx];
+                            w_sum += w;
+                        }
+                blurred[p] = sum / w_sum;
+            }
+        for (int y = 0; y < height; y++)
+            for (int x = 0; x < width; x++) {
+                int p = y * width + x;
+                const double *cp = &signal[3 * p];
+                double sigma = measured[p] ? 4.0 : 4.0 * ldexp(1.0, i > 1 ? 1 - i : 0);
+                double level = (fabs(cp[0]) + fabs(cp[1]) + fabs(cp[2])) / 3.0;
+                double scale = sigma * sqrt(blurred[p]) + 1e-3 * level + 1e-8;
+                double w_sum = 0, sum[3] = {0}, v_sum = 0;
+                for (int j = -2; j <= 2; j++)
+                    for (int k = -2; k <= 2; k++) {
+                        int dx = k * step, dy = j * step;
+                        if (!INSIDE(x + dx, y + dy))
+                            continue;
+                        int q = p + dy * width + dx;
+                        double w = b3[k + 2] * b3[j + 2];
+                        if (q != p) {
+                            double d2 = 0;
+                            for (int c = 0; c < 3; c++)
+                                d2 += (signal[3 * q + c] - cp[c]) * (signal[3 * q + c] - cp[c]);
+                            w *= reference_guide_weight(&pixels[p], &pixels[q], dx, dy, g) * exp(-sqrt(d2 / 3) / scale);
+                        }
+                        w_sum += w;
+                        v_sum += w * w * variance[q];
+                        for (int c = 0; c < 3; c++)
+                            sum[c] += w * signal[3 * q + c];
+                    }
+                for (int c = 0; c < 3; c++)
+                    next[3 * p + c] = sum[c] / w_sum;
+                next_variance[p] = v_sum / (w_sum * w_sum);
+            }
+        double *swap = signal;
+        signal = next;
+        next = swap;
+        swap = variance;
+        variance = next_variance;
+        next_variance = swap;
+    }
+    for (int i = 0; i < n; i++)   /* remodulated; next: the residual, input less denoised */
+        for (int c = 0; c < 3; c++) {
+            double direct = g->emission != NULL ? g->emission->pixels[i * g->emission->channels + c] : 0.0;
+            signal[3 * i + c] = signal[3 * i + c] * divisor[3 * i + c] + direct;
+            next[3 * i + c] = colour->pixels[i * colour->channels + c] - signal[3 * i + c];
+        }
+    for (int y = 0; y < height; y++)   /* the bias check over 3x3 */
+        for (int x = 0; x < width; x++) {
+            int p = y * width + x, count = 0;
+            double residual[3] = {0}, v_sum = 0;
+            bool known = g->variance != NULL;
+            for (int dy = -1; dy <= 1 && known; dy++)
+                for (int dx = -1; dx <= 1; dx++)
+                    if (INSIDE(x + dx, y + dy)) {
+                        int q = p + dy * width + dx;
+                        float v = g->variance->pixels[q * g->variance->channels];
+                        known = known && v >= 0.0f && isfinite(v);
+                        v_sum += v;
+                        for (int c = 0; c < 3; c++)
+                            residual[c] += next[3 * q + c] / 9.0;
+                        count++;
+                    }
+            double share = 0.0;
+            if (known) {
+                for (int c = 0; c < 3; c++)
+                    residual[c] *= 9.0 / count;
+                double z = fabs(luminance_double(residual[0], residual[1], residual[2])) / (sqrt(v_sum) / count + 1e-20);
+                share = z <= 1.0 ? 0.0 : z >= 3.0 ? 1.0 : (z - 1.0) / 2.0;
+            }
+            for (int c = 0; c < 3; c++)
+                colour->pixels[p * colour->channels + c] = (float)(signal[3 * p + c] + share * residual[c]);
+        }
+#undef INSIDE
+    free(pixels);
+    free(signal);
+    free(next);
+    free(variance);
+    free(next_variance);
+    free(blurred);
+    free(divisor);
+    free(measured);
+}
+
+/* postprocess_denoise() gives the reference's image (above) to float rounding, with every
+ * guide and with none, on an image wider than its runs of 256 pixels. */
+static void test_denoise_matches_the_reference(void **state)
+{
+    (void)state;
+    rt_image inputs[6];
+    make_denoiser_inputs(290, 70, inputs);
+    const postprocess_denoise_guides cases[2] = {
+        {.albedo = &inputs[1], .normal = &inputs[2], .depth = &inputs[3], .emission = &inputs[4],
+         .variance = &inputs[5]},
+        {0},
+    };
+    for (int i = 0; i < 2; i++) {
+        rt_image denoised = region_of(&inputs[0], 0, 0, inputs[0].width, inputs[0].height);
+        rt_image reference = region_of(&inputs[0], 0, 0, inputs[0].width, inputs[0].height);
+        assert_int_equal(postprocess_denoise(&denoised, &cases[i], NULL, NULL), RT_OK);
+        reference_denoise(&reference, &cases[i]);
+        double largest = 0.0, change = 0.0;
+        for (size_t k = 0; k < (size_t)denoised.width * denoised.height * 3; k++) {
+            largest = fmax(largest, fabs(denoised.pixels[k] - reference.pixels[k]) / (1.0 + fabs(reference.pixels[k])));
+            change = fmax(change, fabs(inputs[0].pixels[k] - reference.pixels[k]));
+        }
+        print_message("denoise against the reference, %s guides: largest difference %.3g (the filter moved "
+                      "values by up to %.3g)\n", i == 0 ? "all" : "no", largest, change);
+        assert_true(largest < 2e-5);
+        assert_true(change > 0.1);
+        image_free(&denoised);
+        image_free(&reference);
+    }
+    for (int i = 0; i < 6; i++)
+        image_free(&inputs[i]);
 }
 
 /* A bright line one pixel wide whose own samples are noisy (the strip of ceiling beside
@@ -1033,7 +1264,8 @@ int main(void)
         cmocka_unit_test(test_denoise_leaves_the_emission_seen_at_once),
         cmocka_unit_test(test_denoise_keeps_a_highlight_its_variance_vouches_for),
         cmocka_unit_test(test_denoise_gives_back_a_noisy_bright_line),
-        cmocka_unit_test(test_bands_with_the_reach_are_exact),
+        cmocka_unit_test(test_blocks_with_the_reach_are_exact),
+        cmocka_unit_test(test_denoise_matches_the_reference),
         cmocka_unit_test(test_denoise_rejects_bad_input),
         cmocka_unit_test(test_tonemap_reinhard_of_one_is_a_half),
         cmocka_unit_test(test_tonemap_curves_are_monotonic_and_bounded),
