@@ -5,7 +5,8 @@
  * channel_names says otherwise.
  *
  * Writing picks the format from the file extension:
- *   .exr        linear float32, all channels and names kept, attributes stored as metadata
+ *   .exr        linear float32, all channels and names kept, attributes stored as metadata;
+ *               compressed losslessly with EXR_COMPRESSION (below)
  *   .hdr        linear float (RGB only)
  *   .png .jpg .jpeg .tif .tiff  8-bit sRGB: multiplied by 2^exposure, clamped to [0,1],
  *               sRGB-encoded; alpha (if any) is written linearly
@@ -32,6 +33,9 @@ extern "C" {
 #endif
 
 #define IMAGE_MAX_CHANNELS 128
+/* The EXR files' compression, as OpenImageIO names it: PIZ (lossless; docs/performance.md,
+ * the log, has what it saves against ZIP). */
+#define EXR_COMPRESSION "piz"
 #define IMAGE_CHANNEL_NAME_MAX 32
 
 typedef struct rt_image {
