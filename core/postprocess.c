@@ -29,6 +29,10 @@
 #define BIAS_RADIUS 1
 #define BIAS_Z_FROM 1.0
 #define BIAS_Z_ALL 3.0
+/* The choice among the iterations' images (postprocess.h, step 5): each one's risk is
+ * averaged over a pixel's neighbours out to CHOICE_RADIUS pixels in x and in y, with a
+ * Gaussian of CHOICE_RADIUS / 2 and the guides' weights. */
+#define CHOICE_RADIUS 9
 /* The denoiser's threads: at most this many, and each with at least this many rows. */
 #define DENOISE_THREADS_MAX 64
 #define DENOISE_ROWS_PER_THREAD_MIN 16
@@ -185,6 +189,13 @@ typedef struct denoiser {
     float inverse_normal_sigma2, inverse_albedo_sigma2;   /* 0 without that guide */
     float sigma_colour;          /* this iteration's, for pixels with the render's variance */
     float sigma_colour_measured; /* every iteration's, for pixels whose noise was measured */
+    /* The choice (step 5), with the render's variance only; self_weight NULL without it. */
+    float *self_weight;          /* dF_p / dy_p of the image so far: its iterations' centre weights' product */
+    const rt_image *input;       /* the caller's colour as given */
+    const rt_image *emission;    /* the emission guide, or NULL */
+    const rt_image *mean_variance;   /* the variance guide */
+    bool demodulate;             /* with an albedo guide */
+    float albedo_epsilon;
 } denoiser;
 
 static float finite_or_zero(float value)
@@ -304,6 +315,10 @@ typedef struct stage {
     float *const *filtered;      /* atrous_rows: three planes */
     float *colour;               /* correct_bias_rows's output: the caller's colour image, */
     int channels;                /* channels floats a pixel */
+    float *risk;                 /* risk_rows's output; smooth_rows's input and output */
+    float *smoothed;             /* smooth_rows's horizontal pass, choose_rows's input */
+    float *best_risk;            /* choose_rows: the lowest smoothed risk so far, per pixel */
+    float *const *best;          /* choose_rows: that image (three planes, output space) */
 } stage;
 
 /* The sums one tap loop adds to, one element per pixel of the run. */
@@ -390,6 +405,8 @@ static void atrous_rows(const stage *s, int y0, int y1)
                 for (int c = 0; c < 3; c++)
                     s->filtered[c][p] = sums.colour[c][k] / sums.weight[k];
                 s->variance_out[p] = sums.variance[k] / (sums.weight[k] * sums.weight[k]);
+                if (d->self_weight != NULL)
+                    d->self_weight[p] *= centre / sums.weight[k];
             }
         }
 }
@@ -486,6 +503,115 @@ static void blur_rows(const stage *s, int y0, int y1)
                     weight_sum += w;
                 }
             blurred[p] = sum / weight_sum;
+        }
+}
+
+/* Channel c of pixel p of the image whose demodulated colour is signal, in the caller's
+ * units: multiplied back by the albedo, the emission added back. */
+static float remodulated(const denoiser *d, float *const *signal, size_t p, int c)
+{
+    float factor = d->demodulate ? fmaxf(d->g.albedo[c][p], d->albedo_epsilon) : 1.0f;
+    float direct = d->emission != NULL ? d->emission->pixels[p * d->emission->channels + c] : 0.0f;
+    return signal[c][p] * factor + direct;
+}
+
+/* Step 5's risk of each pixel of rows y0 .. y1-1 in the image whose demodulated colour is
+ * s->signal: Stein's unbiased estimate of its luminance's squared error, (L(F) - L(y))^2 -
+ * var + 2 var dF/dy, y the input and var the variance of its mean (the variance guide);
+ * NAN where that is unknown. */
+static void risk_rows(const stage *s, int y0, int y1)
+{
+    const denoiser *d = s->d;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < d->width; x++) {
+            size_t p = (size_t)y * d->width + x;
+            float v = d->mean_variance->pixels[p * d->mean_variance->channels];
+            if (!(v >= 0.0f) || !isfinite(v)) {
+                s->risk[p] = NAN;
+                continue;
+            }
+            const float *in = &d->input->pixels[p * d->input->channels];
+            float difference[3];
+            for (int c = 0; c < 3; c++)
+                difference[c] = remodulated(d, s->signal, p, c) - in[c];
+            float luminance = luminance_float(difference[0], difference[1], difference[2]);
+            s->risk[p] = luminance * luminance - v + 2.0f * v * d->self_weight[p];
+        }
+}
+
+/* Adds the tap (dx, dy) of step 5's smoothing, one of whose two is 0, to the sums of run
+ * pixels k0 .. k1-1 (pixel p = first + k): value[q] by the Gaussian's weight kernel and
+ * the guides' weight (0 between a hit and sky; a NAN value makes the sum NAN). */
+VECTOR_CLONES static void smooth_taps(const denoiser *d, const float *restrict value, size_t first,
+                                      ptrdiff_t offset, float dx, float dy, float kernel, int k0, int k1,
+                                      tap_sums *restrict sums)
+{
+#pragma GCC ivdep
+    for (int k = k0; k < k1; k++) {
+        size_t p = first + (size_t)k, q = (size_t)((ptrdiff_t)p + offset);
+        float w = kernel * guide_match(d, p, q) * exp_negative(guide_exponent(d, p, q, dx, dy));
+        sums->weight[k] += w;
+        sums->colour[0][k] += w * value[q];
+    }
+}
+
+/* The smoothing's Gaussian weight of a tap distance pixels away along one axis. */
+static float choice_kernel(int distance)
+{
+    float sigma = CHOICE_RADIUS / 2.0f;
+    return expf(-(float)(distance * distance) / (2.0f * sigma * sigma));
+}
+
+/* Step 5's average of value over the pixels of row y from column x0 on (run of them), along
+ * x (along_x) or along y, into mean[0 .. run-1]. */
+static void average_run(const denoiser *d, const float *value, int y, int x0, int run, bool along_x, float *mean)
+{
+    tap_sums sums;
+    size_t first = (size_t)y * d->width + x0;
+    memset(sums.weight, 0, sizeof sums.weight);
+    memset(sums.colour[0], 0, sizeof sums.colour[0]);
+    for (int t = -CHOICE_RADIUS; t <= CHOICE_RADIUS; t++) {
+        if (along_x) {
+            int k0 = -t - x0 > 0 ? -t - x0 : 0, k1 = d->width - t - x0 < run ? d->width - t - x0 : run;
+            if (k0 < k1)
+                smooth_taps(d, value, first, t, (float)t, 0.0f, choice_kernel(t), k0, k1, &sums);
+        } else if (y + t >= 0 && y + t < d->height) {
+            smooth_taps(d, value, first, (ptrdiff_t)t * d->width, 0.0f, (float)t, choice_kernel(t), 0, run, &sums);
+        }
+    }
+    for (int k = 0; k < run; k++)
+        mean[k] = sums.colour[0][k] / sums.weight[k];
+}
+
+/* Step 5's average along x of rows y0 .. y1-1: s->risk into s->smoothed. */
+static void smooth_rows(const stage *s, int y0, int y1)
+{
+    int width = s->d->width;
+    for (int y = y0; y < y1; y++)
+        for (int x0 = 0; x0 < width; x0 += DENOISE_RUN)
+            average_run(s->d, s->risk, y, x0, width - x0 < DENOISE_RUN ? width - x0 : DENOISE_RUN, true,
+                        s->smoothed + (size_t)y * width + x0);
+}
+
+/* Step 5's average along y of rows y0 .. y1-1 (s->smoothed), and the choice: where a
+ * pixel's averaged risk is below the lowest so far, the image whose demodulated colour is
+ * s->signal becomes its best. A NAN risk (the variance unknown nearby) chooses nothing. */
+static void choose_rows(const stage *s, int y0, int y1)
+{
+    const denoiser *d = s->d;
+    float risk[DENOISE_RUN];
+    for (int y = y0; y < y1; y++)
+        for (int x0 = 0; x0 < d->width; x0 += DENOISE_RUN) {
+            int run = d->width - x0 < DENOISE_RUN ? d->width - x0 : DENOISE_RUN;
+            average_run(d, s->smoothed, y, x0, run, false, risk);
+            for (int k = 0; k < run; k++) {
+                size_t p = (size_t)y * d->width + x0 + k;
+                if (!(risk[k] < s->best_risk[p]))
+                    continue;
+                s->best_risk[p] = risk[k];
+                for (int c = 0; c < 3; c++)
+                    s->best[c][p] = remodulated(d, s->signal, p, c);
+            }
         }
 }
 
@@ -716,6 +842,18 @@ static bool allocate_planes(size_t count, denoise_planes *planes, guide_planes *
     return true;
 }
 
+/* Step 5 for the image after an iteration, whose demodulated colour is signal: its risk,
+ * smoothed, and where lower than the best so far, it becomes the best (choice's planes). */
+static void offer_choice(const denoiser *d, float *const *signal, const stage *choice)
+{
+    stage s = *choice;
+    s.d = d;
+    s.signal = signal;
+    run_rows(&s, risk_rows);
+    run_rows(&s, smooth_rows);
+    run_rows(&s, choose_rows);
+}
+
 rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides *given_guides,
                               const postprocess_denoise_options *options, rt_error *error)
 {
@@ -747,6 +885,36 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
                             colour->width, colour->height);
     load_guides(albedo, normal, depth, colour->width, colour->height,
                 or_default(given.sigma_depth, DEFAULT_SIGMA_DEPTH), &d.g);
+    /* Step 5's planes, with the render's variance: dF/dy, the risk and its smoothing, the
+     * best image so far and its risk. */
+    enum { CHOICE_PLANES = 7 };
+    float *choice_block = NULL, *best[3] = {NULL, NULL, NULL};
+    stage choice = {0};
+    if (mean_variance != NULL) {
+        choice_block = count <= SIZE_MAX / (CHOICE_PLANES * sizeof(float))
+                           ? malloc(count * CHOICE_PLANES * sizeof(float)) : NULL;
+        if (choice_block == NULL) {
+            free(planes.block);
+            return rt_error_set(error, RT_ERROR_RUNTIME, "POSTPROCESS: out of memory denoising a %dx%d image",
+                                colour->width, colour->height);
+        }
+        d.self_weight = choice_block;
+        choice.risk = choice_block + count;
+        choice.smoothed = choice_block + 2 * count;
+        choice.best_risk = choice_block + 3 * count;
+        for (int c = 0; c < 3; c++)
+            best[c] = choice_block + (4 + c) * count;
+        choice.best = best;
+        for (size_t i = 0; i < count; i++) {
+            d.self_weight[i] = 1.0f;
+            choice.best_risk[i] = INFINITY;
+        }
+    }
+    d.input = colour;
+    d.emission = emission;
+    d.mean_variance = mean_variance;
+    d.demodulate = albedo != NULL;
+    d.albedo_epsilon = albedo_epsilon;
     float **signal = planes.signal, **filtered = planes.filtered;
     float *variance = planes.variance, *filtered_variance = planes.filtered_variance,
           *blurred_variance = planes.blurred_variance;
@@ -777,14 +945,16 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
         float *swap_variance = variance;
         variance = filtered_variance;
         filtered_variance = swap_variance;
+        if (choice_block != NULL)
+            offer_choice(&d, signal, &choice);
     }
-    /* The denoised colour into signal, what it took from the input into filtered, and the
-     * render's variance of each pixel's mean luminance into blurred_variance, for step 4. */
+    /* The denoised colour (step 5's choice where it made one) into signal, what it took from
+     * the input into filtered, and the render's variance of each pixel's mean luminance into
+     * blurred_variance, for step 4. */
     for (size_t i = 0; i < count; i++) {
+        bool chosen = choice_block != NULL && choice.best_risk[i] < INFINITY;
         for (int c = 0; c < 3; c++) {
-            float factor = albedo != NULL ? fmaxf(d.g.albedo[c][i], albedo_epsilon) : 1.0f;
-            float direct = emission != NULL ? emission->pixels[i * emission->channels + c] : 0.0f;
-            signal[c][i] = signal[c][i] * factor + direct;
+            signal[c][i] = chosen ? best[c][i] : remodulated(&d, signal, i, c);
             filtered[c][i] = colour->pixels[i * channels + c] - signal[c][i];
         }
         float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
@@ -794,6 +964,7 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
                       .colour = colour->pixels, .channels = channels},
              correct_bias_rows);
     free(planes.block);
+    free(choice_block);
     return RT_OK;
 }
 int postprocess_blur_reach(float sigma_pixels, int passes)
@@ -806,7 +977,7 @@ int postprocess_blur_reach(float sigma_pixels, int passes)
 int postprocess_denoise_reach(const postprocess_denoise_options *options)
 {
     int iterations = options != NULL && options->iterations != 0 ? options->iterations : DEFAULT_ITERATIONS;
-    return 2 * ((1 << iterations) - 1) + VARIANCE_RADIUS + 1 + BIAS_RADIUS;
+    return 2 * ((1 << iterations) - 1) + VARIANCE_RADIUS + 1 + CHOICE_RADIUS + BIAS_RADIUS;
 }
 
 /* ---------------------------------------------------------------------------------- */

@@ -70,10 +70,24 @@
  *      show (a strip lit from close by, a reflection) leaves the same residual on every
  *      side and gets back what the filter took, where its samples say so. docs/sampling.md,
  *      "Denoising", has what it gives.
- * Each stage (the noise estimate, each iteration's variance blur and filter, the bias
- * check) runs in bands of rows on as many threads as the machine has cores (pthreads; at
- * most 64, each with at least 16 rows), the noise estimate's and the filter's taps in
- * vector loops over runs of 256 pixels (AVX-512, AVX2 or SSE2, picked for the CPU when the
+ *   5. Choice among the iterations' images, where the variance guide has values (it runs
+ *      before step 4, whose input is its output): for the image after each iteration k
+ *      (1 .. iterations) Stein's unbiased risk estimate of each pixel's squared error in
+ *      luminance, (L(F_k) - L(y))^2 - var + 2 var dF_k/dy (y the input, var the variance
+ *      guide, dF_k/dy the product of the iterations' centre weight shares: exact for the
+ *      first iteration, a little low after), averaged over the pixel's neighbours out to
+ *      9 pixels with a Gaussian of 4.5 pixels and the normal, depth and albedo weights
+ *      (along x, then along y); each pixel takes the image of lowest averaged risk (a
+ *      neighbourhood with an unknown variance takes the last). Where the guides do not show
+ *      what the filter blurs (reflections, refractions, the horizon in a mirror, lighting
+ *      that changes within a surface) fewer iterations win; elsewhere all of them.
+ *      (Rousselle, Knaus, Zwicker, "Adaptive rendering with non-local means filtering",
+ *      SIGGRAPH Asia 2012, choose among filters by SURE this way.) The input itself is not
+ *      offered: on four scenes' renders it was never chosen.
+ * Each stage (the noise estimate, each iteration's variance blur and filter, the choice's
+ * risks and averages, the bias check) runs in bands of rows on as many threads as the machine has cores (pthreads; at
+ * most 64, each with at least 16 rows), the noise estimate's, the filter's and the
+ * choice's taps in vector loops over runs of 256 pixels (AVX-512, AVX2 or SSE2, picked for the CPU when the
  * program starts; core/postprocess.c); every pixel is computed alone and alike in every
  * lane and every clone, so the image depends on none of this. Sums are in float and the
  * weights' exponential is the filter's own (a few ulps from libm's): the image is
@@ -194,7 +208,8 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
  * their reaches. The blur's: passes x ceil(3 sigma) (0 when it changes nothing); the
  * denoiser's, with options (NULL: defaults): 2 (2^iterations - 1) for the iterations'
  * taps (the 3x3 variance blur stays within them), + 3 for the 7x7 noise estimate, + 1
- * for the depth gradient, + 1 for the bias check's 3x3: 67 with the defaults. */
+ * for the depth gradient, + 9 for the choice's average, + 1 for the bias check's 3x3:
+ * 76 with the defaults. */
 int postprocess_blur_reach(float sigma_pixels, int passes);
 int postprocess_denoise_reach(const postprocess_denoise_options *options);
 

@@ -328,7 +328,7 @@ typedef struct band_postprocess {
  * quarter of budget at bytes_per_pixel (the spooled channels, the filtered colour and
  * the denoiser's own arrays; the tiles' device memory is free by then), at least 64 and at
  * most 1024 pixels. The larger the block, the less of the work is its halo's: (side + 2
- * halo)^2 / side^2 of the image's, 1.4x at the default budget and 67 pixels of halo. */
+ * halo)^2 / side^2 of the image's, 1.4x at the default budget and 76 pixels of halo. */
 static int filter_block_side(uint64_t budget, size_t bytes_per_pixel, int halo)
 {
     double side = sqrt((double)budget / 4.0 / (double)bytes_per_pixel) - 2.0 * halo;
@@ -441,9 +441,9 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     if (status == RT_OK)
         status = image_create(&band, width, band_rows, layout.channels, error);
     if (status == RT_OK && filtered) {
-        /* Per pixel of a block: the spooled channels, the filtered colour and about 24
-         * floats of the denoiser's arrays. */
-        post.block = filter_block_side(budget, (size_t)run->channels * 4 + 12 + 96, post.halo);
+        /* Per pixel of a block: the spooled channels, the filtered colour and about 28
+         * floats of the denoiser's arrays (core/postprocess.c: 20 planes, 7 for the choice). */
+        post.block = filter_block_side(budget, (size_t)run->channels * 4 + 12 + 112, post.halo);
         int block_width = post.block + 2 * post.halo < width ? post.block + 2 * post.halo : width;
         int block_height = post.block + 2 * post.halo < height ? post.block + 2 * post.halo : height;
         size_t block_pixels = (size_t)block_width * block_height, band_pixels = (size_t)width * band_rows;
