@@ -149,7 +149,7 @@ rt_status postprocess_gaussian_blur(rt_image *image, float sigma_pixels, int pas
 /* ---------------------------------------------------------------------------------- */
 /* Denoiser                                                                             */
 
-/* The filter's tap loops (atrous_taps, estimate_taps) are written for the compiler to make
+/* The tap loops (atrous_taps, estimate_taps, smooth_taps) are written for the compiler to make
  * vector loops of: planes of one float per pixel, each tap applied to a run of consecutive
  * pixels, no branch in the loop, no library call (exp_negative below). The Makefile
  * builds this file with -O3, which vectorises them, and GCC compiles one clone of each for
