@@ -653,8 +653,10 @@ static void correct_bias_rows(const stage *s, int y0, int y1)
             double share = z <= BIAS_Z_FROM ? 0.0
                            : z >= BIAS_Z_ALL ? 1.0
                                              : (z - BIAS_Z_FROM) / (BIAS_Z_ALL - BIAS_Z_FROM);
+            /* What it gives back never takes a colour below 0 (a render's never is), nor
+             * below what the filter left where that already was. */
             for (int c = 0; c < 3; c++)
-                out[c] = (float)(out[c] + share * residual[c]);
+                out[c] = fmaxf(fminf(out[c], 0.0f), (float)(out[c] + share * residual[c]));
         }
 }
 

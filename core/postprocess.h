@@ -66,10 +66,11 @@
  *      over it of the residual (input colour less denoised) against that mean's standard
  *      error (the root of the summed variances over 9): at a z-score of its luminance
  *      under 1 nothing, over 3 all of the mean residual is added back, in between a
- *      linear share. Noise leaves residuals that average out; a feature the guides do not
- *      show (a strip lit from close by, a reflection) leaves the same residual on every
- *      side and gets back what the filter took, where its samples say so. docs/sampling.md,
- *      "Denoising", has what it gives.
+ *      linear share (never below 0: no render's colour is; nor below what the filter left
+ *      where that already was). Noise leaves residuals that average out; a feature the
+ *      guides do not show (a strip lit from close by, a reflection) leaves the same
+ *      residual on every side and gets back what the filter took, where its samples say
+ *      so. docs/sampling.md, "Denoising", has what it gives.
  *   5. Choice among the iterations' images, where the variance guide has values (it runs
  *      before step 4, whose input is its output): for the image after each iteration k
  *      (1 .. iterations) Stein's unbiased risk estimate of each pixel's squared error in

@@ -914,7 +914,8 @@ static void reference_denoise(rt_image *colour, const postprocess_denoise_guides
                 share = z <= 1.0 ? 0.0 : z >= 3.0 ? 1.0 : (z - 1.0) / 2.0;
             }
             for (int c = 0; c < 3; c++)
-                colour->pixels[p * colour->channels + c] = (float)(signal[3 * p + c] + share * residual[c]);
+                colour->pixels[p * colour->channels + c] =
+                    (float)fmax(fmin(signal[3 * p + c], 0.0), signal[3 * p + c] + share * residual[c]);
         }
 #undef INSIDE
     free(pixels);
@@ -1014,6 +1015,46 @@ static void test_denoise_keeps_detail_the_guides_do_not_show(void **state)
                   ratio);
     assert_true(contrast > 0.045 && contrast < 0.1);
     assert_true(ratio > 150);
+}
+
+/* A dim surface as 4 samples a pixel see it: most pixels 0 (no sample found light), some
+ * lit, with the render's variance. The bias check gives back a mean residual where it
+ * stands out, which beside a lit pixel is negative; it must not take a pixel below 0 (it
+ * took some to -0.044 before it was bounded). The mean comes out 14% low (0.086 of 0.100):
+ * a pixel all of whose samples were 0 has a variance of 0, so its colour weight lets little
+ * light in, while the lit pixels give theirs away; a known limit at so few samples
+ * (docs/sampling.md, "Denoising", has what was tried), bounded here at 20%. */
+static void test_denoise_never_makes_a_colour_negative(void **state)
+{
+    (void)state;
+    buffers b = make_flat(0.0f, 0.0f, 5);
+    rt_image variance = make_image(SIZE, SIZE, 1, 0.0f);
+    random_state random = {99};
+    double input_sum = 0.0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            int lit = 0;
+            for (int sample = 0; sample < 4; sample++)
+                lit += random_uniform(&random) < 0.1;
+            float value = 0.25f * lit;   /* each lit sample 1, the mean of 4 */
+            for (int c = 0; c < 3; c++)
+                *at(&b.colour, x, y, c) = value;
+            *at(&variance, x, y, 0) = (float)((lit / 4.0 - (lit / 4.0) * (lit / 4.0)) / 3.0);
+            input_sum += value;
+        }
+    postprocess_denoise_guides guides = {.albedo = &b.albedo, .normal = &b.normal, .depth = &b.depth,
+                                         .variance = &variance};
+    assert_int_equal(postprocess_denoise(&b.colour, &guides, NULL, NULL), RT_OK);
+    float lowest = INFINITY;
+    for (size_t i = 0; i < (size_t)SIZE * SIZE * 3; i++)
+        lowest = fminf(lowest, b.colour.pixels[i]);
+    double mean = region_mean(&b.colour, 0, 0, 0, SIZE, SIZE);
+    print_message("a dim surface at 4 spp: lowest denoised value %g, mean %.4f (input %.4f)\n", lowest, mean,
+                  input_sum / (SIZE * SIZE));
+    assert_true(lowest >= 0.0f);
+    assert_relative(mean, input_sum / (SIZE * SIZE), 0.2);
+    image_free(&variance);
+    free_buffers(&b);
 }
 
 /* A bright line one pixel wide whose own samples are noisy (the strip of ceiling beside
@@ -1382,6 +1423,7 @@ int main(void)
         cmocka_unit_test(test_blocks_with_the_reach_are_exact),
         cmocka_unit_test(test_denoise_matches_the_reference),
         cmocka_unit_test(test_denoise_keeps_detail_the_guides_do_not_show),
+        cmocka_unit_test(test_denoise_never_makes_a_colour_negative),
         cmocka_unit_test(test_denoise_rejects_bad_input),
         cmocka_unit_test(test_tonemap_reinhard_of_one_is_a_half),
         cmocka_unit_test(test_tonemap_curves_are_monotonic_and_bounded),
