@@ -804,43 +804,50 @@ static rt_status check_denoise_arguments(const rt_image *colour, const postproce
 
 /* The planes postprocess_denoise() works in, count floats each (bytes for noise_measured),
  * in one allocation: the guides' eleven float planes and the variance, the signal and
- * filtered colours, the filtered and blurred variances. */
-enum { GUIDE_FLOAT_PLANES = 12, SIGNAL_PLANES = 3, OTHER_PLANES = 2 };
+ * filtered colours, the filtered and blurred variances, and with step 5 its seven: dF/dy,
+ * the risk and its average along x, the lowest risk so far and its image. */
+enum { GUIDE_FLOAT_PLANES = 12, SIGNAL_PLANES = 3, OTHER_PLANES = 2, CHOICE_PLANES = 7 };
 typedef struct denoise_planes {
     float *block;
     float *signal[SIGNAL_PLANES], *filtered[SIGNAL_PLANES];   /* ping-pong */
     float *variance, *filtered_variance, *blurred_variance;
+    float *best[3];              /* step 5's (NULL without it), as choice.best points at */
+    stage choice;                /* step 5's planes: risk, smoothed, best_risk, best */
 } denoise_planes;
 
-/* Allocates the planes of a count-pixel image into *planes and the guides into *g; false
+/* Allocates the planes of a count-pixel image into *planes and the guides into *g, with
+ * step 5's (choosing; then d->self_weight too, all 1, and every best risk infinite); false
  * when out of memory (nothing to free then). Free with free(planes->block). */
-static bool allocate_planes(size_t count, denoise_planes *planes, guide_planes *g)
+static bool allocate_planes(size_t count, bool choosing, denoise_planes *planes, denoiser *d)
 {
-    size_t floats = GUIDE_FLOAT_PLANES + 2 * SIGNAL_PLANES + OTHER_PLANES;
-    size_t bytes = count * (floats * sizeof(float) + 1);
+    guide_planes *g = &d->g;
+    size_t floats = GUIDE_FLOAT_PLANES + 2 * SIGNAL_PLANES + OTHER_PLANES + (choosing ? CHOICE_PLANES : 0);
     if (count > SIZE_MAX / (floats * sizeof(float) + 1))
         return false;
-    planes->block = malloc(bytes);
+    memset(planes, 0, sizeof *planes);
+    planes->block = malloc(count * (floats * sizeof(float) + 1));
     if (planes->block == NULL)
         return false;
     float *next = planes->block;
-    float **guide_float_planes[GUIDE_FLOAT_PLANES] = {
+    float **float_planes[GUIDE_FLOAT_PLANES + 2 * SIGNAL_PLANES + OTHER_PLANES + CHOICE_PLANES] = {
         &g->normal[0], &g->normal[1], &g->normal[2], &g->albedo[0], &g->albedo[1], &g->albedo[2],
         &g->depth, &g->gradient[0], &g->gradient[1], &g->depth_scale, &g->hit, &planes->variance,
+        &planes->signal[0], &planes->signal[1], &planes->signal[2],
+        &planes->filtered[0], &planes->filtered[1], &planes->filtered[2],
+        &planes->filtered_variance, &planes->blurred_variance,
+        &d->self_weight, &planes->choice.risk, &planes->choice.smoothed, &planes->choice.best_risk,
+        &planes->best[0], &planes->best[1], &planes->best[2],
     };
-    for (int i = 0; i < GUIDE_FLOAT_PLANES; i++, next += count)
-        *guide_float_planes[i] = next;
-    for (int c = 0; c < SIGNAL_PLANES; c++) {
-        planes->signal[c] = next;
-        next += count;
-        planes->filtered[c] = next;
-        next += count;
-    }
-    planes->filtered_variance = next;
-    next += count;
-    planes->blurred_variance = next;
-    next += count;
+    for (size_t i = 0; i < floats; i++, next += count)
+        *float_planes[i] = next;
     g->noise_measured = (unsigned char *)next;   /* the count bytes after the floats */
+    if (choosing) {
+        planes->choice.best = planes->best;
+        for (size_t i = 0; i < count; i++) {
+            d->self_weight[i] = 1.0f;
+            planes->choice.best_risk[i] = INFINITY;
+        }
+    }
     return true;
 }
 
@@ -881,37 +888,14 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
         .inverse_albedo_sigma2 = albedo != NULL ? 1.0f / (sigma_albedo * sigma_albedo) : 0.0f,
         .sigma_colour = or_default(given.sigma_colour, DEFAULT_SIGMA_COLOUR),
     };
+    /* Step 5 where the render's variance is known. */
+    bool choosing = mean_variance != NULL;
     denoise_planes planes;
-    if (!allocate_planes(count, &planes, &d.g))
+    if (!allocate_planes(count, choosing, &planes, &d))
         return rt_error_set(error, RT_ERROR_RUNTIME, "POSTPROCESS: out of memory denoising a %dx%d image",
                             colour->width, colour->height);
     load_guides(albedo, normal, depth, colour->width, colour->height,
                 or_default(given.sigma_depth, DEFAULT_SIGMA_DEPTH), &d.g);
-    /* Step 5's planes, with the render's variance: dF/dy, the risk and its smoothing, the
-     * best image so far and its risk. */
-    enum { CHOICE_PLANES = 7 };
-    float *choice_block = NULL, *best[3] = {NULL, NULL, NULL};
-    stage choice = {0};
-    if (mean_variance != NULL) {
-        choice_block = count <= SIZE_MAX / (CHOICE_PLANES * sizeof(float))
-                           ? malloc(count * CHOICE_PLANES * sizeof(float)) : NULL;
-        if (choice_block == NULL) {
-            free(planes.block);
-            return rt_error_set(error, RT_ERROR_RUNTIME, "POSTPROCESS: out of memory denoising a %dx%d image",
-                                colour->width, colour->height);
-        }
-        d.self_weight = choice_block;
-        choice.risk = choice_block + count;
-        choice.smoothed = choice_block + 2 * count;
-        choice.best_risk = choice_block + 3 * count;
-        for (int c = 0; c < 3; c++)
-            best[c] = choice_block + (4 + c) * count;
-        choice.best = best;
-        for (size_t i = 0; i < count; i++) {
-            d.self_weight[i] = 1.0f;
-            choice.best_risk[i] = INFINITY;
-        }
-    }
     d.input = colour;
     d.emission = emission;
     d.mean_variance = mean_variance;
@@ -947,16 +931,16 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
         float *swap_variance = variance;
         variance = filtered_variance;
         filtered_variance = swap_variance;
-        if (choice_block != NULL)
-            offer_choice(&d, signal, &choice);
+        if (choosing)
+            offer_choice(&d, signal, &planes.choice);
     }
     /* The denoised colour (step 5's choice where it made one) into signal, what it took from
      * the input into filtered, and the render's variance of each pixel's mean luminance into
      * blurred_variance, for step 4. */
     for (size_t i = 0; i < count; i++) {
-        bool chosen = choice_block != NULL && choice.best_risk[i] < INFINITY;
+        bool chosen = choosing && planes.choice.best_risk[i] < INFINITY;
         for (int c = 0; c < 3; c++) {
-            signal[c][i] = chosen ? best[c][i] : remodulated(&d, signal, i, c);
+            signal[c][i] = chosen ? planes.best[c][i] : remodulated(&d, signal, i, c);
             filtered[c][i] = colour->pixels[i * channels + c] - signal[c][i];
         }
         float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
@@ -966,7 +950,6 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
                       .colour = colour->pixels, .channels = channels},
              correct_bias_rows);
     free(planes.block);
-    free(choice_block);
     return RT_OK;
 }
 int postprocess_blur_reach(float sigma_pixels, int passes)
