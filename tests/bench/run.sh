@@ -24,6 +24,9 @@
 #   crystal-ball   640x480, 4 spp
 #   pbr-chart      scenes/pbr-chart.txt 640x360, 16 spp: the pbr material, every
 #                  roughness and metallic (issue 14)
+#   denoise-1080p  `rtspheres denoise` of a three-balls 1920x1080 4-spp --aovs render
+#                  (the render untimed): the denoiser's speed for a frame, the EXR's
+#                  reading and writing in it
 #   panorama-20000, square-16384  three-balls at 20000x2000 (wider than the device) and
 #                  16384x16384 (depth 2), 1 spp, in tiles (issue 17: peak RSS targets)
 #   full-hd, full-hd-untiled  three-balls 1920x1080, 1 spp, with the default budget and
@@ -236,6 +239,27 @@ bench_sweep() {
         "$sweep_rows separate renders"
 }
 
+# Times `rtspheres denoise` of a 1920x1080 4-spp --aovs render of the three balls (its
+# render untimed) under the peak-RSS wrapper as NAME: a frame's denoising, reading and
+# writing its EXR included (3.7-3.9 s before the denoiser's vector loops and PIZ,
+# docs/performance.md, the log).
+bench_denoise() {
+    name=$1
+    input="$work/$name-input.exr" out="$work/$name.exr" log="$work/$name.log"
+    rm -f "$out"
+    if ! "$program" render scenes/three-balls.txt -o "$input" --size 1920x1080 --spp 4 --aovs --quiet \
+        >"$log" 2>&1 || ! "$work/peak_rss" "$program" denoise "$input" -o "$out" --quiet 2>"$log" >/dev/null; then
+        echo "$name: rtspheres FAILED (see $log:)"; tail -n 3 "$log"
+        failures=$((failures + 1))
+        return 0
+    fi
+    measured=$(grep "^peak_rss:" "$log" | tail -n 1)
+    rss=$(field "$measured" 's/^peak_rss: \([0-9]*\) KiB.*/\1/p')
+    record "$name" 1920x1080 4 1 0 "$(field "$measured" 's/.*, \([0-9.]*\) s wall.*/\1/p')" - - - - - - - \
+        "$(awk -v k="$rss" 'BEGIN { if (k == "-") print "-"; else printf "%.0f", k / 1024 }')" - \
+        "$(field "$measured" 's/.*, \([0-9.]*\) s CPU.*/\1/p')" "rtspheres denoise of a 4-spp --aovs render"
+}
+
 # Renders the three-ball animation (frames 0 .. FRAMES-1 on one GPU context) as NAME and
 # records its row: rates over all frames, first pass and BVH of the first frame.
 bench_animation() {
@@ -364,6 +388,7 @@ bench next-week scenes/next-week.txt 400x400 "$(scaled 2)" ""
 bench crystal-ball scenes/crystal-ball.txt 640x480 "$(scaled 4)" ""
 # The pbr material (issue 14): a chart of roughness by metallic under a sphere light.
 bench pbr-chart scenes/pbr-chart.txt 640x360 "$(scaled 16)" ""
+bench_denoise denoise-1080p
 # Any image size in bounded memory (issue 17): a panorama wider than the device's 16384
 # pixels, a 16384-pixel square at depth 2 (both in tiles, the default --memory-budget),
 # and a plain 1920x1080 as it renders by default and with a budget that never tiles it:
