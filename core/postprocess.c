@@ -159,7 +159,8 @@ rt_status postprocess_gaussian_blur(rt_image *image, float sigma_pixels, int pas
  * not depend on the CPU, the threads or where a block of a tiled render starts. 2026-12-03:
  * a 1920x1080 image's five iterations took 3.4 CPU-s as scalar code (docs/performance.md,
  * the log). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(RT_NO_TARGET_CLONES)
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) \
+    && !defined(RT_NO_TARGET_CLONES)
 #define VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define VECTOR_CLONES

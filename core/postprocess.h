@@ -86,13 +86,14 @@
  *      SIGGRAPH Asia 2012, choose among filters by SURE this way.) The input itself is not
  *      offered: on four scenes' renders it was never chosen.
  * Each stage (the noise estimate, each iteration's variance blur and filter, the choice's
- * risks and averages, the bias check) runs in bands of rows on as many threads as the machine has cores (pthreads; at
- * most 64, each with at least 16 rows), the noise estimate's, the filter's and the
- * choice's taps in vector loops over runs of 256 pixels (AVX-512, AVX2 or SSE2, picked for the CPU when the
- * program starts; core/postprocess.c); every pixel is computed alone and alike in every
- * lane and every clone, so the image depends on none of this. Sums are in float and the
- * weights' exponential is the filter's own (a few ulps from libm's): the image is
- * tests/unit/test_postprocess.c's plain double reference to within 2e-5.
+ * risks and averages, the bias check) runs in bands of rows on as many threads as the
+ * machine has cores (pthreads; at most 64, each with at least 16 rows), the noise
+ * estimate's, the filter's and the choice's taps in vector loops over runs of 256 pixels
+ * (AVX-512, AVX2 or SSE2, picked for the CPU when the program starts; core/postprocess.c);
+ * every pixel is computed alone and alike in every lane and every clone, so the image
+ * depends on none of this. Sums are in float and the weights' exponential is the filter's
+ * own (a few ulps from libm's): the image is tests/unit/test_postprocess.c's plain double
+ * reference to within 2e-5.
  * Depth is a distance; a pixel whose depth is 0, negative, infinite or NaN hit nothing
  * (sky): such pixels form their own class and never mix with pixels that hit something.
  * Between two sky pixels only the colour weight counts.

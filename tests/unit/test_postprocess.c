@@ -660,7 +660,8 @@ static void test_blocks_with_the_reach_are_exact(void **state)
     enum { WIDTH = 300, HEIGHT = 260 };
     rt_image inputs[6];
     make_denoiser_inputs(WIDTH, HEIGHT, inputs);
-    rt_image denoised = region_of(&inputs[0], 0, 0, WIDTH, HEIGHT), blurred = region_of(&inputs[0], 0, 0, WIDTH, HEIGHT);
+    rt_image denoised = region_of(&inputs[0], 0, 0, WIDTH, HEIGHT);
+    rt_image blurred = region_of(&inputs[0], 0, 0, WIDTH, HEIGHT);
     postprocess_denoise_guides guides = {.albedo = &inputs[1], .normal = &inputs[2], .depth = &inputs[3],
                                          .emission = &inputs[4], .variance = &inputs[5]};
     assert_int_equal(postprocess_denoise(&denoised, &guides, NULL, NULL), RT_OK);
@@ -887,7 +888,8 @@ static void reference_denoise(rt_image *colour, const postprocess_denoise_guides
     for (int i = 0; i < n; i++)   /* remodulated or chosen; next: the residual, input less denoised */
         for (int c = 0; c < 3; c++) {
             double direct = g->emission != NULL ? g->emission->pixels[i * g->emission->channels + c] : 0.0;
-            signal[3 * i + c] = best_risk[i] < INFINITY ? best[3 * i + c] : signal[3 * i + c] * divisor[3 * i + c] + direct;
+            signal[3 * i + c] = best_risk[i] < INFINITY ? best[3 * i + c]
+                                                        : signal[3 * i + c] * divisor[3 * i + c] + direct;
             next[3 * i + c] = colour->pixels[i * colour->channels + c] - signal[3 * i + c];
         }
     for (int y = 0; y < height; y++)   /* the bias check over 3x3 */
@@ -910,7 +912,8 @@ static void reference_denoise(rt_image *colour, const postprocess_denoise_guides
             if (known) {
                 for (int c = 0; c < 3; c++)
                     residual[c] *= 9.0 / count;
-                double z = fabs(luminance_double(residual[0], residual[1], residual[2])) / (sqrt(v_sum) / count + 1e-20);
+                double luminance = fabs(luminance_double(residual[0], residual[1], residual[2]));
+                double z = luminance / (sqrt(v_sum) / count + 1e-20);
                 share = z <= 1.0 ? 0.0 : z >= 3.0 ? 1.0 : (z - 1.0) / 2.0;
             }
             for (int c = 0; c < 3; c++)
