@@ -208,13 +208,17 @@ static rt_status spool_io(tile_run *run, int fd, bool write, void *bytes, size_t
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0) {
+            /* The filtered colour's spool holds 3 floats a pixel, the tiles' all channels. */
             const job_image *image = run->image;
+            bool filtered = fd == run->filtered_fd;
             double bytes_needed = (double)(image->plan.window[2] - image->plan.window[0])
-                                  * (image->plan.window[3] - image->plan.window[1]) * run->channels * 4;
+                                  * (image->plan.window[3] - image->plan.window[1])
+                                  * (filtered ? 3 : run->channels) * 4;
             char needed[32];
             return rt_error_set(error, RT_ERROR_RUNTIME,
-                                "cannot %s the tile spool beside %s (%s on disk for the whole image): %s",
-                                write ? "write" : "read", image->plan.output, size_text(bytes_needed, needed),
+                                "cannot %s the %s beside %s (%s on disk for the whole image): %s",
+                                write ? "write" : "read", filtered ? "filtered colour's spool" : "tile spool",
+                                image->plan.output, size_text(bytes_needed, needed),
                                 n < 0 ? strerror(errno) : "the file is short");
         }
         at += n;
