@@ -97,11 +97,11 @@ $(BUILD)/%.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(Q)$(CXX) $(OUR_CXXFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c $< -o $@
 
-# core/postprocess.c's denoiser loops are written to be vectorised (see the file): -O3
+# core/postprocess_denoise.c's loops are written to be vectorised (see the file): -O3
 # vectorises them, once no square root can set errno and no comparison is taken to trap
 # (neither changes a value); -ffp-contract=off (C11's default, said here) keeps a multiply
 # and an add apart in every CPU's clone of them, so that the image does not depend on the CPU.
-$(BUILD)/core/postprocess.o: OUR_CFLAGS += -O3 -fno-math-errno -fno-trapping-math -ffp-contract=off
+$(BUILD)/core/postprocess_denoise.o: OUR_CFLAGS += -O3 -fno-math-errno -fno-trapping-math -ffp-contract=off
 
 # The shaders are embedded with the assembler's .incbin, so the binary runs from anywhere.
 $(BUILD)/%.o: %.S $(SHADERS)

@@ -89,7 +89,7 @@
  * risks and averages, the bias check) runs in bands of rows on as many threads as the
  * machine has cores (pthreads; at most 64, each with at least 16 rows), the noise
  * estimate's, the filter's and the choice's taps in vector loops over runs of 256 pixels
- * (AVX-512, AVX2 or SSE2, picked for the CPU when the program starts; core/postprocess.c);
+ * (AVX-512, AVX2 or SSE2, picked for the CPU when the program starts; core/postprocess_denoise.c);
  * every pixel is computed alone and alike in every lane and every clone, so the image
  * depends on none of this. Sums are in float and the weights' exponential is the filter's
  * own (a few ulps from libm's): the image is tests/unit/test_postprocess.c's plain double

@@ -446,7 +446,7 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
         status = image_create(&band, width, band_rows, layout.channels, error);
     if (status == RT_OK && filtered) {
         /* Per pixel of a block: the spooled channels, the filtered colour and about 28
-         * floats of the denoiser's arrays (core/postprocess.c: 20 planes, 7 for the choice). */
+         * floats of the denoiser's arrays (core/postprocess_denoise.c: 20 planes, 7 for the choice). */
         post.block = filter_block_side(budget, (size_t)run->channels * 4 + 12 + 112, post.halo);
         int block_width = post.block + 2 * post.halo < width ? post.block + 2 * post.halo : width;
         int block_height = post.block + 2 * post.halo < height ? post.block + 2 * post.halo : height;

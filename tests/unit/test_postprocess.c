@@ -650,7 +650,7 @@ static void make_denoiser_inputs(int width, int height, rt_image inputs[6])
 /* A block of the image denoised (or blurred) with postprocess_*_reach() more pixels on
  * every side is the whole image's pixels bit for bit: what a render in tiles relies on to
  * post-process its output block by block (core/render_job_tiles.c). The image is wider
- * than the denoiser's runs of 256 pixels (core/postprocess.c, DENOISE_RUN), and blocks
+ * than the denoiser's runs of 256 pixels (core/postprocess_denoise.c, DENOISE_RUN), and blocks
  * start at other columns than the whole image, so a pixel is computed at another place in
  * a run, in a vector lane or not. With a halo too short the pixels differ, so the
  * comparison can see a wrong reach. */
@@ -690,7 +690,7 @@ static void test_blocks_with_the_reach_are_exact(void **state)
 }
 
 /* The denoiser of postprocess.h with its default options, written out pixel by pixel in
- * doubles with libm's exp, as a reference for core/postprocess.c's vector loops (planes,
+ * doubles with libm's exp, as a reference for core/postprocess_denoise.c's vector loops (planes,
  * runs of pixels, float sums, its own exponential). g's images may be NULL. */
 typedef struct reference_pixel {
     double normal[3], albedo[3], depth, gradient[2];
