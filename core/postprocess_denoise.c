@@ -154,6 +154,14 @@ static inline float guide_match(const denoiser *d, size_t p, size_t q)
     return d->g.hit[p] == d->g.hit[q] ? 1.0f : 0.0f;
 }
 
+/* The variance guide's value at pixel p (the variance of its mean luminance), or -1 where
+ * it has none: no guide, or a negative, infinite or NaN value. */
+static float guide_variance(const rt_image *mean_variance, size_t p)
+{
+    float v = mean_variance != NULL ? mean_variance->pixels[p * mean_variance->channels] : -1.0f;
+    return v >= 0.0f && isfinite(v) ? v : -1.0f;
+}
+
 /* The one-sided difference of smaller size between centre and its two neighbours (each
  * NAN when missing or not a hit): on a surface both agree; next to a depth step the one
  * across the step is the large one and is ignored. 0 when neither neighbour counts. */
@@ -218,7 +226,7 @@ typedef struct stage {
     float *const *filtered;      /* atrous_rows: three planes */
     float *colour;               /* correct_bias_rows's output: the caller's colour image, */
     int channels;                /* channels floats a pixel */
-    float *risk;                 /* risk_rows's output; smooth_rows's input and output */
+    float *risk;                 /* risk_rows's output, smooth_rows's input */
     float *smoothed;             /* smooth_rows's horizontal pass, choose_rows's input */
     float *best_risk;            /* choose_rows: the lowest smoothed risk so far, per pixel */
     float *const *best;          /* choose_rows: that image (three planes, output space) */
@@ -428,8 +436,8 @@ static void risk_rows(const stage *s, int y0, int y1)
     for (int y = y0; y < y1; y++)
         for (int x = 0; x < d->width; x++) {
             size_t p = (size_t)y * d->width + x;
-            float v = d->mean_variance->pixels[p * d->mean_variance->channels];
-            if (!(v >= 0.0f) || !isfinite(v)) {
+            float v = guide_variance(d->mean_variance, p);
+            if (v < 0.0f) {
                 s->risk[p] = NAN;
                 continue;
             }
@@ -628,9 +636,9 @@ static void noise_from_guide(const rt_image *mean_variance, const guide_planes *
                              float albedo_epsilon, size_t count, float *variance)
 {
     for (size_t i = 0; i < count; i++) {
-        float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
+        float v = guide_variance(mean_variance, i);
         variance[i] = -1.0f;
-        if (!(v >= 0.0f) || !isfinite(v))
+        if (v < 0.0f)
             continue;
         double total = 0.0;
         for (int c = 0; c < 3; c++) {
@@ -846,8 +854,7 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
             signal[c][i] = chosen ? planes.best[c][i] : remodulated(&d, signal, i, c);
             filtered[c][i] = colour->pixels[i * channels + c] - signal[c][i];
         }
-        float v = mean_variance != NULL ? mean_variance->pixels[i * mean_variance->channels] : -1.0f;
-        blurred_variance[i] = v >= 0.0f && isfinite(v) ? v : -1.0f;
+        blurred_variance[i] = guide_variance(mean_variance, i);
     }
     run_rows(&(stage){.d = &d, .signal = signal, .filtered = filtered, .variance = blurred_variance,
                       .colour = colour->pixels, .channels = channels},
