@@ -64,13 +64,17 @@
  *      colour weight reads it blurred over 3x3.
  *   4. Bias check, where the variance guide covers a pixel's 3x3 neighbourhood: the mean
  *      over it of the residual (input colour less denoised) against that mean's standard
- *      error (the root of the summed variances over 9): at a z-score of its luminance
+ *      error (the root of the summed variances over 9, the sum taken no lower than 9 x
+ *      the mean variance over the 5x5 neighbourhood): at a z-score of its luminance
  *      under 1 nothing, over 3 all of the mean residual is added back, in between a
  *      linear share (never below 0: no render's colour is; nor below what the filter left
  *      where that already was). Noise leaves residuals that average out; a feature the
  *      guides do not show (a strip lit from close by, a reflection) leaves the same
  *      residual on every side and gets back what the filter took, where its samples say
- *      so. docs/sampling.md, "Denoising", has what it gives.
+ *      so. The 5x5 floor is for few samples, whose variance is heavy-tailed: pixels that
+ *      all missed a rare bright path have a variance near 0, and without it they got
+ *      their dark specks back (and their neighbours' bright ones). docs/sampling.md,
+ *      "Denoising", has what it gives.
  *   5. Choice among the iterations' images, where the variance guide has values (it runs
  *      before step 4, whose input is its output): for the image after each iteration k
  *      (1 .. iterations) Stein's unbiased risk estimate of each pixel's squared error in
@@ -210,8 +214,8 @@ rt_status postprocess_denoise(rt_image *colour, const postprocess_denoise_guides
  * their reaches. The blur's: passes x ceil(3 sigma) (0 when it changes nothing); the
  * denoiser's, with options (NULL: defaults): 2 (2^iterations - 1) for the iterations'
  * taps (the 3x3 variance blur stays within them), + 3 for the 7x7 noise estimate, + 1
- * for the depth gradient, + 9 for the choice's average, + 1 for the bias check's 3x3:
- * 76 with the defaults. */
+ * for the depth gradient, + 9 for the choice's average, + 1 for the bias check's 3x3
+ * (its 5x5 pool reads only the variance guide, well within): 76 with the defaults. */
 int postprocess_blur_reach(float sigma_pixels, int passes);
 int postprocess_denoise_reach(const postprocess_denoise_options *options);
 

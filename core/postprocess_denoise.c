@@ -28,6 +28,8 @@
  * pixels whose mean residual is weighed, and the z-scores of that mean from which some
  * of it is added back and from which all of it is. */
 #define BIAS_RADIUS 1
+/* The wider window whose mean variance the check's standard error is never below. */
+#define BIAS_POOL_RADIUS 2
 #define BIAS_Z_FROM 1.0
 #define BIAS_Z_ALL 3.0
 /* The choice among the iterations' images (postprocess.h, step 5): each one's risk is
@@ -559,6 +561,23 @@ static void correct_bias_rows(const stage *s, int y0, int y1)
                 continue;
             for (int c = 0; c < 3; c++)
                 residual[c] /= n;
+            /* Not below the 5x5 mean variance, so that pixels whose few samples all missed
+             * a rare bright path (variance near 0: heavy-tailed noise) do not pass for
+             * certain and get their dark or bright speck back (docs/sampling.md). */
+            double pooled_sum = 0.0;
+            int pooled = 0;
+            for (int dy = -BIAS_POOL_RADIUS; dy <= BIAS_POOL_RADIUS; dy++)
+                for (int dx = -BIAS_POOL_RADIUS; dx <= BIAS_POOL_RADIUS; dx++) {
+                    int qx = x + dx, qy = y + dy;
+                    if (qx < 0 || qx >= d->width || qy < 0 || qy >= d->height)
+                        continue;
+                    float v = s->variance[(size_t)qy * d->width + qx];
+                    if (v >= 0.0f) {
+                        pooled_sum += v;
+                        pooled++;
+                    }
+                }
+            variance_sum = fmax(variance_sum, n * pooled_sum / pooled);
             double standard_error = sqrt(variance_sum) / n;
             double z = fabs(luminance_double(residual[0], residual[1], residual[2])) / (standard_error + 1e-20);
             double share = z <= BIAS_Z_FROM ? 0.0
