@@ -127,6 +127,8 @@ int command_info(int argc, char **argv)
                info.max_pass_work_budget);
     printf("max draw buffers: %d\n", info.max_draw_buffers);
     printf("max fragment atomic counters: %d\n", info.max_fragment_atomic_counters);
+    printf("max fragment image units: %d (of images and outputs together: %d)\n", info.max_fragment_image_units,
+           info.max_images_and_outputs);
     gpu_destroy(context);
     return EXIT_OK;
 }

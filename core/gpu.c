@@ -232,6 +232,8 @@ static void read_gl_info(gpu_context *context)
     glGetIntegerv(GL_MAX_DRAW_BUFFERS, &info->max_draw_buffers);
     glGetIntegerv(GL_MAX_COLOR_ATTACHMENTS, &info->max_color_attachments);
     glGetIntegerv(GL_MAX_FRAGMENT_ATOMIC_COUNTERS, &info->max_fragment_atomic_counters);
+    glGetIntegerv(GL_MAX_FRAGMENT_IMAGE_UNIFORMS, &info->max_fragment_image_units);
+    glGetIntegerv(GL_MAX_COMBINED_IMAGE_UNITS_AND_FRAGMENT_OUTPUTS, &info->max_images_and_outputs);
     info->software = strstr(info->gl_renderer, "llvmpipe") != NULL || strstr(info->gl_renderer, "softpipe") != NULL
                      || strstr(info->gl_renderer, "swrast") != NULL;
     set_work_limits(info);

@@ -142,6 +142,10 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
  * is still a valid texture store) and a buffer texture of format over it. */
 void gpu_create_buffer_texture(GLenum format, const void *data, size_t bytes, GLuint *buffer, GLuint *texture);
 
+/* Binds a packed scene's RGBA32UI buffer texture for the next draws: on the image unit
+ * TRACER_PACKED_SCENE_IMAGE_UNIT, read-only (glsl/parameters.glsl packed_scene). */
+void gpu_bind_packed_scene(GLuint texture);
+
 /* The error for a packed scene of texel_count texels on a device whose buffer textures
  * hold fewer, or RT_OK. */
 rt_status gpu_check_packed_size(const gpu_context *context, uint32_t texel_count, rt_error *error);

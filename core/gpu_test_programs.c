@@ -114,8 +114,7 @@ static rt_status run_query_test(gpu_context *context, uintptr_t program_bit, con
     glGenVertexArrays(1, &vertex_array);
     glBindVertexArray(vertex_array);
     glUseProgram(program);
-    glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
-    glBindTexture(GL_TEXTURE_BUFFER, inputs[0]);
+    gpu_bind_packed_scene(inputs[0]);
     glActiveTexture(GL_TEXTURE0 + query_unit);
     glBindTexture(GL_TEXTURE_BUFFER, inputs[1]);
     glUniform1i(glGetUniformLocation(program, "query_width"), QUERY_TEST_WIDTH);

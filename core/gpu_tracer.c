@@ -268,6 +268,11 @@ void gpu_create_buffer_texture(GLenum format, const void *data, size_t bytes, GL
     glBindTexture(GL_TEXTURE_BUFFER, 0);
 }
 
+void gpu_bind_packed_scene(GLuint texture)
+{
+    glBindImageTexture(TRACER_PACKED_SCENE_IMAGE_UNIT, texture, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32UI);
+}
+
 rt_status gpu_check_packed_size(const gpu_context *context, uint32_t texel_count, rt_error *error)
 {
     int64_t max_texels = context->info.max_texture_buffer_size;
@@ -279,11 +284,12 @@ rt_status gpu_check_packed_size(const gpu_context *context, uint32_t texel_count
     return RT_OK;
 }
 
-/* Uploads the packed scene into a buffer object read through an RGBA32UI buffer texture
- * (usamplerBuffer), checked against GL_MAX_TEXTURE_BUFFER_SIZE. A buffer texture rather
- * than a 2D one because a fetch from it is a bounds check and a load: on llvmpipe a 2D
- * texelFetch also looks up each lane's mip level and row pitch (docs/performance.md
- * has what that cost). */
+/* Uploads the packed scene into a buffer object behind an RGBA32UI buffer texture, checked
+ * against GL_MAX_TEXTURE_BUFFER_SIZE; the programs read it as an image of that texture
+ * (gpu_bind_packed_scene). A buffer rather than a 2D texture because a read of it is a
+ * bounds check and a load: on llvmpipe a 2D texelFetch also looks up each lane's mip level
+ * and row pitch, and a texelFetch of any texture is a call (docs/performance.md has what
+ * each cost). */
 static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels, uint32_t texel_count,
                                      rt_error *error)
 {
@@ -385,9 +391,16 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
                             "GPU: the image %dx%d is larger than the device's textures and framebuffers (%d pixels "
                             "a side): render it in tiles of at most %d pixels a side",
                             tracer->width, tracer->height, max_size, max_size);
-    if (tracer->context->info.max_draw_buffers < TRACER_STATE_COUNT)
+    const gpu_info *info = &tracer->context->info;
+    if (info->max_draw_buffers < TRACER_STATE_COUNT)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
-                            TRACER_STATE_COUNT, tracer->context->info.max_draw_buffers);
+                            TRACER_STATE_COUNT, info->max_draw_buffers);
+    if (info->max_fragment_image_units < TRACER_IMAGE_UNIT_COUNT
+        || info->max_images_and_outputs < TRACER_IMAGE_UNIT_COUNT + TRACER_STATE_COUNT)
+        return rt_error_set(error, RT_ERROR_RUNTIME,
+                            "GPU: the tracer needs %d image units beside %d outputs, the device has %d (%d together)",
+                            TRACER_IMAGE_UNIT_COUNT, TRACER_STATE_COUNT, info->max_fragment_image_units,
+                            info->max_images_and_outputs);
     /* The test hook forces the two failures a real device shows only for huge images. */
     const char *forced = getenv("RTSPHERES_TEST_GPU_FAILURE");
     if (forced != NULL && strcmp(forced, "memory") == 0)
@@ -650,8 +663,7 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     }
     glActiveTexture(GL_TEXTURE0 + TRACER_PIXEL_MAP_UNIT);
     glBindTexture(GL_TEXTURE_2D, compacted ? compact->pixel_map : tracer->no_pixel_map);
-    glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
-    glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
+    gpu_bind_packed_scene(tracer->packed_texture);
     glActiveTexture(GL_TEXTURE0 + TRACER_SAMPLE_LIMITS_UNIT);
     glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
     if (tracer->light_group_texture != 0)
@@ -833,8 +845,7 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
         glUseProgram(program);
         glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
         glViewport(0, 0, width, height);
-        glActiveTexture(GL_TEXTURE0 + TRACER_PACKED_SCENE_UNIT);
-        glBindTexture(GL_TEXTURE_BUFFER, tracer->packed_texture);
+        gpu_bind_packed_scene(tracer->packed_texture);
         glBindVertexArray(tracer->vertex_array);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         float *outputs[2] = {albedo_depth, normal_coverage};

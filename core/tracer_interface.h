@@ -87,11 +87,10 @@
 #define LIGHT_TEST_QUERY_TEXELS 2
 #define LIGHT_TEST_OUTPUTS 2
 
-/* ---- bindings: texture unit of the packed scene, uniform buffer of the parameter block,
- * atomic counter buffer (unfinished pixels at offset 0, finished samples at offset 4),
- * texture unit of the per-pixel sample limits (R32UI: a pixel starts no sample at or past
- * min(its limit, samples_per_pixel); adaptive sampling, core/adaptive.h) */
-#define TRACER_PACKED_SCENE_UNIT 8   /* after the state textures' units */
+/* ---- bindings: uniform buffer of the parameter block, atomic counter buffer (unfinished
+ * pixels at offset 0, finished samples at offset 4), texture unit of the per-pixel sample
+ * limits (R32UI: a pixel starts no sample at or past min(its limit, samples_per_pixel);
+ * adaptive sampling, core/adaptive.h) */
 #define TRACER_SAMPLE_LIMITS_UNIT 9
 #define TRACER_PARAMETER_BINDING 0
 #define TRACER_COUNTER_BINDING 0
@@ -99,6 +98,10 @@
 #define TRACER_LIGHT_GROUP_IMAGE_UNIT 0
 /* image unit of the direct emission sums (glsl/direct_emission.glsl): an rgba32f 2D image */
 #define TRACER_DIRECT_EMISSION_IMAGE_UNIT 1
+/* image unit of the packed scene (core/packed_layout.h): its RGBA32UI buffer texture bound
+ * as a read-only uimageBuffer, read with imageLoad (glsl/scene_access.glsl) */
+#define TRACER_PACKED_SCENE_IMAGE_UNIT 2
+#define TRACER_IMAGE_UNIT_COUNT 3    /* the fragment image units the programs use */
 
 /* ---- compacted passes (core/gpu_compact.c; gpu.h gpu_tracer_set_pass_pixels): the pixels
  * still taking samples packed densely into compact state textures, so that no lane of a

@@ -15,8 +15,9 @@ layout(std140, binding = TRACER_PARAMETER_BINDING) uniform tracer_parameter_bloc
     TRACER_PARAMETERS(TRACER_GLSL_MEMBER)
 };
 
-// The packed scene (core/packed_layout.h): texel i is texelFetch(packed_scene, i).
-layout(binding = TRACER_PACKED_SCENE_UNIT) uniform usamplerBuffer packed_scene;
+// The packed scene (core/packed_layout.h): texel i is imageLoad(packed_scene, i), an
+// image rather than a usamplerBuffer for llvmpipe's sake (glsl/scene_access.glsl).
+layout(binding = TRACER_PACKED_SCENE_IMAGE_UNIT, rgba32ui) uniform readonly restrict uimageBuffer packed_scene;
 
 const float INFINITY = 1.0 / 0.0;
 const float PI = 3.14159265358979;
