@@ -10,9 +10,9 @@
  * bit pattern (C: memcpy; GLSL: uintBitsToFloat). No index is ever a float, so there is no
  * precision limit at 2^24 as the seed report's At() had. PACKED_NONE marks "no index".
  *
- * The array is uploaded as one buffer texture (GL_TEXTURE_BUFFER, GL_RGBA32UI; a
- * usamplerBuffer in the shader): texel i is texelFetch(packed_scene, i), and the scene's
- * size is bounded by GL_MAX_TEXTURE_BUFFER_SIZE texels.
+ * The array is uploaded as one buffer texture (GL_TEXTURE_BUFFER, GL_RGBA32UI), which the
+ * shader reads as a read-only uimageBuffer: texel i is imageLoad(packed_scene, i), and the
+ * scene's size is bounded by GL_MAX_TEXTURE_BUFFER_SIZE texels.
  *
  * Geometry is two-level, as in hardware ray tracing APIs: one node array holds the top-level
  * BVH (root: node 0) over world primitives and instances, and one bottom-level BVH per
