@@ -253,14 +253,14 @@ static void show_summary(void *user, const render_job_image *image, const render
                 "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights%s; BVH depth %d, "
                 "built in %.3f s; packed %llu bytes (%.1f per triangle without images)%s; first pass "
                 "done %.3f s after start (context, parse, BVH, upload, compile); after it %.3f s for "
-                "%llu samples (%.3g us/sample); tracer program %s\n",
+                "%llu samples (%.3g us/sample); tracer program %s; %d of its passes skipped finished pixels\n",
                 result->primitive_count, result->triangle_count, result->instance_count, result->light_count,
                 choice, result->bvh_depth, result->bvh_build_seconds, (unsigned long long)result->packed_bytes,
                 result->triangle_count ? (double)geometry_bytes / result->triangle_count : 0.0,
                 result->reused_scene ? ", already on the device" : "", shown->first_pass, result->steady_seconds,
                 (unsigned long long)result->steady_samples,
                 result->steady_samples ? result->steady_seconds / (double)result->steady_samples * 1e6 : 0.0,
-                result->compiled_program ? "compiled" : "from the context's cache");
+                result->compiled_program ? "compiled" : "from the context's cache", result->culled_passes);
         show_reuse(image, result);
     }
     if (!shown->arguments->quiet)

@@ -277,6 +277,7 @@ rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limit
      * Before any limits: none, or samples_per_pixel once passes have run. */
     uint32_t most = tracer->parameters.shader.samples_per_pixel;
     bool first = c->limits == NULL;
+    gpu_uncull(tracer);   /* a finished pixel may have samples to take again */
     if (first) {
         c->limits = malloc(pixels * sizeof *c->limits);
         c->started = malloc(pixels * sizeof *c->started);
@@ -304,6 +305,7 @@ rt_status gpu_tracer_set_pass_pixels(gpu_tracer *tracer, const uint32_t *pixels,
     gpu_compact *c = &tracer->compact;
     if (count <= 0 || pixels == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: a compacted pass needs at least one pixel");
+    gpu_uncull(tracer);   /* the slots are the state textures' texels: no pixel's depth applies */
     rt_status status = c->sums[0] == NULL ? start_host_sums(tracer, error)
                        : c->count > 0    ? commit_round(tracer, error)
                                          : RT_OK;

@@ -26,6 +26,7 @@ struct gpu_context {
         GLuint program;
     } tracer_programs[GPU_PROGRAM_CACHE_SIZE];
     int tracer_program_count;
+    GLuint cull_program;                  /* glsl/cull.frag, built when first used (0 before) */
     int next_eviction;                    /* the slot a full cache replaces next */
     GLuint packed_texture;                /* a buffer texture over packed_buffer */
     GLuint packed_buffer;
@@ -86,6 +87,9 @@ struct gpu_tracer {
                                   * program has no light group code */
     GLuint direct_emission_texture;  /* the direct emission sums (a 2D array of one rgba32f
                                       * layer), or 0 when the program has no such code */
+    GLuint depth_buffer;         /* both full state sets' depth: 0 where full passes skip the
+                                  * pixel (gpu_tracer_cull_finished), else 1 */
+    bool culling;                /* some pixel is marked: full passes test the depth */
     int current;                 /* which state set holds the latest pass */
     uint64_t passes;             /* passes run */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */
@@ -94,6 +98,10 @@ struct gpu_tracer {
     bool compiled_program;       /* its program was compiled for it (not in the cache) */
     gpu_tracer_timings timings;
 };
+
+/* Unmarks every pixel gpu_tracer_cull_finished marked (the depth back to 1): what was
+ * finished may go on once the sample limits or the pixels traced change. */
+void gpu_uncull(gpu_tracer *tracer);
 
 /* Reads the sums of state TRACER_STATE_ACCUMULATED, _STATISTICS or _SQUARES of every
  * pixel into out (4 floats a pixel, rows top to bottom) when passes have been compacted:

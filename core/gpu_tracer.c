@@ -428,6 +428,21 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
                 glClearBufferfv(GL_COLOR, target, zero);
         }
     }
+    /* One depth buffer for both sets, all 1: no pixel skipped (gpu_tracer_cull_finished). */
+    glGenRenderbuffers(1, &tracer->depth_buffer);
+    glBindRenderbuffer(GL_RENDERBUFFER, tracer->depth_buffer);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, tracer->width, tracer->height);
+    for (int set = 0; set < 2; set++) {
+        glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[set]);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, tracer->depth_buffer);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            while (glGetError() != GL_NO_ERROR) {
+            }
+            return state_out_of_memory(tracer, "the driver left the state framebuffer's depth incomplete", error);
+        }
+    }
+    const GLfloat far_depth = 1.0f;
+    glClearBufferfv(GL_DEPTH, 0, &far_depth);
     /* No limit but samples_per_pixel until gpu_tracer_set_sample_limits says otherwise. */
     glGenTextures(1, &tracer->sample_limits);
     glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
@@ -675,7 +690,18 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     glBindVertexArray(tracer->vertex_array);
     if (compacted)
         gpu_compact_scissor(tracer, true);
+    /* Marked pixels (gpu_tracer_cull_finished) fail the depth test before the shader runs. */
+    bool cull = tracer->culling && !compacted;
+    if (cull) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_FALSE);
+    }
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (cull) {
+        glDepthMask(GL_TRUE);
+        glDisable(GL_DEPTH_TEST);
+    }
     if (compacted)
         gpu_compact_scissor(tracer, false);
     /* Image stores of this pass are read by the next pass and by the read-back. */
@@ -696,6 +722,49 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     if (next_round)
         report->unfinished_pixels = (uint32_t)compact->count;
     return status;
+}
+
+rt_status gpu_tracer_cull_finished(gpu_tracer *tracer, rt_error *error)
+{
+    gpu_context *context = tracer->context;
+    if (tracer->compact.count > 0)
+        return RT_OK;
+    if (context->cull_program == 0) {
+        context->cull_program = build_fragment_program(SHADER_PROGRAM_CULL, "", error);
+        if (context->cull_program == 0)
+            return RT_ERROR_RUNTIME;
+    }
+    int latest = tracer->current;
+    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[latest]);
+    glViewport(0, 0, tracer->width, tracer->height);
+    glUseProgram(context->cull_program);
+    glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[latest][TRACER_STATE_COUNTERS]);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[1 - latest][TRACER_STATE_COUNTERS]);
+    glActiveTexture(GL_TEXTURE0 + TRACER_SAMPLE_LIMITS_UNIT);
+    glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDepthMask(GL_TRUE);
+    glBindVertexArray(tracer->vertex_array);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisable(GL_DEPTH_TEST);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    tracer->culling = true;
+    return gpu_check_gl("marking finished pixels", error);
+}
+
+void gpu_uncull(gpu_tracer *tracer)
+{
+    if (!tracer->culling)
+        return;
+    const GLfloat far_depth = 1.0f;
+    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[0]);
+    glClearBufferfv(GL_DEPTH, 0, &far_depth);
+    tracer->culling = false;
 }
 
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
@@ -912,12 +981,16 @@ void gpu_tracer_destroy(gpu_tracer *tracer)
     glDeleteVertexArrays(1, &tracer->vertex_array);
     glDeleteTextures(1, &tracer->sample_limits);
     glDeleteTextures(1, &tracer->no_pixel_map);
+    glDeleteRenderbuffers(1, &tracer->depth_buffer);
     gpu_compact_destroy(tracer);
     free(tracer);
 }
 
 void gpu_tracer_release(gpu_context *context)
 {
+    if (context->cull_program)
+        glDeleteProgram(context->cull_program);
+    context->cull_program = 0;
     for (int i = 0; i < context->tracer_program_count; i++)
         if (context->tracer_programs[i].program)
             glDeleteProgram(context->tracer_programs[i].program);

@@ -188,6 +188,7 @@ typedef struct render_result {
     double upload_seconds;       /* the packed scene to the device (0: already there) */
     double path_segments;        /* rays traced, counted by the shader */
     int passes;
+    int culled_passes;           /* passes that skipped finished pixels (gpu.h gpu_tracer_cull_finished) */
     render_stop_reason stop_reason;
     int bvh_depth;
     double bvh_build_seconds;

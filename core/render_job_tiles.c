@@ -301,6 +301,7 @@ static void add_tile(tile_run *run, const render_result *result, int tile)
         total->steady_seconds += result->steady_seconds;
         total->steady_samples += result->steady_samples;
         total->passes += result->passes;
+        total->culled_passes += result->culled_passes;
         total->samples_min = result->samples_min < total->samples_min ? result->samples_min : total->samples_min;
         total->samples_max = result->samples_max > total->samples_max ? result->samples_max : total->samples_max;
     }

@@ -13,6 +13,7 @@
  * the log: longer passes), and nothing kills a long draw there. */
 #define DEFAULT_TARGET_PASS_SECONDS 0.25
 #define SOFTWARE_TARGET_PASS_SECONDS 1.0
+#define CULL_MIN_PIXELS (512 * 512)
 
 /* Moves the adaptive pass budget *budget towards a pass of target_seconds after a pass of
  * pass_seconds, within [MINIMUM_ADAPTIVE_BUDGET, most_budget], and gives it to the tracer. */
@@ -155,6 +156,20 @@ rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const rend
     rt_status status = start_adaptive(tracer, options, samples_per_pixel, traced[2] - traced[0],
                                       traced[3] - traced[1], &adaptive, error);
     *stop = RENDER_STOP_SAMPLES;
+    /* Finished pixels are marked for full passes to skip (gpu.h gpu_tracer_cull_finished)
+     * once at most half the pixels go on, and again each time those fall to a quarter: at
+     * the end of a render a few slow pixels (long paths through glass) take several passes
+     * that would otherwise read and write the whole image's state. Adaptive renders end in
+     * compacted passes instead. Only for images of CULL_MIN_PIXELS or more: the marking
+     * program costs a compile (0.25 s on llvmpipe when Mesa's cache lacks it) and a pass of
+     * a smaller image costs little anyway. RTSPHERES_TEST_CULL=always|never overrides that,
+     * for tests. */
+    uint64_t traced_pixels = (uint64_t)(traced[2] - traced[0]) * (uint64_t)(traced[3] - traced[1]);
+    const char *test_cull = getenv("RTSPHERES_TEST_CULL");
+    bool may_cull = adaptive.sampler == NULL
+                    && (test_cull != NULL ? strcmp(test_cull, "always") == 0 : traced_pixels >= CULL_MIN_PIXELS);
+    uint64_t cull_at_most = traced_pixels / 2;
+    bool marked = false;
     for (bool done = false; status == RT_OK && !done;) {
         if (!pass_fits_deadline(tracer, options, last_pass_seconds, adaptive_budget, &budget)) {
             *stop = RENDER_STOP_TIME;
@@ -180,6 +195,15 @@ rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const rend
         }
         if (options->progress != NULL)
             options->progress(options->progress_context, progress);
+        if (marked)
+            result->culled_passes++;
+        if (may_cull && report.unfinished_pixels > 0 && report.unfinished_pixels <= cull_at_most) {
+            status = gpu_tracer_cull_finished(tracer, error);
+            marked = true;
+            cull_at_most = report.unfinished_pixels / 4;
+            if (status != RT_OK)
+                break;
+        }
         if (status == RT_OK && report.unfinished_pixels == 0) {
             done = true;
             if (adaptive.sampler != NULL) {

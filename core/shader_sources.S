@@ -28,11 +28,13 @@
     .balign 16
     .global shader_modules
 shader_modules:
-    module "core/tracer_interface.h", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST /* ids, parameters */
-    module "core/packed_layout.h", SHADER_PROGRAM_SHADING           /* the packed scene's records */
+    /* ids, parameters */
+    module "core/tracer_interface.h", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST|SHADER_PROGRAM_CULL
+    module "core/packed_layout.h", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_CULL /* the packed scene's records */
     module "glsl/random.glsl", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_RANDOM_TEST
     module "glsl/random_test.frag", SHADER_PROGRAM_RANDOM_TEST
-    module "glsl/parameters.glsl", SHADER_PROGRAM_SHADING
+    module "glsl/parameters.glsl", SHADER_PROGRAM_SHADING|SHADER_PROGRAM_CULL
+    module "glsl/cull.frag", SHADER_PROGRAM_CULL
     module "glsl/variant.glsl", SHADER_PROGRAM_SHADING
     module "glsl/work.glsl", SHADER_PROGRAM_SHADING
     module "glsl/sampling.glsl", SHADER_PROGRAM_SHADING

@@ -16,6 +16,7 @@
 #define SHADER_PROGRAM_RANDOM_TEST 4    /* the random-number test (glsl/random_test.frag) */
 #define SHADER_PROGRAM_MATERIAL_TEST 8  /* the material test (glsl/material_test.frag) */
 #define SHADER_PROGRAM_LIGHT_TEST 16    /* the light choice test (glsl/light_test.frag) */
+#define SHADER_PROGRAM_CULL 32          /* the finished pixels' depth mark (glsl/cull.frag) */
 #define SHADER_PROGRAM_TRACER (SHADER_PROGRAM_PASS|SHADER_PROGRAM_AOV)   /* no spaces: an assembler macro argument */
 /* The modules up to the materials: the tracer's, and the material and light tests'. */
 #define SHADER_PROGRAM_SHADING (SHADER_PROGRAM_PASS|SHADER_PROGRAM_AOV|SHADER_PROGRAM_MATERIAL_TEST|SHADER_PROGRAM_LIGHT_TEST)

@@ -56,6 +56,10 @@ void write_state(PixelState s, uint round)
     out_squares = s.squares;
 }
 
+// Early fragment tests: a pixel that gpu_tracer_cull_finished marked (core/gpu.h) fails
+// the depth test of full passes before any of this runs, image stores and counters included.
+layout(early_fragment_tests) in;
+
 void main()
 {
     // The state lives where this invocation draws: the pixel itself, or its compact slot.

@@ -97,4 +97,40 @@ same_at_budgets "many lights (light tree)" scenes/many-lights.txt --size 12x8 --
 # (see the scene): the render must not reach the work cap, and gives the image of the
 # smallest budget.
 same_at_budgets "lights behind volumes (whitted)" tests/render/scenes/lights-behind-volumes.txt --integrator whitted
+
+# Passes that skip finished pixels (core/gpu.h gpu_tracer_cull_finished; on their own only
+# for images of 512x512 pixels or more, RTSPHERES_TEST_CULL forces them on or off): the
+# last passes of a render with many small passes, where a few pixels behind glass take
+# the longest, must leave every channel as passes over the whole image do: the beauty,
+# light group layers, AOVs, samples and variance.
+same_with_culling() {
+    name=$1 scene=$2
+    shift 2
+    stem=$(printf '%s' "$name" | tr -c 'a-z0-9' '-')
+    for mode in always never; do
+        if ! RTSPHERES_TEST_CULL=$mode "$program" render "$scene" -o "$scratch/$stem-$mode.exr" --pass-budget 300 \
+            --verbose "$@" 2>"$scratch/$stem-$mode.log"; then
+            fail "$name, culling $mode" "render failed: $(tr '\n' ' ' <"$scratch/$stem-$mode.log")"
+            return
+        fi
+        "$program" stats "$scratch/$stem-$mode.exr" | grep -v render_seconds >"$scratch/$stem-$mode.stats"
+    done
+    culled=$(sed -n 's/.*; \([0-9]*\) of its passes skipped finished pixels.*/\1/p' "$scratch/$stem-always.log")
+    never=$(sed -n 's/.*; \([0-9]*\) of its passes skipped finished pixels.*/\1/p' "$scratch/$stem-never.log")
+    if [ "${culled:-0}" -gt 0 ] && [ "$never" = 0 ]; then
+        pass "$name: $culled passes skipped finished pixels (none when told not to)"
+    else
+        fail "$name" "passes that skipped finished pixels: '$culled' forced on, '$never' forced off"
+    fi
+    if "$program" diff "$scratch/$stem-always.exr" "$scratch/$stem-never.exr" --fail 0 --failpercent 0 \
+        >"$scratch/$stem.diff" 2>&1 && cmp -s "$scratch/$stem-always.stats" "$scratch/$stem-never.stats"; then
+        pass "$name: the same image and channels with and without skipping"
+    else
+        fail "$name" "$(tr '\n' ' ' <"$scratch/$stem.diff") $(diff "$scratch/$stem-always.stats" \
+            "$scratch/$stem-never.stats" | head -n 4 | tr '\n' ' ')"
+    fi
+}
+same_with_culling "three balls, skipping finished pixels" scenes/three-balls.txt --size 64x36 --spp 32 --aovs --variance
+same_with_culling "lights, light groups, skipping finished pixels" scenes/lights.txt --size 64x36 --spp 32 \
+    --light-groups
 finish
