@@ -80,7 +80,7 @@ typedef struct gpu_info {
     int max_draw_buffers;
     int max_color_attachments;
     int max_fragment_atomic_counters;
-    int max_fragment_image_units;   /* GL_MAX_FRAGMENT_IMAGE_UNIFORMS: the tracer uses TRACER_IMAGE_UNIT_COUNT */
+    int max_fragment_image_units;   /* GL_MAX_FRAGMENT_IMAGE_UNIFORMS: the tracer uses 1 to 3 */
     int max_images_and_outputs;  /* GL_MAX_COMBINED_IMAGE_UNITS_AND_FRAGMENT_OUTPUTS */
     bool software;               /* a CPU rasteriser (llvmpipe, softpipe) */
     int software_threads;        /* llvmpipe rasteriser threads running for this context

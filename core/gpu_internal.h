@@ -90,6 +90,8 @@ struct gpu_tracer {
     GLuint depth_buffer;         /* both full state sets' depth: 0 where full passes skip the
                                   * pixel (gpu_tracer_cull_finished), else 1 */
     bool culling;                /* some pixel is marked: full passes test the depth */
+    int image_units;             /* the program's image units: the packed scene's, and the light
+                                  * group layers' and direct emission's when it has them */
     int current;                 /* which state set holds the latest pass */
     uint64_t passes;             /* passes run */
     gpu_tracer_parameters parameters;   /* as created, for the AOV pass */

@@ -395,11 +395,11 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
     if (info->max_draw_buffers < TRACER_STATE_COUNT)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
                             TRACER_STATE_COUNT, info->max_draw_buffers);
-    if (info->max_fragment_image_units < TRACER_IMAGE_UNIT_COUNT
-        || info->max_images_and_outputs < TRACER_IMAGE_UNIT_COUNT + TRACER_STATE_COUNT)
+    if (info->max_fragment_image_units < tracer->image_units
+        || info->max_images_and_outputs < tracer->image_units + TRACER_STATE_COUNT)
         return rt_error_set(error, RT_ERROR_RUNTIME,
                             "GPU: the tracer needs %d image units beside %d outputs, the device has %d (%d together)",
-                            TRACER_IMAGE_UNIT_COUNT, TRACER_STATE_COUNT, info->max_fragment_image_units,
+                            tracer->image_units, TRACER_STATE_COUNT, info->max_fragment_image_units,
                             info->max_images_and_outputs);
     /* The test hook forces the two failures a real device shows only for huge images. */
     const char *forced = getenv("RTSPHERES_TEST_GPU_FAILURE");
@@ -582,6 +582,8 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->context = context;
     tracer->width = parameters->shader.image_size[0];
     tracer->height = parameters->shader.image_size[1];
+    tracer->image_units = 1 + !(parameters->omitted_features & GPU_OMIT_LIGHT_GROUPS)
+                          + !(parameters->omitted_features & GPU_OMIT_DIRECT_EMISSION);
     double step_start = clock_seconds();
     rt_status status = build_program(tracer, parameters, error);
     tracer->timings.compile_seconds = tracer->compiled_program ? clock_seconds() - step_start : 0;

@@ -101,7 +101,6 @@
 /* image unit of the packed scene (core/packed_layout.h): its RGBA32UI buffer texture bound
  * as a read-only uimageBuffer, read with imageLoad (glsl/scene_access.glsl) */
 #define TRACER_PACKED_SCENE_IMAGE_UNIT 2
-#define TRACER_IMAGE_UNIT_COUNT 3    /* the fragment image units the programs use */
 
 /* ---- compacted passes (core/gpu_compact.c; gpu.h gpu_tracer_set_pass_pixels): the pixels
  * still taking samples packed densely into compact state textures, so that no lane of a
