@@ -1,6 +1,7 @@
 /* gpu_internal.h: what core/gpu.c (the EGL context), core/gpu_tracer.c (the tracer on it),
- * core/gpu_compact.c (its compacted passes) and core/gpu_test_programs.c (the programs
- * only tests use) share; no other file includes it. */
+ * core/gpu_compact.c (its compacted passes), core/gpu_cull.c (full passes that skip
+ * finished pixels) and core/gpu_test_programs.c (the programs only tests use) share; no
+ * other file includes it. */
 #ifndef RT_GPU_INTERNAL_H
 #define RT_GPU_INTERNAL_H
 

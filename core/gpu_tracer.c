@@ -726,49 +726,6 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     return status;
 }
 
-rt_status gpu_tracer_cull_finished(gpu_tracer *tracer, rt_error *error)
-{
-    gpu_context *context = tracer->context;
-    if (tracer->compact.count > 0)
-        return RT_OK;
-    if (context->cull_program == 0) {
-        context->cull_program = build_fragment_program(SHADER_PROGRAM_CULL, "", error);
-        if (context->cull_program == 0)
-            return RT_ERROR_RUNTIME;
-    }
-    int latest = tracer->current;
-    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[latest]);
-    glViewport(0, 0, tracer->width, tracer->height);
-    glUseProgram(context->cull_program);
-    glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[latest][TRACER_STATE_COUNTERS]);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, tracer->state_textures[1 - latest][TRACER_STATE_COUNTERS]);
-    glActiveTexture(GL_TEXTURE0 + TRACER_SAMPLE_LIMITS_UNIT);
-    glBindTexture(GL_TEXTURE_2D, tracer->sample_limits);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_ALWAYS);
-    glDepthMask(GL_TRUE);
-    glBindVertexArray(tracer->vertex_array);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glDisable(GL_DEPTH_TEST);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    tracer->culling = true;
-    return gpu_check_gl("marking finished pixels", error);
-}
-
-void gpu_uncull(gpu_tracer *tracer)
-{
-    if (!tracer->culling)
-        return;
-    const GLfloat far_depth = 1.0f;
-    glBindFramebuffer(GL_FRAMEBUFFER, tracer->framebuffers[0]);
-    glClearBufferfv(GL_DEPTH, 0, &far_depth);
-    tracer->culling = false;
-}
-
 void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
 {
     tracer->parameters.shader.pass_work_budget = (int32_t)clamp_budget(&tracer->context->info, budget);
