@@ -104,7 +104,7 @@ void integrate(inout PixelState s)
             crossing = shadow_at_boundary(shadow.ray, blocked, shadow_hit);
             if (!crossing) {
                 vec3 light = shadow_arrived(shadow.transit, shadow.ray, blocked, shadow_hit) * shadow.contribution;
-                add_to_light_group(shadow.light_group, light);
+                set_shadow_light(shadow.light_group, light);
                 shadow.pending = false;
                 if (finishing) {
                     finish_sample(s, finishing_radiance + light);
@@ -132,7 +132,7 @@ void integrate(inout PixelState s)
             } else if (path_hit.t == INFINITY) {
                 vec3 sky = s.throughput * sky_radiance(s.direction) * integrator_sky_weight(s);
                 s.radiance += sky;
-                add_to_light_group(sky_light_group, sky);
+                set_segment_light(sky_light_group, sky);
                 add_direct_emission(segment_bounce, sky);
                 path_done = true;
             } else {
@@ -194,6 +194,8 @@ void integrate(inout PixelState s)
             finish_sample(s, finishing_radiance);
             finishing = false;
         }
+        flush_light_groups();
+        flush_direct_emission();
         if (overflow)
             break;
     }

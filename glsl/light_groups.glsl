@@ -21,13 +21,56 @@ layout(binding = TRACER_LIGHT_GROUP_IMAGE_UNIT, rgba32f) uniform image2DArray li
 bool collects_light_groups() { return HAS_LIGHT_GROUPS && light_group_count > 0u; }
 
 // Adds value (radiance the path gathered, throughput included) to group's layer at this
-// pixel.
+// pixel at once. For contributions gathered outside the segment loop's top level (Whitted's
+// shadow rays walked in place, its ambient term); the segment loop's own go through the
+// two slots below.
 void add_to_light_group(uint group, vec3 value)
 {
     if (!collects_light_groups())
         return;
     ivec3 at = ivec3(frame_pixel, int(min(group, light_group_count - 1u)));
     imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(value, 0.0));
+}
+
+// The segment loop's contributions of one iteration (glsl/integrators.glsl): the light its
+// shadow ray brought, and what its path segment found (the sky, or an emitter; never
+// both). They are set where they arise and added to their layers by flush_light_groups,
+// once per iteration at the loop's top level, whether or not a lane has anything to add.
+// An image store inside a condition is, on llvmpipe, a branch per lane on the lane's
+// mask, which goes either way at random when the condition does; at the top level every
+// lane still in the loop stores, and three such sites in conditions became two that
+// always store (docs/performance.md, the log: lights.txt --light-groups about 4% faster).
+uint shadow_light_group = 0u;
+vec3 shadow_light = vec3(0.0);
+uint segment_light_group = 0u;
+vec3 segment_light = vec3(0.0);
+
+// The light this iteration's shadow ray brought, for group.
+void set_shadow_light(uint group, vec3 value)
+{
+    shadow_light_group = group;
+    shadow_light = value;
+}
+
+// The light this iteration's path segment found (sky or emitter), for group.
+void set_segment_light(uint group, vec3 value)
+{
+    segment_light_group = group;
+    segment_light = value;
+}
+
+// Adds this iteration's two contributions to their layers (zero when there was none) and
+// clears them: the shadow ray's first, as the segment loop gathered them before.
+void flush_light_groups()
+{
+    if (!collects_light_groups())
+        return;
+    ivec3 at = ivec3(frame_pixel, int(min(shadow_light_group, light_group_count - 1u)));
+    imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(shadow_light, 0.0));
+    at = ivec3(frame_pixel, int(min(segment_light_group, light_group_count - 1u)));
+    imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(segment_light, 0.0));
+    shadow_light = vec3(0.0);
+    segment_light = vec3(0.0);
 }
 
 // The light group of light (texel 4 of its record, core/packed_layout.h).

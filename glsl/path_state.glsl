@@ -130,6 +130,6 @@ vec3 hit_emitter(inout PixelState s, Hit hit, Surface surface, Material material
     float weight = emitter_mis_weight(hit, s.previous_pdf, s.choice_memo, vertex, surface.position, surface.geometric);
     vec3 emitted = s.throughput * material_emitted(material, surface.position, surface.uv) * weight;
     s.radiance += emitted;
-    add_to_light_group(emitter_light_group(material), emitted);
+    set_segment_light(emitter_light_group(material), emitted);
     return emitted;
 }
