@@ -3,6 +3,7 @@
  * the light choice test (glsl/light_test.frag) and the parameter block's layout as the GLSL
  * compiler lays it out. They share the tracer's program assembly and helpers through
  * gpu_internal.h. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -253,6 +254,11 @@ rt_status gpu_light_choice_test(gpu_context *context, const uint32_t *packed_tex
     return status;
 }
 
+/* "block_": what TRACER_BLOCK_MEMBER (core/tracer_interface.h) puts before a parameter's name. */
+#define EXPANDED_STRING(x) STRING(x)
+#define STRING(x) #x
+#define BLOCK_MEMBER_PREFIX EXPANDED_STRING(TRACER_BLOCK_MEMBER())
+
 rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const char *const *names, int *offsets,
                                       int *block_size, rt_error *error)
 {
@@ -263,8 +269,11 @@ rt_status gpu_tracer_parameter_layout(gpu_context *context, int count, const cha
     if (program == 0)
         return RT_ERROR_RUNTIME;
     for (int i = 0; i < count; i++) {
+        char member[128];
+        snprintf(member, sizeof member, "%s%s", BLOCK_MEMBER_PREFIX, names[i]);
+        const char *member_name = member;
         GLuint index = GL_INVALID_INDEX;
-        glGetUniformIndices(program, 1, &names[i], &index);
+        glGetUniformIndices(program, 1, &member_name, &index);
         offsets[i] = -1;
         if (index != GL_INVALID_INDEX)
             glGetActiveUniformsiv(program, 1, &index, GL_UNIFORM_OFFSET, &offsets[i]);

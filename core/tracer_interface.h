@@ -5,7 +5,8 @@
  * Like packed_layout.h, this file is included by C (core/gpu.h, core/render.h,
  * core/scene.h) and prepended, byte for byte, to the tracer's GLSL (the module table in
  * core/shader_sources.S). It must stay valid in both languages: only comments, include
- * guards and #define of plain numbers and of the parameter list below.
+ * guards and #define of plain numbers, of the parameter list below and of the name its
+ * members have in the GLSL block (TRACER_BLOCK_MEMBER).
  *
  * The parameter list is expanded twice: into the C struct tracer_parameter_block
  * (core/gpu.h) and into the GLSL uniform block of the same name (glsl/parameters.glsl),
@@ -118,6 +119,11 @@
 #define TRACER_PIXEL_MAP_UNIT 10
 #define TRACER_PIXEL_MAP_SHIFT 16
 #define TRACER_NO_PIXEL 4294967295u
+
+/* The GLSL uniform block's member of parameter NAME is TRACER_BLOCK_MEMBER(NAME); the
+ * tracer reads a copy of it called NAME (glsl/parameters.glsl says why), and C asks the GL
+ * for the member by this name (core/gpu_test_programs.c). */
+#define TRACER_BLOCK_MEMBER(name) block_##name
 
 /* ---- the parameter block. Vectors are world space; pixels count from the top left. */
 #define TRACER_PARAMETERS(P) \

@@ -8,6 +8,7 @@ layout(location = TRACER_AOV_NORMAL) out vec4 out_normal;  // xyz: world shading
 
 void main()
 {
+    read_parameters();
     read_header();
     light_count = 0u;
     frame_pixel = ivec2(gl_FragCoord.xy);

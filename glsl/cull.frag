@@ -11,6 +11,7 @@ layout(binding = TRACER_SAMPLE_LIMITS_UNIT) uniform usampler2D cull_sample_limit
 
 void main()
 {
+    read_parameters();
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     uint limit = min(samples_per_pixel, texelFetch(cull_sample_limits, pixel, 0).x);
     uvec4 latest = texelFetch(counters_latest, pixel, 0), before = texelFetch(counters_before, pixel, 0);

@@ -16,6 +16,7 @@ layout(location = 1) out vec4 out_again;    // light_choice_probability of the l
 
 void main()
 {
+    read_parameters();
     read_header();
     work = 0;
     int query = int(gl_FragCoord.y) * query_width + int(gl_FragCoord.x);

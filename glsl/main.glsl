@@ -62,6 +62,7 @@ layout(early_fragment_tests) in;
 
 void main()
 {
+    read_parameters();
     // The state lives where this invocation draws: the pixel itself, or its compact slot.
     // A compact slot traces a run of its pixel's samples (core/tracer_interface.h), and its
     // samples_started counts from the run's first.

@@ -18,6 +18,7 @@ layout(location = 3) out vec4 out_at_sample;      // evaluate.rgb, pdf at the sa
 
 void main()
 {
+    read_parameters();
     read_header();
     work = 0;
     int query = int(gl_FragCoord.y) * query_width + int(gl_FragCoord.x);
