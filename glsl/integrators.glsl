@@ -199,4 +199,5 @@ void integrate(inout PixelState s)
         if (overflow)
             break;
     }
+    flush_light_groups_at_end();
 }

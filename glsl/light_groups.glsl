@@ -20,30 +20,48 @@ layout(binding = TRACER_LIGHT_GROUP_IMAGE_UNIT, rgba32f) uniform image2DArray li
 // Whether this pass collects light groups: the variant has the code and the render asked.
 bool collects_light_groups() { return HAS_LIGHT_GROUPS && light_group_count > 0u; }
 
+// Adds value to group's layer at this pixel.
+void add_to_layer(uint group, vec3 value)
+{
+    ivec3 at = ivec3(frame_pixel, int(min(group, light_group_count - 1u)));
+    imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(value, 0.0));
+}
+
 // Adds value (radiance the path gathered, throughput included) to group's layer at this
 // pixel at once. For contributions gathered outside the segment loop's top level (Whitted's
 // shadow rays walked in place, its ambient term); the segment loop's own go through the
 // two slots below.
 void add_to_light_group(uint group, vec3 value)
 {
-    if (!collects_light_groups())
-        return;
-    ivec3 at = ivec3(frame_pixel, int(min(group, light_group_count - 1u)));
-    imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(value, 0.0));
+    if (collects_light_groups())
+        add_to_layer(group, value);
 }
 
 // The segment loop's contributions of one iteration (glsl/integrators.glsl): the light its
 // shadow ray brought, and what its path segment found (the sky, or an emitter; never
-// both). They are set where they arise and added to their layers by flush_light_groups,
-// once per iteration at the loop's top level, whether or not a lane has anything to add.
-// An image store inside a condition is, on llvmpipe, a branch per lane on the lane's
-// mask, which goes either way at random when the condition does; at the top level every
-// lane still in the loop stores, and three such sites in conditions became two that
-// always store (docs/performance.md, the log: lights.txt --light-groups about 4% faster).
+// both). They are set where they arise and added to their layers by flush_light_groups at
+// the loop's top level, whether or not a lane has anything to add: an image store inside
+// a condition is, on llvmpipe, a branch per lane on the lane's mask, which goes either way
+// at random when the condition does, and every store in the loop costs in every iteration
+// (docs/performance.md, the log).
+//
+// Where a segment's light always ends its path with no shadow ray left (no volumes, whose
+// boundaries hold shadow rays back, and no pbr emitter, which scatters on and samples a
+// light), the next iteration starts a new sample and brings no shadow light: so the
+// segment's light waits for that iteration and goes through the one store the shadow light
+// uses, and the layers receive the same additions in the same order with one store an
+// iteration instead of two. flush_light_groups_at_end adds what still waits when the loop
+// ends. Not for Whitted, whose ambient term and lights go to the layers at once
+// (add_to_light_group) in the iteration a deferred light would wait for: the order of the
+// additions, and so the sums' rounding, would change.
+const bool SEGMENT_LIGHT_ENDS_PATH = !HAS_VOLUMES && !(HAS_PBR && HAS_EMITTERS);
+bool segment_light_waits() { return SEGMENT_LIGHT_ENDS_PATH && tracer_integrator() != INTEGRATOR_WHITTED; }
 uint shadow_light_group = 0u;
 vec3 shadow_light = vec3(0.0);
 uint segment_light_group = 0u;
 vec3 segment_light = vec3(0.0);
+uint waiting_light_group = 0u;   // segment_light_waits(): the segment light of the iteration before
+vec3 waiting_light = vec3(0.0);
 
 // The light this iteration's shadow ray brought, for group.
 void set_shadow_light(uint group, vec3 value)
@@ -59,18 +77,31 @@ void set_segment_light(uint group, vec3 value)
     segment_light = value;
 }
 
-// Adds this iteration's two contributions to their layers (zero when there was none) and
-// clears them: the shadow ray's first, as the segment loop gathered them before.
+// Adds this iteration's contributions to their layers (zero when there was none), the
+// shadow ray's before the segment's, as the segment loop gathers them, and clears them.
 void flush_light_groups()
 {
     if (!collects_light_groups())
         return;
-    ivec3 at = ivec3(frame_pixel, int(min(shadow_light_group, light_group_count - 1u)));
-    imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(shadow_light, 0.0));
-    at = ivec3(frame_pixel, int(min(segment_light_group, light_group_count - 1u)));
-    imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(segment_light, 0.0));
+    if (segment_light_waits()) {
+        // A light still waiting means a sample began this iteration: no shadow light.
+        bool waiting = any(notEqual(waiting_light, vec3(0.0)));
+        add_to_layer(waiting ? waiting_light_group : shadow_light_group, waiting ? waiting_light : shadow_light);
+        waiting_light_group = segment_light_group;
+        waiting_light = segment_light;
+    } else {
+        add_to_layer(shadow_light_group, shadow_light);
+        add_to_layer(segment_light_group, segment_light);
+    }
     shadow_light = vec3(0.0);
     segment_light = vec3(0.0);
+}
+
+// After the segment loop: adds the segment light still waiting (segment_light_waits()).
+void flush_light_groups_at_end()
+{
+    if (collects_light_groups() && segment_light_waits())
+        add_to_layer(waiting_light_group, waiting_light);
 }
 
 // The light group of light (texel 4 of its record, core/packed_layout.h).
