@@ -8,10 +8,10 @@
 // uses too.
 
 // The parameter block: core/tracer_interface.h lists its members (the same list makes the
-// C struct tracer_parameter_block of core/gpu.h). The block's members are
-// TRACER_BLOCK_MEMBER(NAME) (block_NAME);
-// the rest of the tracer reads a global copy of each by its own name (image_size, seed,
-// ...), which read_parameters() makes first thing in every main().
+// C struct tracer_parameter_block of core/gpu.h). The block's members are called
+// TRACER_BLOCK_MEMBER(NAME) (block_NAME); the rest of the tracer reads a global copy of
+// each by its own name (image_size, seed, ...), which read_parameters() makes first thing
+// in every main().
 //
 // Why copies: llvmpipe reads a uniform block member as a bounds-checked load for every
 // lane (a dozen instructions), and reads it again wherever it is used, in every iteration
