@@ -113,9 +113,11 @@ $(LIBRARY): $(CORE_OBJ)
 	$(say) AR $@
 	$(Q)rm -f $@ && ar rcs $@ $^
 
+# The GPU driver (loaded by EGL) must find core/large_pages.c's posix_memalign before libc's.
 $(PROGRAM): $(CLI_OBJ) $(LIBRARY)
 	$(say) LINK $@
-	$(Q)$(CXX) $(OUR_LDFLAGS) $(LDFLAGS) $(CLI_OBJ) $(LIBRARY) $(PKG_LIBS) -lm -o $@
+	$(Q)$(CXX) $(OUR_LDFLAGS) -Wl,--export-dynamic-symbol=posix_memalign $(LDFLAGS) $(CLI_OBJ) $(LIBRARY) \
+		$(PKG_LIBS) -lm -o $@
 
 $(BUILD)/tests/%: tests/unit/%.c $(LIBRARY)
 	$(say) TEST $@
@@ -227,7 +229,7 @@ FUZZ_EXPRESSION_SOURCES := tests/fuzz/fuzz_expression.c core/expression.c core/s
 FUZZ_CXX ?= clang++
 FUZZ_ASSET_SOURCES := $(FUZZ_PARSER_SOURCES) core/expression.c core/scene.c core/status.c core/bvh.c \
 	$(FUZZ_PACK_SOURCES) core/camera.c core/scene_assets.c core/ply_load.c core/obj_load.cpp core/image_io.cpp \
-	$(FUZZ_GLTF_CXX_SOURCES)
+	core/large_pages.c $(FUZZ_GLTF_CXX_SOURCES)
 FUZZ_HARNESSES := $(FUZZ_DIR)/fuzz_scene_parse $(FUZZ_DIR)/fuzz_expression $(FUZZ_DIR)/fuzz_obj_load \
 	$(FUZZ_DIR)/fuzz_gltf_load $(FUZZ_DIR)/fuzz_ply_load
 

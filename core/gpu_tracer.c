@@ -9,6 +9,7 @@
 #include "clock.h"
 #include "gpu_internal.h"
 #include "hash.h"
+#include "large_pages.h"
 #include "shader_sources.h"
 
 
@@ -733,18 +734,33 @@ void gpu_tracer_set_pass_work_budget(gpu_tracer *tracer, uint32_t budget)
                      tracer->parameters.shader.pass_work_budget);
 }
 
+/* Turns rows read bottom to top (OpenGL's order) into rows top to bottom, in place, so that
+ * a read goes straight into the caller's array: a second image-sized buffer would be
+ * memory touched the first time, which is slow (core/large_pages.h). False when the one
+ * row it needs cannot be allocated. */
+static bool flip_rows(void *rows, size_t row_bytes, int height)
+{
+    char *bytes = rows, *row = malloc(row_bytes);
+    if (row == NULL)
+        return false;
+    for (int top = 0, bottom = height - 1; top < bottom; top++, bottom--) {
+        memcpy(row, bytes + (size_t)top * row_bytes, row_bytes);
+        memcpy(bytes + (size_t)top * row_bytes, bytes + (size_t)bottom * row_bytes, row_bytes);
+        memcpy(bytes + (size_t)bottom * row_bytes, row, row_bytes);
+    }
+    free(row);
+    return true;
+}
+
 rt_status gpu_read_full_state(gpu_tracer *tracer, int state, float *out, rt_error *error)
 {
     size_t row_bytes = (size_t)tracer->width * 16;
-    char *bottom_up = malloc(row_bytes * tracer->height), *rows = (char *)out;
-    if (bottom_up == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the pass state");
+    large_pages_advise(out, row_bytes * tracer->height);
     glBindTexture(GL_TEXTURE_2D, tracer->state_textures[tracer->current][state]);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, bottom_up);
-    for (int row = 0; row < tracer->height; row++)
-        memcpy(rows + (size_t)row * row_bytes, bottom_up + (size_t)(tracer->height - 1 - row) * row_bytes, row_bytes);
-    free(bottom_up);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, out);
+    if (!flip_rows(out, row_bytes, tracer->height))
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the pass state");
     return RT_OK;
 }
 
@@ -800,20 +816,15 @@ static rt_status read_sum_layers(gpu_tracer *tracer, GLuint texture, uint32_t co
                                  rt_error *error)
 {
     size_t row_floats = (size_t)tracer->width * 4, layer_floats = row_floats * tracer->height;
-    float *bottom_up = malloc(layer_floats * count * sizeof(float));
-    if (bottom_up == NULL)
-        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the %s", what);
+    large_pages_advise(layers, layer_floats * count * sizeof(float));
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, texture);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glGetTexImage(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA, GL_FLOAT, bottom_up);
+    glGetTexImage(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA, GL_FLOAT, layers);
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
     for (uint32_t layer = 0; layer < count; layer++)
-        for (int row = 0; row < tracer->height; row++)
-            memcpy(layers + layer * layer_floats + (size_t)row * row_floats,
-                   bottom_up + layer * layer_floats + (size_t)(tracer->height - 1 - row) * row_floats,
-                   row_floats * sizeof(float));
-    free(bottom_up);
+        if (!flip_rows(layers + layer * layer_floats, row_floats * sizeof(float), tracer->height))
+            return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the %s", what);
     char doing[64];
     snprintf(doing, sizeof doing, "reading the %s", what);
     return gpu_check_gl(doing, error);
@@ -877,19 +888,15 @@ rt_status gpu_tracer_render_aovs(gpu_tracer *tracer, int samples, float *albedo_
         glBindVertexArray(tracer->vertex_array);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         float *outputs[2] = {albedo_depth, normal_coverage};
-        size_t row_floats = (size_t)width * 4;
-        float *bottom_up = malloc(row_floats * (size_t)height * sizeof(float));
-        if (bottom_up == NULL)
-            status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the AOVs");
+        size_t row_bytes = (size_t)width * 4 * sizeof(float);
         for (int k = 0; k < 2 && status == RT_OK; k++) {
+            large_pages_advise(outputs[k], row_bytes * height);
             glReadBuffer(GL_COLOR_ATTACHMENT0 + k);
             glPixelStorei(GL_PACK_ALIGNMENT, 4);
-            glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, bottom_up);
-            for (int row = 0; row < height; row++)
-                memcpy(outputs[k] + (size_t)row * row_floats, bottom_up + (size_t)(height - 1 - row) * row_floats,
-                       row_floats * sizeof(float));
+            glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, outputs[k]);
+            if (!flip_rows(outputs[k], row_bytes, height))
+                status = rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the AOVs");
         }
-        free(bottom_up);
     }
     glDeleteFramebuffers(1, &framebuffer);
     glDeleteTextures(2, textures);

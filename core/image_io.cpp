@@ -16,6 +16,7 @@
  * the temporary file directly; libtiff reports write errors properly.
  */
 #include "image_io.h"
+#include "large_pages.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
@@ -408,8 +409,15 @@ rt_status image_write_impl(const char *path, const rt_image *image,
     std::string failure;
     try {
         std::vector<unsigned char> bytes;
-        OIIO::Filesystem::IOVecOutput memory(bytes);
         bool in_memory = encodes_in_memory(extension);
+        if (in_memory) {
+            /* Room for the pixels as floats (what an EXR holds at most, about) up front, on
+             * huge pages: growing the vector by doubling copies it and touches fresh memory
+             * each time, which is slow (core/large_pages.h); 60 ms of a 1200x675 EXR. */
+            bytes.reserve((size_t)image->width * image->height * image->channels * sizeof(float) + 65536);
+            large_pages_advise(bytes.data(), bytes.capacity());
+        }
+        OIIO::Filesystem::IOVecOutput memory(bytes);
         failure = encode(destination, temporary_path, kind, image, options,
                          in_memory ? &memory : nullptr);
         if (failure.empty()) {

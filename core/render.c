@@ -24,8 +24,11 @@ render_options render_options_defaults(void)
 
 uint64_t render_bytes_per_pixel(const render_options *options, int light_group_count)
 {
-    /* Read-back: the rgba sums, GL's bottom-up copy, the statistics and theirs; the
-     * result's four channels and the copy a region's crop makes. */
+    /* Read-back: the rgba sums and the statistics, 2 x 16 more where GL's bottom-up copies
+     * of them were until read-backs flipped rows in place (2026-12-03): kept as headroom,
+     * so that tiles, and the peaks measured with them (docs/performance.md), stay as they
+     * were; the result's four channels and the copy a region's crop makes. The other GL
+     * copies below are gone the same way and kept the same way. */
     uint64_t bytes = GPU_TRACER_STATE_BYTES_PER_PIXEL + 4 * 16 + 2 * 16;
     if (options->aovs)           /* two AOV textures, their read-back, the 8-channel image twice */
         bytes += 2 * 16 + 2 * 16 + 16 + 2 * 32 + 4;

@@ -16,6 +16,8 @@
  *   scratch: make_scratch / remove_scratch (a cmocka setup/teardown pair), in_scratch,
  *            write_file, scratch_write             a fresh directory per test
  *   scratch_test(test)                             a test table entry with that pair
+ *   skip_because(test, reason)                     skips the running test, with the "SKIP
+ *            name: reason" line tests/run.sh lists (cmocka's skip() gives no reason)
  *
  * The assertions fail the running test at the caller's file and line, as cmocka's own
  * assert_* do; the value printed is the expression as written in the test. */
@@ -307,5 +309,16 @@ static inline int gpu_fixture_tear_down(void **state)
     gpu_fixture_context = NULL;
     return 0;
 }
+
+/* ---- skips ---------------------------------------------------------------------------------- */
+
+/* Skips the running test (a check this machine cannot run) and prints the "SKIP name: reason"
+ * line that tests/run.sh counts and lists; test is the test function's name. */
+#define skip_because(test, reason)                 \
+    do {                                           \
+        printf("SKIP %s: %s\n", #test, (reason)); \
+        fflush(stdout);                            \
+        skip();                                    \
+    } while (0)
 
 #endif

@@ -1,0 +1,50 @@
+/* large_pages.h: large blocks of memory on transparent huge pages (2 MiB), also the GPU
+ * driver's.
+ *
+ * Memory is slow to touch the first time: each 4 KiB page is a page fault, and on a
+ * virtual machine (CI runners, cloud farms) a fault costs about 11 us (docs/performance.md,
+ * "Memory touched the first time"). llvmpipe zeroes every texture it creates, so the
+ * tracer's pass state at 1200x675 (16 RGBA32F textures, 207 MB) took 0.58 s to create on
+ * such a machine before the first pass, of a 6.8 s render. With the kernel's transparent
+ * huge pages asked for (madvise), a fault brings 2 MiB, and the same took 0.03-0.36 s.
+ *
+ * Where the kernel's setting (/sys/kernel/mm/transparent_hugepage/enabled) is "always",
+ * this changes nothing; where it is "never", nothing either; where it is "madvise" (the
+ * default of many distributions' kernels), it is what asks. RTSPHERES_NO_HUGE_PAGES=1 in
+ * the environment turns it off (to measure it, or should a system mind).
+ *
+ * The driver allocates its textures with posix_memalign (Mesa 22.3), which this module
+ * defines for the whole process: a shared library calls the executable's definition
+ * before libc's (ELF symbol interposition; the Makefile's link of the program exports
+ * it), and blocks are freed by glibc's free as before. It is glibc's memalign, except
+ * that a block of LARGE_PAGES_ROUNDED_BYTES or more is aligned to a huge page, rounded up
+ * to whole ones and advised: a 320x180 texture (0.9 MB) would otherwise hold no whole
+ * huge page. That costs at most one huge page of memory a block where every byte is used
+ * (a 1920x1080 render's peak grew by 8 MB of 740). A driver that allocates another way is
+ * simply not advised; tests/render/test-large-pages.sh checks that llvmpipe's calls bind here.
+ *
+ *   void large_pages_advise(void *block, size_t bytes)
+ *       Asks for huge pages over the whole 4 KiB pages inside [block, block + bytes) when
+ *       bytes >= LARGE_PAGES_MIN_BYTES. Call it before the block is first written. Never
+ *       fails: without the advice the memory is the same, only slower to touch.
+ */
+#ifndef RT_LARGE_PAGES_H
+#define RT_LARGE_PAGES_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LARGE_PAGES_HUGE_BYTES ((size_t)2 << 20)       /* x86-64's huge page */
+#define LARGE_PAGES_MIN_BYTES LARGE_PAGES_HUGE_BYTES     /* large_pages_advise's smallest block */
+#define LARGE_PAGES_ROUNDED_BYTES ((size_t)512 << 10)    /* posix_memalign's */
+
+void large_pages_advise(void *block, size_t bytes);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

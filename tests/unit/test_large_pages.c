@@ -1,0 +1,127 @@
+/* test_large_pages.c: core/large_pages.h: the process's posix_memalign keeps POSIX's
+ * contract, and large blocks (only they, and not when turned off) carry the kernel's
+ * huge-page advice, as /proc/self/smaps shows it (the "hg" VmFlag). */
+#include "large_pages.h"
+
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include "support.h"
+
+/* Larger than glibc's largest dynamic mmap threshold (32 MiB), so that the block is a
+ * mapping of its own whatever the tests before did, and its flags are its own. */
+#define OWN_MAPPING_BYTES ((size_t)40 << 20)
+
+/* Whether the mapping that holds address has the huge-page advice (VmFlags "hg"). */
+static bool advised(const void *address)
+{
+    FILE *maps = fopen("/proc/self/smaps", "r");
+    assert_non_null(maps);
+    char line[512];
+    bool inside = false, found = false, result = false;
+    while (!found && fgets(line, sizeof line, maps) != NULL) {
+        unsigned long start, end;
+        if (sscanf(line, "%lx-%lx ", &start, &end) == 2 && strchr(line, '-') < strchr(line, ' ')) {
+            inside = (uintptr_t)address >= start && (uintptr_t)address < end;
+            continue;
+        }
+        if (inside && strncmp(line, "VmFlags:", 8) == 0) {
+            found = true;
+            result = strstr(line, " hg") != NULL;
+        }
+    }
+    fclose(maps);
+    assert_true(found);
+    return result;
+}
+
+/* The advice needs a kernel with transparent huge pages; without them the tests of it skip. */
+static bool kernel_has_huge_pages(void)
+{
+    return access("/sys/kernel/mm/transparent_hugepage/enabled", R_OK) == 0;
+}
+
+/* EINVAL for alignments POSIX refuses, ENOMEM when the memory cannot be had; otherwise an
+ * aligned, writable block that free() takes. */
+static void posix_memalign_keeps_its_contract(void **state)
+{
+    (void)state;
+    void *block = NULL;
+    const size_t refused[] = {0, 3, sizeof(void *) / 2, 3 * sizeof(void *), 4096 + sizeof(void *)};
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++)
+        assert_int_equal(posix_memalign(&block, refused[k], 64), EINVAL);
+    assert_null(block);
+#ifndef __SANITIZE_ADDRESS__
+    /* AddressSanitizer ends the process on such a request instead (allocator_may_return_null=0). */
+    assert_int_equal(posix_memalign(&block, 64, SIZE_MAX - 4096), ENOMEM);
+    assert_null(block);
+#endif
+    const size_t alignments[] = {sizeof(void *), 64, 4096, (size_t)2 << 20};
+    const size_t sizes[] = {1, 100, (size_t)3 << 20};
+    for (size_t a = 0; a < sizeof alignments / sizeof alignments[0]; a++)
+        for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; s++) {
+            assert_int_equal(posix_memalign(&block, alignments[a], sizes[s]), 0);
+            assert_non_null(block);
+            assert_int_equal((uintptr_t)block % alignments[a], 0);
+            memset(block, 0x5a, sizes[s]);
+            assert_int_equal(((unsigned char *)block)[sizes[s] - 1], 0x5a);
+            free(block);
+        }
+}
+
+/* posix_memalign advises a block of LARGE_PAGES_ROUNDED_BYTES or more, aligned to a huge
+ * page; large_pages_advise a block of LARGE_PAGES_MIN_BYTES or more, and not a smaller one. */
+static void large_blocks_are_advised(void **state)
+{
+    (void)state;
+    if (!kernel_has_huge_pages())
+        skip_because(large_blocks_are_advised, "this kernel has no transparent huge pages");
+    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    void *large = NULL;
+    assert_int_equal(posix_memalign(&large, 64, OWN_MAPPING_BYTES), 0);
+    assert_true(advised((char *)large + OWN_MAPPING_BYTES / 2));
+    free(large);
+    /* From LARGE_PAGES_ROUNDED_BYTES on, a block starts a huge page, so that it fills one. */
+    void *medium = NULL;
+    assert_int_equal(posix_memalign(&medium, 64, LARGE_PAGES_ROUNDED_BYTES + 4096), 0);
+    assert_int_equal((uintptr_t)medium % LARGE_PAGES_HUGE_BYTES, 0);
+    assert_true(advised(medium));
+    memset(medium, 1, LARGE_PAGES_ROUNDED_BYTES + 4096);
+    free(medium);
+    /* large_pages_advise on a mapping of our own: the same advice, and none below the size. */
+    char *mapping = mmap(NULL, 2 * LARGE_PAGES_MIN_BYTES, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    assert_true(mapping != MAP_FAILED);
+    large_pages_advise(mapping, LARGE_PAGES_MIN_BYTES - 4096);
+    assert_false(advised(mapping));
+    large_pages_advise(mapping, 2 * LARGE_PAGES_MIN_BYTES);
+    assert_true(advised(mapping));
+    munmap(mapping, 2 * LARGE_PAGES_MIN_BYTES);
+}
+
+/* RTSPHERES_NO_HUGE_PAGES=1 turns the advice off; "0" leaves it on. */
+static void advice_can_be_turned_off(void **state)
+{
+    (void)state;
+    if (!kernel_has_huge_pages())
+        skip_because(advice_can_be_turned_off, "this kernel has no transparent huge pages");
+    void *block = NULL;
+    setenv("RTSPHERES_NO_HUGE_PAGES", "1", 1);
+    assert_int_equal(posix_memalign(&block, 64, OWN_MAPPING_BYTES), 0);
+    assert_false(advised((char *)block + OWN_MAPPING_BYTES / 2));
+    free(block);
+    setenv("RTSPHERES_NO_HUGE_PAGES", "0", 1);
+    assert_int_equal(posix_memalign(&block, 64, OWN_MAPPING_BYTES), 0);
+    assert_true(advised((char *)block + OWN_MAPPING_BYTES / 2));
+    free(block);
+    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(posix_memalign_keeps_its_contract),
+        cmocka_unit_test(large_blocks_are_advised),
+        cmocka_unit_test(advice_can_be_turned_off),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
