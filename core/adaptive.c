@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "large_pages.h"
 #include "luminance.h"
 
 struct adaptive_sampler {
@@ -63,9 +64,9 @@ rt_status adaptive_create(int width, int height, float threshold, uint32_t min_s
     adaptive_sampler *sampler = calloc(1, sizeof *sampler);
     size_t pixels = (size_t)width * height;
     if (sampler != NULL) {
-        sampler->limits = malloc(pixels * sizeof *sampler->limits);
-        sampler->going = malloc(pixels);
-        sampler->unconverged = malloc(pixels);
+        sampler->limits = large_pages_alloc(pixels * sizeof *sampler->limits);
+        sampler->going = large_pages_alloc(pixels);
+        sampler->unconverged = large_pages_alloc(pixels);
     }
     if (sampler == NULL || !sampler->limits || !sampler->going || !sampler->unconverged) {
         adaptive_free(sampler);

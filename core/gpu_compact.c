@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "gpu_internal.h"
+#include "large_pages.h"
 
 /* The slot (x, y) of slot index k in the state textures (width x height): in 4 x 2 blocks
  * of 8 slots, block after block along the rows (blocks), which is what llvmpipe shades as
@@ -76,7 +77,7 @@ static rt_status add_round(gpu_tracer *tracer, int state, float *target, rt_erro
 {
     gpu_compact *c = &tracer->compact;
     size_t texels = (size_t)c->used_width * c->used_height;
-    float *slots = malloc(texels * 16);
+    float *slots = large_pages_alloc(texels * 16);
     if (slots == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading the compacted state");
     read_slots(tracer, state, slots);
@@ -187,7 +188,7 @@ void gpu_compact_note_full_read(gpu_tracer *tracer, int state, const float *sums
         return;
     size_t bytes = (size_t)tracer->width * tracer->height * 4 * sizeof(float);
     if (c->full_copies[index] == NULL)
-        c->full_copies[index] = malloc(bytes);
+        c->full_copies[index] = large_pages_alloc(bytes);
     if (c->full_copies[index] != NULL) {
         memcpy(c->full_copies[index], sums, bytes);
         c->full_copy_passes[index] = tracer->passes;
@@ -230,7 +231,7 @@ static rt_status start_host_sums(gpu_tracer *tracer, rt_error *error)
             c->sums[index] = c->full_copies[index];
             c->full_copies[index] = NULL;
         } else {
-            c->sums[index] = malloc(pixels * 4 * sizeof(float));
+            c->sums[index] = large_pages_alloc(pixels * 4 * sizeof(float));
             if (c->sums[index] != NULL && gpu_read_full_state(tracer, state, c->sums[index], error) != RT_OK) {
                 free(c->sums[index]);
                 c->sums[index] = NULL;
@@ -248,7 +249,7 @@ static rt_status start_host_sums(gpu_tracer *tracer, rt_error *error)
         }
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the compacted passes' sums");
     }
-    c->slot_map = malloc(pixels * 4 * sizeof *c->slot_map);
+    c->slot_map = large_pages_alloc(pixels * 4 * sizeof *c->slot_map);
     if (c->slot_map == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the pixel map");
     glGenTextures(1, &c->pixel_map);
@@ -279,10 +280,10 @@ rt_status gpu_tracer_set_sample_limits(gpu_tracer *tracer, const uint32_t *limit
     bool first = c->limits == NULL;
     gpu_uncull(tracer);   /* a finished pixel may have samples to take again */
     if (first) {
-        c->limits = malloc(pixels * sizeof *c->limits);
-        c->started = malloc(pixels * sizeof *c->started);
+        c->limits = large_pages_alloc(pixels * sizeof *c->limits);
+        c->started = large_pages_alloc(pixels * sizeof *c->started);
     }
-    uint32_t *bottom_up = malloc(pixels * sizeof *bottom_up);
+    uint32_t *bottom_up = large_pages_alloc(pixels * sizeof *bottom_up);
     if (bottom_up == NULL || c->limits == NULL || c->started == NULL) {
         free(bottom_up);
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory for the sample limits");

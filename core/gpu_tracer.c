@@ -516,8 +516,8 @@ static rt_status create_sums(gpu_tracer *tracer, rt_error *error)
 static rt_status load_resume_state(gpu_tracer *tracer, const float *resume, rt_error *error)
 {
     size_t pixel_count = (size_t)tracer->width * tracer->height;
-    float *sums = malloc(pixel_count * 4 * sizeof(float));
-    uint32_t *counters = calloc(pixel_count * 4, sizeof(uint32_t));
+    float *sums = large_pages_alloc(pixel_count * 4 * sizeof(float));
+    uint32_t *counters = large_pages_calloc(pixel_count * 4, sizeof(uint32_t));
     if (sums == NULL || counters == NULL) {
         free(sums);
         free(counters);
@@ -788,7 +788,7 @@ rt_status gpu_tracer_read(gpu_tracer *tracer, float *rgba, float *luminance_squa
         return status;
     if (totals != NULL || luminance_squares != NULL) {
         size_t count = (size_t)tracer->width * tracer->height;
-        float *statistics = malloc(count * 4 * sizeof(float));
+        float *statistics = large_pages_alloc(count * 4 * sizeof(float));
         if (statistics == NULL)
             return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory reading statistics");
         status = read_state(tracer, TRACER_STATE_STATISTICS, statistics, error);

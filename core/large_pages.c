@@ -53,3 +53,19 @@ int posix_memalign(void **out, size_t alignment, size_t bytes)
     *out = block;
     return 0;
 }
+
+void *large_pages_alloc(size_t bytes)
+{
+    void *block = NULL;
+    return posix_memalign(&block, 64, bytes) == 0 ? block : NULL;
+}
+
+void *large_pages_calloc(size_t count, size_t size)
+{
+    if (size != 0 && count > SIZE_MAX / size)
+        return NULL;
+    void *block = large_pages_alloc(count * size);
+    if (block != NULL)
+        memset(block, 0, count * size);
+    return block;
+}

@@ -23,6 +23,13 @@
  * (a 1920x1080 render's peak grew by 8 MB of 740). A driver that allocates another way is
  * simply not advised; tests/render/test-large-pages.sh checks that llvmpipe's calls bind here.
  *
+ *   void *large_pages_alloc(size_t bytes)
+ *   void *large_pages_calloc(size_t count, size_t size)
+ *       malloc and calloc for arrays of an image's size (read-backs, per-pixel sums and
+ *       lists): through posix_memalign above, so that from LARGE_PAGES_ROUNDED_BYTES on
+ *       they start a huge page and are advised. NULL when out of memory (or, for
+ *       large_pages_calloc, when count x size overflows); free with free().
+ *
  *   void large_pages_advise(void *block, size_t bytes)
  *       Asks for huge pages over the whole 4 KiB pages inside [block, block + bytes) when
  *       bytes >= LARGE_PAGES_MIN_BYTES. Call it before the block is first written. Never
@@ -41,6 +48,8 @@ extern "C" {
 #define LARGE_PAGES_MIN_BYTES LARGE_PAGES_HUGE_BYTES     /* large_pages_advise's smallest block */
 #define LARGE_PAGES_ROUNDED_BYTES ((size_t)512 << 10)    /* posix_memalign's */
 
+void *large_pages_alloc(size_t bytes);
+void *large_pages_calloc(size_t count, size_t size);
 void large_pages_advise(void *block, size_t bytes);
 
 #ifdef __cplusplus

@@ -10,6 +10,7 @@
 #include "camera.h"
 #include "clock.h"
 #include "hash.h"
+#include "large_pages.h"
 #include "luminance.h"
 #include "pack.h"
 #include "packed_traverse.h"
@@ -283,7 +284,7 @@ static rt_status read_light_groups(gpu_tracer *tracer, const scene *s, const rt_
 {
     int width = colour->width, height = colour->height, count = s->light_group_count;
     size_t pixel_count = (size_t)width * height;
-    float *layers = malloc(pixel_count * 4 * (size_t)count * sizeof(float));
+    float *layers = large_pages_alloc(pixel_count * 4 * (size_t)count * sizeof(float));
     if (layers == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for the light groups");
     rt_status status = gpu_tracer_read_light_groups(tracer, layers, error);
@@ -319,8 +320,8 @@ static rt_status render_aovs(gpu_tracer *tracer, int width, int height, const rt
                              const float *luminance_squares, rt_image *aovs, rt_error *error)
 {
     size_t pixel_count = (size_t)width * height;
-    float *albedo_depth = malloc(pixel_count * 4 * sizeof(float));
-    float *normal = malloc(pixel_count * 4 * sizeof(float));
+    float *albedo_depth = large_pages_alloc(pixel_count * 4 * sizeof(float));
+    float *normal = large_pages_alloc(pixel_count * 4 * sizeof(float));
     rt_status status = albedo_depth && normal ? RT_OK : rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
     if (status == RT_OK)
         status = gpu_tracer_render_aovs(tracer, AOV_SAMPLES, albedo_depth, normal, error);
@@ -398,7 +399,7 @@ static rt_status variance_layers(int width, int height, const rt_image *colour, 
 static rt_status add_variance_layers(gpu_tracer *tracer, int width, int height, render_result *result,
                                      rt_error *error)
 {
-    float *squares = malloc((size_t)width * height * 4 * sizeof *squares);
+    float *squares = large_pages_alloc((size_t)width * height * 4 * sizeof *squares);
     if (squares == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
     rt_image layers = {0};
@@ -417,7 +418,7 @@ static rt_status add_direct_emission_layer(gpu_tracer *tracer, int width, int he
                                            rt_error *error)
 {
     size_t pixel_count = (size_t)width * height;
-    float *sums = malloc(pixel_count * 4 * sizeof *sums);
+    float *sums = large_pages_alloc(pixel_count * 4 * sizeof *sums);
     if (sums == NULL)
         return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
     rt_image layer = {0};
@@ -455,7 +456,7 @@ static float *resume_sums(const rt_image *partial, int width, int height, uint32
                      "samples", partial->width, partial->height, partial->channels, width, height);
         return NULL;
     }
-    float *sums = malloc((size_t)width * height * 4 * sizeof(float));
+    float *sums = large_pages_alloc((size_t)width * height * 4 * sizeof(float));
     if (sums == NULL) {
         rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
         return NULL;
@@ -627,7 +628,7 @@ static rt_status read_result(gpu_context *context, gpu_tracer *tracer, const sce
     float *luminance_squares = NULL;
     rt_status status = RT_OK;
     if (options->aovs) {
-        luminance_squares = malloc((size_t)width * height * sizeof *luminance_squares);
+        luminance_squares = large_pages_alloc((size_t)width * height * sizeof *luminance_squares);
         if (luminance_squares == NULL)
             status = rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
     }

@@ -6,6 +6,7 @@
 
 #include "adaptive.h"
 #include "clock.h"
+#include "large_pages.h"
 #include "render_internal.h"
 
 /* Passes of about a second on a CPU rasteriser, a quarter on a GPU (under any watchdog):
@@ -58,9 +59,9 @@ static rt_status start_adaptive(gpu_tracer *tracer, const render_options *option
     if (status != RT_OK)
         return status;
     size_t pixels = (size_t)width * height;
-    run->rgba = malloc(pixels * 4 * sizeof *run->rgba);
-    run->luminance_squares = malloc(pixels * sizeof *run->luminance_squares);
-    run->pixels = malloc(pixels * sizeof *run->pixels);
+    run->rgba = large_pages_alloc(pixels * 4 * sizeof *run->rgba);
+    run->luminance_squares = large_pages_alloc(pixels * sizeof *run->luminance_squares);
+    run->pixels = large_pages_alloc(pixels * sizeof *run->pixels);
     status = run->rgba && run->luminance_squares && run->pixels
                  ? gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error)
                  : rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory for adaptive sampling");

@@ -116,12 +116,39 @@ static void advice_can_be_turned_off(void **state)
     unsetenv("RTSPHERES_NO_HUGE_PAGES");
 }
 
+/* large_pages_alloc and _calloc: image-sized arrays through the same path (aligned and
+ * advised from LARGE_PAGES_ROUNDED_BYTES on), calloc's zeroes, and NULL on overflow. */
+static void image_arrays_take_the_same_path(void **state)
+{
+    (void)state;
+    size_t bytes = LARGE_PAGES_ROUNDED_BYTES * 3;
+    unsigned char *block = large_pages_alloc(bytes);
+    assert_non_null(block);
+    assert_int_equal((uintptr_t)block % LARGE_PAGES_HUGE_BYTES, 0);
+    if (kernel_has_huge_pages())
+        assert_true(advised(block));
+    memset(block, 7, bytes);
+    free(block);
+    uint32_t *zeros = large_pages_calloc(bytes / sizeof(uint32_t), sizeof(uint32_t));
+    assert_non_null(zeros);
+    for (size_t k = 0; k < bytes / sizeof(uint32_t); k++)
+        assert_int_equal(zeros[k], 0);
+    free(zeros);
+    unsigned char *small = large_pages_calloc(3, 5);
+    assert_non_null(small);
+    for (int k = 0; k < 15; k++)
+        assert_int_equal(small[k], 0);
+    free(small);
+    assert_null(large_pages_calloc(SIZE_MAX / 2, 3));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(posix_memalign_keeps_its_contract),
         cmocka_unit_test(large_blocks_are_advised),
         cmocka_unit_test(advice_can_be_turned_off),
+        cmocka_unit_test(image_arrays_take_the_same_path),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
