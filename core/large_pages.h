@@ -23,6 +23,19 @@
  * (a 1920x1080 render's peak grew by 8 MB of 740). A driver that allocates another way is
  * simply not advised; tests/render/test-large-pages.sh checks that llvmpipe's calls bind here.
  *
+ * The heap. Every small block (Mesa's GLSL compiler, OpenImageIO's start-up strings)
+ * comes from glibc's heap, which grows page by page, each a fault: a cold start's heap
+ * reaches 79 MB, a cached one's 44 MB. At the program's start, before any shared
+ * library's constructor (a function in the program's preinit_array), this module sets
+ * glibc's thresholds to where its dynamic ones end anyway once a program has freed a
+ * large block (blocks under 32 MiB from the heap, trimmed past 64 MiB free) and a top pad
+ * of LARGE_PAGES_HEAP_BYTES, and advises the heap's first extension: glibc's own
+ * GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which must be set before the process starts, for
+ * the first 64 MiB. A cached start to the first pass 0.155 -> 0.11 s, a cold one
+ * 0.615 -> 0.53 s, for about 30 MB more at a 1200x675 render's peak (the heap keeps up to
+ * its pad). RTSPHERES_NO_HUGE_PAGES=1 in the environment the program starts with leaves
+ * the heap as glibc has it. Not under AddressSanitizer, whose allocator has no such heap.
+ *
  *   void *large_pages_alloc(size_t bytes)
  *   void *large_pages_calloc(size_t count, size_t size)
  *       malloc and calloc for arrays of an image's size (read-backs, per-pixel sums and
@@ -47,6 +60,7 @@ extern "C" {
 #define LARGE_PAGES_HUGE_BYTES ((size_t)2 << 20)       /* x86-64's huge page */
 #define LARGE_PAGES_MIN_BYTES LARGE_PAGES_HUGE_BYTES     /* large_pages_advise's smallest block */
 #define LARGE_PAGES_ROUNDED_BYTES ((size_t)512 << 10)    /* posix_memalign's */
+#define LARGE_PAGES_HEAP_BYTES ((size_t)64 << 20)        /* the heap's advised start, top pad */
 
 void *large_pages_alloc(size_t bytes);
 void *large_pages_calloc(size_t count, size_t size);

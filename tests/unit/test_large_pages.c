@@ -8,8 +8,8 @@
 
 #include "support.h"
 
-/* Larger than glibc's largest dynamic mmap threshold (32 MiB), so that the block is a
- * mapping of its own whatever the tests before did, and its flags are its own. */
+/* Larger than the heap's mmap threshold (32 MiB, set at the start): a mapping of its own,
+ * unless the heap's advised top has room for it; advised either way. */
 #define OWN_MAPPING_BYTES ((size_t)40 << 20)
 
 /* Whether the mapping that holds address has the huge-page advice (VmFlags "hg"). */
@@ -98,22 +98,59 @@ static void large_blocks_are_advised(void **state)
     munmap(mapping, 2 * LARGE_PAGES_MIN_BYTES);
 }
 
-/* RTSPHERES_NO_HUGE_PAGES=1 turns the advice off; "0" leaves it on. */
+/* RTSPHERES_NO_HUGE_PAGES=1 turns the advice off; "0" leaves it on. (The heap's advice is
+ * decided once, at the start: the program's render tests cover the variable there.) */
 static void advice_can_be_turned_off(void **state)
 {
     (void)state;
     if (!kernel_has_huge_pages())
         skip_because(advice_can_be_turned_off, "this kernel has no transparent huge pages");
-    void *block = NULL;
+    size_t bytes = 2 * LARGE_PAGES_MIN_BYTES;
+    char *mapping = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    assert_true(mapping != MAP_FAILED);
     setenv("RTSPHERES_NO_HUGE_PAGES", "1", 1);
-    assert_int_equal(posix_memalign(&block, 64, OWN_MAPPING_BYTES), 0);
-    assert_false(advised((char *)block + OWN_MAPPING_BYTES / 2));
-    free(block);
+    large_pages_advise(mapping, bytes);
+    bool advised_when_off = advised(mapping);
     setenv("RTSPHERES_NO_HUGE_PAGES", "0", 1);
-    assert_int_equal(posix_memalign(&block, 64, OWN_MAPPING_BYTES), 0);
-    assert_true(advised((char *)block + OWN_MAPPING_BYTES / 2));
-    free(block);
+    large_pages_advise(mapping, bytes);
+    bool advised_when_on = advised(mapping);
     unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    munmap(mapping, bytes);
+    assert_false(advised_when_off);
+    assert_true(advised_when_on);
+}
+
+/* Whether a mapping of the heap ([heap] in /proc/self/smaps) has the huge-page advice. */
+static bool heap_advised(void)
+{
+    FILE *maps = fopen("/proc/self/smaps", "r");
+    assert_non_null(maps);
+    char line[512];
+    bool in_heap = false, result = false;
+    while (!result && fgets(line, sizeof line, maps) != NULL) {
+        unsigned long start, end;
+        if (sscanf(line, "%lx-%lx ", &start, &end) == 2 && strchr(line, '-') < strchr(line, ' '))
+            in_heap = strstr(line, "[heap]") != NULL;
+        else if (in_heap && strncmp(line, "VmFlags:", 8) == 0)
+            result = strstr(line, " hg") != NULL;
+    }
+    fclose(maps);
+    return result;
+}
+
+/* The program's start (preinit_array, before any library's constructor) advised the heap:
+ * this test binary links core/large_pages.c as the program does. */
+static void heap_is_advised_from_the_start(void **state)
+{
+    (void)state;
+    if (!kernel_has_huge_pages())
+        skip_because(heap_is_advised_from_the_start, "this kernel has no transparent huge pages");
+    assert_true(heap_advised());
+    /* Blocks under 32 MiB come from the heap (glibc's thresholds as they end up anyway). */
+    char *block = malloc(8u << 20), *end = sbrk(0);
+    assert_non_null(block);
+    assert_true(block < end && block + (8u << 20) <= end);
+    free(block);
 }
 
 /* large_pages_alloc and _calloc: image-sized arrays through the same path (aligned and
@@ -149,6 +186,7 @@ int main(void)
         cmocka_unit_test(large_blocks_are_advised),
         cmocka_unit_test(advice_can_be_turned_off),
         cmocka_unit_test(image_arrays_take_the_same_path),
+        cmocka_unit_test(heap_is_advised_from_the_start),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
