@@ -35,10 +35,17 @@ static bool advised(const void *address)
     return result;
 }
 
-/* The advice needs a kernel with transparent huge pages; without them the tests of it skip. */
+/* The advice needs a kernel with transparent huge pages; without them the tests of it skip.
+ * Asked of the kernel itself (a chroot may have no /sys): madvise fails without them. */
 static bool kernel_has_huge_pages(void)
 {
-    return access("/sys/kernel/mm/transparent_hugepage/enabled", R_OK) == 0;
+    size_t bytes = LARGE_PAGES_HUGE_BYTES;
+    void *probe = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (probe == MAP_FAILED)
+        return false;
+    bool has = madvise(probe, bytes, MADV_HUGEPAGE) == 0;
+    munmap(probe, bytes);
+    return has;
 }
 
 /* EINVAL for alignments POSIX refuses, ENOMEM when the memory cannot be had; otherwise an
