@@ -94,7 +94,7 @@ static void print_help(FILE *stream)
             "                         reach (lights, volumes, textures); the image is the same,\n"
             "                         only slower: for checking exactly that\n"
             "      --pass-budget N    fixed work units per pixel per GPU pass (default: adapted\n"
-            "                         so a pass takes about 0.25 s, 1 s on llvmpipe; the image is the same)\n"
+            "                         so a pass takes about 0.25 s, 2 s on llvmpipe; the image is the same)\n"
             "      --device N         use EGL device N (see `rtspheres info`)\n"
             "      --threads N        CPU threads of the software device (llvmpipe's LP_NUM_THREADS);\n"
             "                         on a GPU a warning that it does nothing\n"

@@ -20,7 +20,7 @@
  *     loop cap: 3,128 units at 8 lanes; core/gpu.c set_work_limits). A non-zero value is
  *     used for every pass. The image does not depend on it, only the time per pass.
  *   target_pass_seconds 0.25 on a GPU (short passes keep progress, Ctrl-C and watchdogs
- *     happy), 1 on a CPU rasteriser (where each pass costs a share of its time),
+ *     happy), 2 on a CPU rasteriser (where each pass costs a share of its time),
  *   light sampling on (next-event estimation with MIS; the image's expectation is the
  *     same without it, only the noise differs),
  *   russian_roulette_depth 4 (paths may end at random from the 5th segment on),
