@@ -70,35 +70,3 @@ void *large_pages_calloc(size_t count, size_t size)
         memset(block, 0, count * size);
     return block;
 }
-
-/* The heap on huge pages too, from the process's start (core/large_pages.h, "The heap").
- * Runs from the program's preinit_array: before every shared library's constructors
- * (OpenImageIO's fill the heap with thousands of strings), with the environment as its
- * third argument, since libc may not have set environ yet. */
-static void prepare_heap(int argc, char **argv, char **envp)
-{
-    (void)argc;
-    (void)argv;
-#ifndef __SANITIZE_ADDRESS__
-    for (char **variable = envp; variable != NULL && *variable != NULL; variable++)
-        if (strncmp(*variable, "RTSPHERES_NO_HUGE_PAGES=", 24) == 0 && strcmp(*variable + 24, "") != 0
-            && strcmp(*variable + 24, "0") != 0)
-            return;
-    /* glibc's dynamic mmap threshold ends at 32 MiB and its trim threshold at twice that
-     * once a program has freed a large block; set from the start, blocks under 32 MiB come
-     * from the heap (advised below), and a fault of the heap's top brings 2 MiB. */
-    mallopt(M_MMAP_THRESHOLD, (int)LARGE_PAGES_HEAP_BYTES / 2);
-    mallopt(M_TRIM_THRESHOLD, (int)LARGE_PAGES_HEAP_BYTES);
-    mallopt(M_TOP_PAD, (int)LARGE_PAGES_HEAP_BYTES);
-    char *first = malloc(1);
-    char *end = sbrk(0);
-    if (first != NULL && end != (char *)-1 && end > first && (size_t)(end - first) <= 2 * LARGE_PAGES_HEAP_BYTES)
-        large_pages_advise(first, (size_t)(end - first));
-    free(first);
-#else
-    (void)envp;   /* AddressSanitizer's allocator has no such heap */
-#endif
-}
-
-__attribute__((section(".preinit_array"), used)) static void (*const prepare_heap_entry)(int, char **, char **) =
-    prepare_heap;

@@ -23,20 +23,13 @@
  * (a 1920x1080 render's peak grew by 8 MB of 740). A driver that allocates another way is
  * simply not advised; tests/render/test-large-pages.sh checks that llvmpipe's calls bind here.
  *
- * The heap. Every small block (Mesa's GLSL compiler, OpenImageIO's start-up strings)
- * comes from glibc's heap, which grows page by page, each a fault: a cold start's heap
- * reaches 79 MB, a cached one's 44 MB. At the program's start, before any shared
- * library's constructor (a function in the program's preinit_array), this module sets
- * glibc's thresholds to where its dynamic ones end anyway once a program has freed a
- * large block (blocks under 32 MiB from the heap, trimmed past 64 MiB free) and a top pad
- * of LARGE_PAGES_HEAP_BYTES, and advises the heap's first extension: glibc's own
- * GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which must be set before the process starts, for
- * the first 64 MiB. A cached start to the first pass 0.155 -> 0.11 s, a cold one
- * 0.615 -> 0.53 s. The cost is resident memory, the heap being resident in 2 MiB pieces
- * and keeping up to its pad: a 1200x675 render's peak 463 -> 493 MB, a 4000x400 render in
- * tiles of a 130 MiB budget 473 -> 577 MB, a 64x36 one 221 MB either way. A pad of 16 MiB
- * saved nothing (the heap outgrows it) and cost as much. RTSPHERES_NO_HUGE_PAGES=1 in the environment the program starts with leaves
- * the heap as glibc has it. Not under AddressSanitizer, whose allocator has no such heap.
+ * Not the heap: glibc's heap (the small blocks of Mesa's shader compiler and of the
+ * libraries' start-up) stays as glibc has it. Advising it from the program's start (a
+ * function in the preinit_array, glibc's thresholds at their maxima and a 64 MiB top pad;
+ * 2026-12-03) sped up the first pass on one virtual machine and slowed whole renders on
+ * another (2026-12-06: the weekend at 1200x675 8 spp 2.41 s against 2.02 s without it, a
+ * 1920x1080 1-spp render 2.10 s against 1.59 s, the kernel zeroing 2 MiB pages the heap
+ * never used), for 30 to 100 MB more at a render's peak; docs/performance.md, the log.
  *
  *   void *large_pages_alloc(size_t bytes)
  *   void *large_pages_calloc(size_t count, size_t size)
@@ -62,7 +55,6 @@ extern "C" {
 #define LARGE_PAGES_HUGE_BYTES ((size_t)2 << 20)       /* x86-64's huge page */
 #define LARGE_PAGES_MIN_BYTES LARGE_PAGES_HUGE_BYTES     /* large_pages_advise's smallest block */
 #define LARGE_PAGES_ROUNDED_BYTES ((size_t)512 << 10)    /* posix_memalign's */
-#define LARGE_PAGES_HEAP_BYTES ((size_t)64 << 20)        /* the heap's advised start, top pad */
 
 void *large_pages_alloc(size_t bytes);
 void *large_pages_calloc(size_t count, size_t size);

@@ -28,42 +28,6 @@ else
 fi
 rm -f "$bindings".*
 
-# The heap is advised at the program's start (before any library's constructor), unless
-# RTSPHERES_NO_HUGE_PAGES=1 was in its environment: seen in /proc/PID/smaps during a render.
-# heap_flags [VAR=VALUE]: prints the VmFlags of the render's [heap] mappings, or nothing when
-# the render ended before they could be read.
-heap_flags() {
-    env "$@" "$program" render "$scene" -o "$scratch/heap.exr" --size 640x360 --spp 16 --quiet 2>/dev/null &
-    lib_pid=$!
-    lib_flags=
-    lib_tries=0
-    while [ -z "$lib_flags" ] && [ "$lib_tries" -lt 100 ] && kill -0 "$lib_pid" 2>/dev/null; do
-        lib_flags=$(awk '/\[heap\]/ { heap = 1; next } /^[0-9a-f]+-[0-9a-f]+ / { heap = 0 }
-            heap && /^VmFlags:/ { print }' "/proc/$lib_pid/smaps" 2>/dev/null)
-        [ -n "$lib_flags" ] || sleep 0.05
-        lib_tries=$((lib_tries + 1))
-    done
-    wait "$lib_pid"
-    echo "$lib_flags"
-}
-flags_on=$(heap_flags RTSPHERES_UNUSED=1)
-flags_off=$(heap_flags RTSPHERES_NO_HUGE_PAGES=1)
-if [ -z "$flags_on" ] || [ -z "$flags_off" ]; then
-    fail "the heap's advice" "no [heap] mapping seen in /proc/PID/smaps during a render"
-elif ! echo "$flags_on" | grep -q ' hg'; then
-    # The advice fails where the kernel has no transparent huge pages; /sys says whether it
-    # has them (a chroot may not mount it).
-    if [ -r /sys/kernel/mm/transparent_hugepage/enabled ]; then
-        fail "the heap's advice" "not advised: $(echo "$flags_on" | head -2 | tr '\n' ' ')"
-    else
-        echo "SKIP the heap's advice: not advised, and no /sys/kernel/mm/transparent_hugepage to say whether this kernel has huge pages"
-    fi
-elif echo "$flags_off" | grep -q ' hg'; then
-    fail "RTSPHERES_NO_HUGE_PAGES=1" "the heap is advised all the same: $(echo "$flags_off" | tr '\n' ' ')"
-else
-    pass "the heap is on huge pages from the start, and not with RTSPHERES_NO_HUGE_PAGES=1"
-fi
-
 # 512x512: each state texture (4 MB) is over LARGE_PAGES_MIN_BYTES, so it is advised.
 render_options="--size 512x512 --spp 2 --max-depth 8"
 if render "$scratch/advised.exr" && RTSPHERES_NO_HUGE_PAGES=1 render "$scratch/plain.exr"; then

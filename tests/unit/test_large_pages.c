@@ -8,8 +8,7 @@
 
 #include "support.h"
 
-/* Larger than the heap's mmap threshold (32 MiB, set at the start): a mapping of its own,
- * unless the heap's advised top has room for it; advised either way. */
+/* Larger than glibc's mmap threshold (at most 32 MiB): a mapping of its own, advised. */
 #define OWN_MAPPING_BYTES ((size_t)40 << 20)
 
 /* Whether the mapping that holds address has the huge-page advice (VmFlags "hg"). */
@@ -105,8 +104,7 @@ static void large_blocks_are_advised(void **state)
     munmap(mapping, 2 * LARGE_PAGES_MIN_BYTES);
 }
 
-/* RTSPHERES_NO_HUGE_PAGES=1 turns the advice off; "0" leaves it on. (The heap's advice is
- * decided once, at the start: the program's render tests cover the variable there.) */
+/* RTSPHERES_NO_HUGE_PAGES=1 turns the advice off; "0" leaves it on. */
 static void advice_can_be_turned_off(void **state)
 {
     (void)state;
@@ -125,39 +123,6 @@ static void advice_can_be_turned_off(void **state)
     munmap(mapping, bytes);
     assert_false(advised_when_off);
     assert_true(advised_when_on);
-}
-
-/* Whether a mapping of the heap ([heap] in /proc/self/smaps) has the huge-page advice. */
-static bool heap_advised(void)
-{
-    FILE *maps = fopen("/proc/self/smaps", "r");
-    assert_non_null(maps);
-    char line[512];
-    bool in_heap = false, result = false;
-    while (!result && fgets(line, sizeof line, maps) != NULL) {
-        unsigned long start, end;
-        if (sscanf(line, "%lx-%lx ", &start, &end) == 2 && strchr(line, '-') < strchr(line, ' '))
-            in_heap = strstr(line, "[heap]") != NULL;
-        else if (in_heap && strncmp(line, "VmFlags:", 8) == 0)
-            result = strstr(line, " hg") != NULL;
-    }
-    fclose(maps);
-    return result;
-}
-
-/* The program's start (preinit_array, before any library's constructor) advised the heap:
- * this test binary links core/large_pages.c as the program does. */
-static void heap_is_advised_from_the_start(void **state)
-{
-    (void)state;
-    if (!kernel_has_huge_pages())
-        skip_because(heap_is_advised_from_the_start, "this kernel has no transparent huge pages");
-    assert_true(heap_advised());
-    /* Blocks under 32 MiB come from the heap (glibc's thresholds as they end up anyway). */
-    char *block = malloc(8u << 20), *end = sbrk(0);
-    assert_non_null(block);
-    assert_true(block < end && block + (8u << 20) <= end);
-    free(block);
 }
 
 /* large_pages_alloc and _calloc: image-sized arrays through the same path (aligned and
@@ -193,7 +158,6 @@ int main(void)
         cmocka_unit_test(large_blocks_are_advised),
         cmocka_unit_test(advice_can_be_turned_off),
         cmocka_unit_test(image_arrays_take_the_same_path),
-        cmocka_unit_test(heap_is_advised_from_the_start),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
