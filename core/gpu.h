@@ -141,6 +141,9 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_VERTEX_COLORS   no vertex colour section
  *   GPU_OMIT_LIGHT_GROUPS    no light group layers asked for (render_options.light_groups)
  *   GPU_OMIT_DIRECT_EMISSION  no direct emission sums asked for (render_options.direct_emission)
+ *   GPU_OMIT_SQUARES         no per-channel sums of squares asked for (render_options.variance):
+ *                            the pass state has 7 textures instead of 8 (TRACER_STATE_SQUARES
+ *                            left out), and gpu_tracer_read_squares is an error
  *   GPU_OMIT_SPHERE_LIGHTS, GPU_OMIT_TRIANGLE_LIGHTS, GPU_OMIT_DELTA_LIGHTS (point, spot,
  *   GPU_OMIT_ENVIRONMENT_LIGHT  sun)  no light of that kind in the light section
  *   GPU_OMIT_MANY_LIGHTS     at most one light: no light to choose, no search for a hit
@@ -178,7 +181,10 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_DIELECTRIC (1u << 23)
 #define GPU_OMIT_LIGHT_TREE (1u << 24)
 #define GPU_OMIT_DIRECT_EMISSION (1u << 25)
-#define GPU_VARIANT_BITS 25
+#define GPU_OMIT_SQUARES (1u << 26)
+/* The bits a program variant is told apart by (core/gpu_tracer.c variant_key): every bit
+ * above, GPU_FIX_UNIFORMS with them. */
+#define GPU_VARIANT_BITS 27
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct
@@ -241,8 +247,10 @@ typedef struct gpu_tracer gpu_tracer;
  * --memory-budget), never a raw framebuffer status. Test hook: RTSPHERES_TEST_GPU_FAILURE
  * = "memory" or "framebuffer" makes the state's creation fail as that failure would.
  * Free with gpu_tracer_destroy(). GPU_TRACER_STATE_BYTES_PER_PIXEL: the two state sets,
- * the sample limits and the depth buffer of gpu_tracer_cull_finished. */
+ * the sample limits and the depth buffer of gpu_tracer_cull_finished; 2 x 16 bytes less
+ * with GPU_OMIT_SQUARES (GPU_TRACER_SQUARES_BYTES_PER_PIXEL). */
 #define GPU_TRACER_STATE_BYTES_PER_PIXEL (2 * TRACER_STATE_COUNT * 16 + 4 + 4)
+#define GPU_TRACER_SQUARES_BYTES_PER_PIXEL (2 * 16)
 rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels, uint32_t texel_count,
                             uint64_t texel_hash, const gpu_tracer_parameters *parameters, gpu_tracer **out,
                             rt_error *error);
@@ -316,7 +324,8 @@ rt_status gpu_tracer_read_direct_emission(gpu_tracer *tracer, float *sums, rt_er
 
 /* Reads the per-channel sums of squares: squares receives width*height*4 floats, rows top
  * to bottom, (sum of finished samples' squared radiance r^2, g^2, b^2, 0), from which
- * render.c makes the variance layers. */
+ * render.c makes the variance layers. RT_ERROR_RUNTIME for a tracer created with
+ * GPU_OMIT_SQUARES, which keeps none. */
 rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error);
 
 /* Renders the first-hit AOVs with samples jittered camera rays per pixel (the same camera

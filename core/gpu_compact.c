@@ -53,9 +53,11 @@ static void nearest_filtering(void)
 }
 
 /* The state index of sums[] for TRACER_STATE_ACCUMULATED, _STATISTICS, _SQUARES; -1 for
- * the others. */
-static int sums_index(int state)
+ * the others, and for the squares where the tracer keeps none (gpu.h GPU_OMIT_SQUARES). */
+static int sums_index(const gpu_tracer *tracer, int state)
 {
+    if (state >= tracer->state_count)
+        return -1;
     return state == TRACER_STATE_ACCUMULATED ? 0 : state == TRACER_STATE_STATISTICS ? 1
          : state == TRACER_STATE_SQUARES     ? 2 : -1;
 }
@@ -103,7 +105,7 @@ static rt_status commit_round(gpu_tracer *tracer, rt_error *error)
     gpu_compact *c = &tracer->compact;
     rt_status status = RT_OK;
     for (int state = 0; state < TRACER_STATE_COUNT && status == RT_OK; state++) {
-        int index = sums_index(state);
+        int index = sums_index(tracer, state);
         if (index >= 0)
             status = add_round(tracer, state, c->sums[index], error);
     }
@@ -183,7 +185,7 @@ static rt_status start_round(gpu_tracer *tracer, int first_run, rt_error *error)
 void gpu_compact_note_full_read(gpu_tracer *tracer, int state, const float *sums)
 {
     gpu_compact *c = &tracer->compact;
-    int index = sums_index(state);
+    int index = sums_index(tracer, state);
     if (c->limits == NULL || c->sums[0] != NULL || index < 0)
         return;
     size_t bytes = (size_t)tracer->width * tracer->height * 4 * sizeof(float);
@@ -198,7 +200,7 @@ void gpu_compact_note_full_read(gpu_tracer *tracer, int state, const float *sums
 rt_status gpu_compact_read(gpu_tracer *tracer, int state, float *out, bool *compacted, rt_error *error)
 {
     gpu_compact *c = &tracer->compact;
-    int index = sums_index(state);
+    int index = sums_index(tracer, state);
     *compacted = c->sums[0] != NULL && index >= 0;
     if (!*compacted)
         return RT_OK;
@@ -224,7 +226,7 @@ static rt_status start_host_sums(gpu_tracer *tracer, rt_error *error)
     /* What a read since the last pass took from the full state (the check's, before this
      * list) is not read again: a read-back costs llvmpipe about 4 ms a 640 KB texture. */
     for (int state = 0; state < TRACER_STATE_COUNT; state++) {
-        int index = sums_index(state);
+        int index = sums_index(tracer, state);
         if (index < 0)
             continue;
         if (c->full_copies[index] != NULL && c->full_copy_passes[index] == tracer->passes) {
@@ -242,7 +244,8 @@ static rt_status start_host_sums(gpu_tracer *tracer, rt_error *error)
         free(c->full_copies[i]);
         c->full_copies[i] = NULL;
     }
-    if (c->sums[0] == NULL || c->sums[1] == NULL || c->sums[2] == NULL) {
+    bool squares_kept = tracer->state_count > TRACER_STATE_SQUARES;
+    if (c->sums[0] == NULL || c->sums[1] == NULL || (c->sums[2] == NULL && squares_kept)) {
         for (int i = 0; i < 3; i++) {
             free(c->sums[i]);
             c->sums[i] = NULL;

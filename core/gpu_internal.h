@@ -91,6 +91,8 @@ struct gpu_tracer {
     GLuint depth_buffer;         /* both full state sets' depth: 0 where full passes skip the
                                   * pixel (gpu_tracer_cull_finished), else 1 */
     bool culling;                /* some pixel is marked: full passes test the depth */
+    int state_count;             /* state textures a set has: TRACER_STATE_COUNT, or one less
+                                  * when the squares are left out (GPU_OMIT_SQUARES; the last) */
     int image_units;             /* the program's image units: the packed scene's, and the light
                                   * group layers' and direct emission's when it has them */
     int current;                 /* which state set holds the latest pass */
@@ -134,12 +136,14 @@ rt_status gpu_read_full_state(gpu_tracer *tracer, int state, float *out, rt_erro
 /* Frees the tracer's compact state. */
 void gpu_compact_destroy(gpu_tracer *tracer);
 
-/* Creates one set of pass-state textures (TRACER_STATE_COUNT of width x height, nearest
- * filtering; RGBA32F, the counters RGBA32UI) and a framebuffer drawing to them
- * (attachment TRACER_STATE_* for each) into textures and *framebuffer, left bound. Returns
+/* Creates one set of pass-state textures (the first count of TRACER_STATE_COUNT, width x
+ * height, nearest filtering; RGBA32F, the counters RGBA32UI; the others' names 0) and a
+ * framebuffer drawing to them (attachment TRACER_STATE_* for each) into textures and
+ * *framebuffer, left bound. Returns
  * the framebuffer's status: GL_FRAMEBUFFER_COMPLETE, or incomplete where the device could
  * not allocate a texture. In gpu_tracer.c; the caller deletes them. */
-GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], GLuint *framebuffer, int width, int height);
+GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], int count, GLuint *framebuffer, int width,
+                            int height);
 
 /* Shared by gpu_tracer.c (where they are) and gpu_test_programs.c: */
 /* Writes the #defines of a tracer variant into defines (size bytes): every

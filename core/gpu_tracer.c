@@ -198,6 +198,7 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
         {GPU_OMIT_DIELECTRIC, "RTSPHERES_OMIT_DIELECTRIC"},
         {GPU_OMIT_LIGHT_TREE, "RTSPHERES_OMIT_LIGHT_TREE"},
         {GPU_OMIT_DIRECT_EMISSION, "RTSPHERES_OMIT_DIRECT_EMISSION"},
+        {GPU_OMIT_SQUARES, "RTSPHERES_OMIT_SQUARES"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;
@@ -213,6 +214,7 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
 
 /* The key of a variant in the context's program cache: the bits, and the constants
  * compiled in with GPU_FIX_UNIFORMS. */
+_Static_assert(GPU_OMIT_SQUARES << 1 == 1u << GPU_VARIANT_BITS, "GPU_VARIANT_BITS must cover every GPU_OMIT_* bit");
 static uint64_t variant_key(uint32_t omitted, const tracer_parameter_block *settings)
 {
     uint64_t key = omitted & ((1u << GPU_VARIANT_BITS) - 1u);
@@ -306,7 +308,9 @@ static rt_status upload_packed_scene(gpu_tracer *tracer, const uint32_t *texels,
  * it; what: the failure as the driver put it): the size, and what the user can do. */
 static rt_status state_out_of_memory(const gpu_tracer *tracer, const char *what, rt_error *error)
 {
-    double mib = (double)tracer->width * tracer->height * GPU_TRACER_STATE_BYTES_PER_PIXEL / (1024.0 * 1024.0);
+    double bytes_per_pixel = GPU_TRACER_STATE_BYTES_PER_PIXEL
+                             - GPU_TRACER_SQUARES_BYTES_PER_PIXEL * (TRACER_STATE_COUNT - tracer->state_count);
+    double mib = (double)tracer->width * tracer->height * bytes_per_pixel / (1024.0 * 1024.0);
     bool gib = mib >= 1024;
     return rt_error_set(error, RT_ERROR_RUNTIME,
                         "GPU: out of memory for the state of a %dx%d image (%.1f %s on the device; %s): give a "
@@ -363,13 +367,15 @@ static rt_status update_packed_scene(gpu_tracer *tracer, const uint32_t *texels,
     return gpu_check_gl("updating the packed scene", error);
 }
 
-GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], GLuint *framebuffer, int width, int height)
+GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], int count, GLuint *framebuffer, int width,
+                            int height)
 {
     GLenum draw_buffers[TRACER_STATE_COUNT];
-    glGenTextures(TRACER_STATE_COUNT, textures);
+    memset(textures, 0, TRACER_STATE_COUNT * sizeof *textures);
+    glGenTextures(count, textures);
     glGenFramebuffers(1, framebuffer);
     glBindFramebuffer(GL_FRAMEBUFFER, *framebuffer);
-    for (int target = 0; target < TRACER_STATE_COUNT; target++) {
+    for (int target = 0; target < count; target++) {
         /* Nearest filtering: an integer texture with the default (mipmapped, linear) filter
          * is incomplete, and texelFetch reads zeros from it. */
         glBindTexture(GL_TEXTURE_2D, textures[target]);
@@ -379,7 +385,7 @@ GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], GLuint *framebu
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + target, GL_TEXTURE_2D, textures[target], 0);
         draw_buffers[target] = GL_COLOR_ATTACHMENT0 + target;
     }
-    glDrawBuffers(TRACER_STATE_COUNT, draw_buffers);
+    glDrawBuffers(count, draw_buffers);
     return glCheckFramebufferStatus(GL_FRAMEBUFFER);
 }
 
@@ -393,22 +399,23 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
                             "a side): render it in tiles of at most %d pixels a side",
                             tracer->width, tracer->height, max_size, max_size);
     const gpu_info *info = &tracer->context->info;
-    if (info->max_draw_buffers < TRACER_STATE_COUNT)
+    int count = tracer->state_count;
+    if (info->max_draw_buffers < count)
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: the tracer needs %d draw buffers, the device has %d",
-                            TRACER_STATE_COUNT, info->max_draw_buffers);
+                            count, info->max_draw_buffers);
     if (info->max_fragment_image_units < tracer->image_units
-        || info->max_images_and_outputs < tracer->image_units + TRACER_STATE_COUNT)
+        || info->max_images_and_outputs < tracer->image_units + count)
         return rt_error_set(error, RT_ERROR_RUNTIME,
                             "GPU: the tracer needs %d image units beside %d outputs, the device has %d (%d together)",
-                            tracer->image_units, TRACER_STATE_COUNT, info->max_fragment_image_units,
+                            tracer->image_units, count, info->max_fragment_image_units,
                             info->max_images_and_outputs);
     /* The test hook forces the two failures a real device shows only for huge images. */
     const char *forced = getenv("RTSPHERES_TEST_GPU_FAILURE");
     if (forced != NULL && strcmp(forced, "memory") == 0)
         return state_out_of_memory(tracer, "GL_OUT_OF_MEMORY", error);
     for (int set = 0; set < 2; set++) {
-        GLenum complete = gpu_create_state_set(tracer->state_textures[set], &tracer->framebuffers[set], tracer->width,
-                                               tracer->height);
+        GLenum complete = gpu_create_state_set(tracer->state_textures[set], count, &tracer->framebuffers[set],
+                                               tracer->width, tracer->height);
         if (forced != NULL && strcmp(forced, "framebuffer") == 0)
             complete = GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT;
         /* A texture the driver could not allocate leaves its attachment incomplete
@@ -422,7 +429,7 @@ static rt_status create_state(gpu_tracer *tracer, rt_error *error)
         }
         const GLfloat zero[4] = {0, 0, 0, 0};
         const GLuint zero_uint[4] = {0, 0, 0, 0};
-        for (int target = 0; target < TRACER_STATE_COUNT; target++) {
+        for (int target = 0; target < count; target++) {
             if (target == TRACER_STATE_COUNTERS)
                 glClearBufferuiv(GL_COLOR, target, zero_uint);
             else
@@ -583,6 +590,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     tracer->context = context;
     tracer->width = parameters->shader.image_size[0];
     tracer->height = parameters->shader.image_size[1];
+    tracer->state_count = TRACER_STATE_COUNT - ((parameters->omitted_features & GPU_OMIT_SQUARES) != 0);
     tracer->image_units = 1 + !(parameters->omitted_features & GPU_OMIT_LIGHT_GROUPS)
                           + !(parameters->omitted_features & GPU_OMIT_DIRECT_EMISSION);
     double step_start = clock_seconds();
@@ -675,7 +683,7 @@ rt_status gpu_tracer_run_pass(gpu_tracer *tracer, gpu_pass_report *report, rt_er
     glUseProgram(tracer->program);
     glBindBufferBase(GL_UNIFORM_BUFFER, TRACER_PARAMETER_BINDING, tracer->parameter_buffer);
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
-    for (int state = 0; state < TRACER_STATE_COUNT; state++) {
+    for (int state = 0; state < tracer->state_count; state++) {
         glActiveTexture(GL_TEXTURE0 + state);
         glBindTexture(GL_TEXTURE_2D, source_textures[state]);
     }
@@ -847,6 +855,8 @@ rt_status gpu_tracer_read_direct_emission(gpu_tracer *tracer, float *sums, rt_er
 
 rt_status gpu_tracer_read_squares(gpu_tracer *tracer, float *squares, rt_error *error)
 {
+    if (tracer->state_count <= TRACER_STATE_SQUARES)
+        return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: this tracer keeps no sums of squares (GPU_OMIT_SQUARES)");
     glActiveTexture(GL_TEXTURE0);
     rt_status status = read_state(tracer, TRACER_STATE_SQUARES, squares, error);
     if (status != RT_OK)

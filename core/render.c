@@ -31,6 +31,8 @@ uint64_t render_bytes_per_pixel(const render_options *options, int light_group_c
      * were; the result's four channels and the copy a region's crop makes. The other GL
      * copies below are gone the same way and kept the same way. */
     uint64_t bytes = GPU_TRACER_STATE_BYTES_PER_PIXEL + 4 * 16 + 2 * 16;
+    if (!options->variance && !options->full_tracer)   /* no squares in the state (gpu.h GPU_OMIT_SQUARES) */
+        bytes -= GPU_TRACER_SQUARES_BYTES_PER_PIXEL;
     if (options->aovs)           /* two AOV textures, their read-back, the 8-channel image twice */
         bytes += 2 * 16 + 2 * 16 + 16 + 2 * 32 + 4;
     if (options->variance)       /* the squares and GL's copy, the 3 layers, joined to the AOVs */
@@ -163,6 +165,8 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_LIGHT_GROUPS;
     if (!options->direct_emission)
         omitted |= GPU_OMIT_DIRECT_EMISSION;
+    if (!options->variance)
+        omitted |= GPU_OMIT_SQUARES;
     uint32_t lights = contents->light_types;
     if (!(lights & 1u << LIGHT_SPHERE))
         omitted |= GPU_OMIT_SPHERE_LIGHTS;

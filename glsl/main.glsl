@@ -30,7 +30,7 @@ PixelState read_state(ivec2 pixel, uint round)
     s.media = counters.z;
     s.accumulated = texelFetch(state_accumulated, pixel, 0);
     s.statistics = texelFetch(state_statistics, pixel, 0);
-    s.squares = texelFetch(state_squares, pixel, 0);
+    s.squares = HAS_SQUARES ? texelFetch(state_squares, pixel, 0) : vec4(0.0);
     s.finished_here = 0u;
     if (round != 0u && counters.w != round) {
         s.choice_memo = vec2(0.0);
@@ -53,7 +53,8 @@ void write_state(PixelState s, uint round)
     out_counters = uvec4(s.samples_started, s.bounce, s.media, round);
     out_accumulated = s.accumulated;
     out_statistics = s.statistics;
-    out_squares = s.squares;
+    if (HAS_SQUARES)   // else the state has no such texture (core/gpu.h GPU_OMIT_SQUARES)
+        out_squares = s.squares;
 }
 
 // Early fragment tests: a pixel that gpu_tracer_cull_finished marked (core/gpu.h) fails

@@ -22,6 +22,7 @@ const bool HAS_ALPHA_MASK = RTSPHERES_OMIT_ALPHA_MASK == 0;       // alpha-maske
 const bool HAS_VERTEX_COLORS = RTSPHERES_OMIT_VERTEX_COLORS == 0; // the vertex colour section
 const bool HAS_LIGHT_GROUPS = RTSPHERES_OMIT_LIGHT_GROUPS == 0;   // light group layers
 const bool HAS_DIRECT_EMISSION = RTSPHERES_OMIT_DIRECT_EMISSION == 0;   // the denoiser's direct emission sums
+const bool HAS_SQUARES = RTSPHERES_OMIT_SQUARES == 0;   // the sums of squares' state texture (--variance)
 const bool HAS_SPHERE_LIGHTS = RTSPHERES_OMIT_SPHERE_LIGHTS == 0;     // emissive spheres
 const bool HAS_TRIANGLE_LIGHTS = RTSPHERES_OMIT_TRIANGLE_LIGHTS == 0; // emissive triangles
 const bool HAS_DELTA_LIGHTS = RTSPHERES_OMIT_DELTA_LIGHTS == 0;       // point, spot and sun lights

@@ -8,8 +8,9 @@
 #include "support.h"
 
 
-/* Renders text with the given seed and options into *result (asserting success). */
-static void render_text(const char *text, uint32_t seed, bool aovs, render_result *result)
+/* Renders text with the given seed and options into *result (asserting success), with the
+ * variance layers unless without_variance. */
+static void render_text_with(const char *text, uint32_t seed, bool aovs, bool without_variance, render_result *result)
 {
     scene s;
     rt_error error = {{0}};
@@ -18,11 +19,17 @@ static void render_text(const char *text, uint32_t seed, bool aovs, render_resul
         fail_msg("%s", error.message);
     s.render.seed = seed;
     render_options options = render_options_defaults();
-    options.variance = true;
+    options.variance = !without_variance;
     options.aovs = aovs;
     if (render_scene(gpu_fixture_context, &s, &options, result, &error) != RT_OK)
         fail_msg("%s", error.message);
     scene_free(&s);
+}
+
+/* Renders text with the variance layers (render_text_with). */
+static void render_text(const char *text, uint32_t seed, bool aovs, render_result *result)
+{
+    render_text_with(text, seed, aovs, false, result);
 }
 
 /* The index of the layer called name in result->aovs. */
@@ -38,14 +45,16 @@ static int layer(const render_result *result, const char *name)
 /* A black sphere against a constant sky of colour (0.9, 0.5, 0.25): each sample is 0 or
  * the sky (the black surface absorbs every path), so a pixel whose mean is m has the
  * variance m (sky - m) exactly, and the silhouette's pixels lie strictly between. */
+static const char two_valued_scene[] = "render size 24 24 spp 16 depth 4 seed 1\n"
+                                       "camera from 0 0 4 at 0.8 0 0 up 0 1 0 fov 30\n"
+                                       "sky constant 0.9 0.5 0.25\n"
+                                       "material black lambertian 0 0 0\n"
+                                       "sphere 0 0 0 1 black\n";
+
 static void two_valued_samples(void **state)
 {
     (void)state;
-    static const char scene_text[] = "render size 24 24 spp 16 depth 4 seed 1\n"
-                                     "camera from 0 0 4 at 0.8 0 0 up 0 1 0 fov 30\n"
-                                     "sky constant 0.9 0.5 0.25\n"
-                                     "material black lambertian 0 0 0\n"
-                                     "sphere 0 0 0 1 black\n";
+    static const char *scene_text = two_valued_scene;
     static const float sky[3] = {0.9f, 0.5f, 0.25f};
     render_result result;
     render_text(scene_text, 1, false, &result);
@@ -147,9 +156,42 @@ static void predicts_the_spread_of_seeds(void **state)
     assert_true(spread / prediction > 0.1);
 }
 
+/* A render without the variance layers leaves the squares out of the tracer's state
+ * (gpu.h GPU_OMIT_SQUARES), a variant of its own in the context's program cache: the same
+ * context then renders the layers exactly as before (two_valued_samples again), and the
+ * colours do not differ. */
+static void squares_left_out_and_back(void **state)
+{
+    render_result plain;
+    render_text_with(two_valued_scene, 1, false, true, &plain);
+    assert_int_equal(plain.aovs.channels, 0);
+    two_valued_samples(state);
+    render_result with_layers;
+    render_text(two_valued_scene, 1, false, &with_layers);
+    assert_memory_equal(plain.image.pixels, with_layers.image.pixels, 24 * 24 * 4 * sizeof(float));
+    image_free(&plain.image);
+    image_free(&with_layers.image);
+    image_free(&with_layers.aovs);
+}
+
+/* The memory renders are tiled by counts the squares' state only where the state keeps it:
+ * with the variance layers (and their own bytes) or the whole tracer. */
+static void budget_counts_the_squares_where_kept(void **state)
+{
+    (void)state;
+    render_options plain = render_options_defaults(), variance = plain, full = plain;
+    variance.variance = true;
+    full.full_tracer = true;
+    assert_int_equal(render_bytes_per_pixel(&full, 0) - render_bytes_per_pixel(&plain, 0),
+                     GPU_TRACER_SQUARES_BYTES_PER_PIXEL);
+    assert_true(render_bytes_per_pixel(&variance, 0) > render_bytes_per_pixel(&full, 0));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(squares_left_out_and_back),
+        cmocka_unit_test(budget_counts_the_squares_where_kept),
         cmocka_unit_test(two_valued_samples),
         cmocka_unit_test(grey_channels_agree),
         cmocka_unit_test(predicts_the_spread_of_seeds),
