@@ -212,9 +212,10 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
                  fixed ? settings->integrator : 0, fixed ? settings->sky_type : 0, fixed ? settings->sampler : 0);
 }
 
+_Static_assert(GPU_OMIT_SQUARES << 1 == 1u << GPU_VARIANT_BITS, "GPU_VARIANT_BITS must cover every GPU_OMIT_* bit");
+
 /* The key of a variant in the context's program cache: the bits, and the constants
  * compiled in with GPU_FIX_UNIFORMS. */
-_Static_assert(GPU_OMIT_SQUARES << 1 == 1u << GPU_VARIANT_BITS, "GPU_VARIANT_BITS must cover every GPU_OMIT_* bit");
 static uint64_t variant_key(uint32_t omitted, const tracer_parameter_block *settings)
 {
     uint64_t key = omitted & ((1u << GPU_VARIANT_BITS) - 1u);
