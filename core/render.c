@@ -23,6 +23,13 @@ render_options render_options_defaults(void)
     return (render_options){0};
 }
 
+/* Whether the tracer keeps the sums of squares in its state (else gpu.h GPU_OMIT_SQUARES):
+ * for the variance layers, or in the whole tracer. */
+static bool keeps_squares(const render_options *options)
+{
+    return options->variance || options->full_tracer;
+}
+
 uint64_t render_bytes_per_pixel(const render_options *options, int light_group_count)
 {
     /* Read-back: the rgba sums and the statistics, 2 x 16 more where GL's bottom-up copies
@@ -31,7 +38,7 @@ uint64_t render_bytes_per_pixel(const render_options *options, int light_group_c
      * were; the result's four channels and the copy a region's crop makes. The other GL
      * copies below are gone the same way and kept the same way. */
     uint64_t bytes = GPU_TRACER_STATE_BYTES_PER_PIXEL + 4 * 16 + 2 * 16;
-    if (!options->variance && !options->full_tracer)   /* no squares in the state (gpu.h GPU_OMIT_SQUARES) */
+    if (!keeps_squares(options))
         bytes -= GPU_TRACER_SQUARES_BYTES_PER_PIXEL;
     if (options->aovs)           /* two AOV textures, their read-back, the 8-channel image twice */
         bytes += 2 * 16 + 2 * 16 + 16 + 2 * 32 + 4;
@@ -165,7 +172,7 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_LIGHT_GROUPS;
     if (!options->direct_emission)
         omitted |= GPU_OMIT_DIRECT_EMISSION;
-    if (!options->variance)
+    if (!keeps_squares(options))
         omitted |= GPU_OMIT_SQUARES;
     uint32_t lights = contents->light_types;
     if (!(lights & 1u << LIGHT_SPHERE))
