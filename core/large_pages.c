@@ -9,7 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
-#include <unistd.h>
 
 /* Whether the advice is wanted: not when RTSPHERES_NO_HUGE_PAGES is set to anything but
  * "0" or "". getenv neither allocates nor fails, so this is safe inside an allocator, and

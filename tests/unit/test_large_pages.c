@@ -4,7 +4,6 @@
 #include "large_pages.h"
 
 #include <sys/mman.h>
-#include <unistd.h>
 
 #include "support.h"
 
