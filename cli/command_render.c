@@ -250,12 +250,13 @@ static void show_summary(void *user, const render_job_image *image, const render
         else if (result->light_choice == RENDER_LIGHTS_BY_POWER)
             snprintf(choice, sizeof choice, " (chosen by power)");
         fprintf(stderr,
-                "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights%s; BVH depth %d, "
+                "rtspheres: scene: %u primitives (%u triangles), %u instances, %u lights%s; BVH depth %d%s, "
                 "built in %.3f s; packed %llu bytes (%.1f per triangle without images)%s; first pass "
                 "done %.3f s after start (context, parse, BVH, upload, compile); after it %.3f s for "
                 "%llu samples (%.3g us/sample); tracer program %s; %d of its passes skipped finished pixels\n",
                 result->primitive_count, result->triangle_count, result->instance_count, result->light_count,
-                choice, result->bvh_depth, result->bvh_build_seconds, (unsigned long long)result->packed_bytes,
+                choice, result->bvh_depth, result->threaded_walk ? " (walked as threaded lists)" : "",
+                result->bvh_build_seconds, (unsigned long long)result->packed_bytes,
                 result->triangle_count ? (double)geometry_bytes / result->triangle_count : 0.0,
                 result->reused_scene ? ", already on the device" : "", shown->first_pass, result->steady_seconds,
                 (unsigned long long)result->steady_samples,

@@ -144,6 +144,9 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *   GPU_OMIT_SQUARES         no per-channel sums of squares asked for (render_options.variance):
  *                            the pass state has 7 textures instead of 8 (TRACER_STATE_SQUARES
  *                            left out), and gpu_tracer_read_squares is an error
+ *   GPU_OMIT_STACK_WALK      the packed scene has the threaded walk (packed_layout.h; a
+ *                            scene of still spheres in one level): the sphere-only tracer
+ *                            walks its lists, with no stack, instead of the nodes
  *   GPU_OMIT_SPHERE_LIGHTS, GPU_OMIT_TRIANGLE_LIGHTS, GPU_OMIT_DELTA_LIGHTS (point, spot,
  *   GPU_OMIT_ENVIRONMENT_LIGHT  sun)  no light of that kind in the light section
  *   GPU_OMIT_MANY_LIGHTS     at most one light: no light to choose, no search for a hit
@@ -182,9 +185,10 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_LIGHT_TREE (1u << 24)
 #define GPU_OMIT_DIRECT_EMISSION (1u << 25)
 #define GPU_OMIT_SQUARES (1u << 26)
+#define GPU_OMIT_STACK_WALK (1u << 27)
 /* The bits a program variant is told apart by (core/gpu_tracer.c variant_key): every bit
  * above, GPU_FIX_UNIFORMS with them. */
-#define GPU_VARIANT_BITS 27
+#define GPU_VARIANT_BITS 28
 
 /* The tracer's parameter block as C sees it: the list of core/tracer_interface.h, each
  * GLSL type made a C type with its std140 alignment, so that the compiler lays the struct

@@ -199,6 +199,7 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
         {GPU_OMIT_LIGHT_TREE, "RTSPHERES_OMIT_LIGHT_TREE"},
         {GPU_OMIT_DIRECT_EMISSION, "RTSPHERES_OMIT_DIRECT_EMISSION"},
         {GPU_OMIT_SQUARES, "RTSPHERES_OMIT_SQUARES"},
+        {GPU_OMIT_STACK_WALK, "RTSPHERES_OMIT_STACK_WALK"},
     };
     bool fixed = (omitted & GPU_FIX_UNIFORMS) != 0;
     size_t used = 0;
@@ -212,7 +213,7 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
                  fixed ? settings->integrator : 0, fixed ? settings->sky_type : 0, fixed ? settings->sampler : 0);
 }
 
-_Static_assert(GPU_OMIT_SQUARES << 1 == 1u << GPU_VARIANT_BITS, "GPU_VARIANT_BITS must cover every GPU_OMIT_* bit");
+_Static_assert(GPU_OMIT_STACK_WALK << 1 == 1u << GPU_VARIANT_BITS, "GPU_VARIANT_BITS must cover every GPU_OMIT_* bit");
 
 /* The key of a variant in the context's program cache: the bits, and the constants
  * compiled in with GPU_FIX_UNIFORMS. */

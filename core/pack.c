@@ -122,6 +122,9 @@ static rt_status plan_layout(packer *p, rt_error *error)
         layout->light_tree_nodes = 2 * layout->light_count - 1;
         after_lights += layout->light_tree_nodes * PACKED_LIGHT_TREE_NODE_STRIDE;
     }
+    layout->threaded_items = pack_threaded_items(p);
+    layout->threaded_offset = layout->threaded_items ? after_lights : 0;
+    after_lights += layout->threaded_items * PACKED_THREADED_ORDERS * PACKED_THREADED_ITEM_STRIDE;
     layout->pixel_offset = after_lights;
     uint64_t image_pixels = 0;
     for (int i = 0; i < s->image_count; i++)
@@ -163,6 +166,8 @@ static void write_header(packer *p)
     out->light_count = (uint32_t)l->light_count;
     out->area_light_count = (uint32_t)l->area_light_count;
     out->light_tree_offset = (uint32_t)l->light_tree_offset;
+    out->threaded_offset = (uint32_t)l->threaded_offset;
+    out->threaded_items = (uint32_t)l->threaded_items;
     uint32_t environment_offset = (uint32_t)l->environment_offset;
     put_texel(p->texels, 0, PACKED_MAGIC, PACKED_LAYOUT_VERSION, out->material_offset, out->material_count);
     put_texel(p->texels, 1, out->primitive_offset, out->primitive_count, out->node_offset, out->node_count);
@@ -170,7 +175,7 @@ static void write_header(packer *p)
     put_texel(p->texels, 3, out->texture_offset, out->texture_count, out->image_offset, out->image_count);
     put_texel(p->texels, 4, out->light_offset, out->light_count, environment_offset, out->area_light_count);
     put_texel(p->texels, 5, out->shape_offset, out->vertex_offset, out->uv_offset, out->vertex_count);
-    put_texel(p->texels, 6, out->color_offset, out->light_tree_offset, 0, 0);
+    put_texel(p->texels, 6, out->color_offset, out->light_tree_offset, out->threaded_offset, out->threaded_items);
 }
 
 /* Allocates the packer's per-object, per-instance and per-mesh arrays. */
@@ -229,6 +234,7 @@ rt_status pack_scene(const scene *s, const pack_options *options, packed_scene *
         write_header(&p);
         pack_write_materials(&p);
         pack_write_primitives(&p);
+        pack_write_threaded(&p);
         pack_write_vertices(&p);
         status = pack_write_lights(&p, error);
     }

@@ -54,6 +54,9 @@ typedef struct pack_options {
     bool keep_instances;     /* true: only identity placements and emitters join the top
                               * level, every other placement stays an instance (the rule
                               * before baking; for tests and measurements) */
+    bool no_threaded_walk;   /* true: no threaded walk section (packed_layout.h), so the
+                              * tracer walks the nodes with its stack (for tests and
+                              * measurements) */
 } pack_options;
 
 /* What a packed scene holds, noted by each section's writer as it writes: render.c
@@ -95,6 +98,8 @@ typedef struct packed_scene {
     uint32_t light_tree_offset;                 /* PACKED_NONE: no light tree (at most
                                                  * LIGHT_LOCAL_CHOICE_MAX lights) */
     uint32_t light_tree_depth;                  /* its deepest leaf (0: none) */
+    uint32_t threaded_offset, threaded_items;   /* the threaded walk's lists (0 items:
+                                                 * none; packed_layout.h) */
     uint32_t default_material;
     uint32_t triangle_count;     /* triangles stored (mesh triangles once per object) */
     int bvh_depth;               /* deepest level of any BVH */

@@ -106,6 +106,79 @@ void pack_write_primitives(packer *p)
     }
 }
 
+uint64_t pack_threaded_items(const packer *p)
+{
+    const built_tree *top = &p->top;
+    if (p->options->no_threaded_walk || p->packed_instances > 0 || top->primitives.count == 0)
+        return 0;
+    for (uint32_t i = 0; i < top->primitives.count; i++)
+        if (top->primitives.items[i].type != PRIMITIVE_SPHERE)
+            return 0;
+    uint64_t interior = 0;
+    for (uint32_t n = 0; n < top->tree.node_count; n++)
+        interior += top->tree.nodes[n].count == 0;
+    uint64_t items = interior + top->primitives.count;
+    return items <= PACKED_THREADED_MAX_ITEMS ? items : 0;
+}
+
+/* Whether a ray of octant (packed_layout.h "threaded walk") meets an interior node's right
+ * child first: along the axis on which the children's centres lie farthest apart, the
+ * child on the ray's side of the other comes second. */
+static bool right_child_first(const bvh_node *left, const bvh_node *right, int octant)
+{
+    int axis = 0;
+    float widest = -1;
+    for (int a = 0; a < 3; a++) {
+        float apart = fabsf((right->box.min[a] + right->box.max[a]) - (left->box.min[a] + left->box.max[a]));
+        if (apart > widest) {
+            widest = apart;
+            axis = a;
+        }
+    }
+    bool right_above = right->box.min[axis] + right->box.max[axis] > left->box.min[axis] + left->box.max[axis];
+    bool negative = (octant >> axis) & 1;
+    return right_above == negative;
+}
+
+/* Writes node n's subtree of the top BVH into octant's list at list (its first texel) from
+ * item on, depth first; returns the item after it. Recursion is as deep as the BVH
+ * (BVH_MAX_DEPTH). */
+static uint32_t write_threaded_subtree(packer *p, uint32_t n, int octant, uint64_t list, uint32_t item)
+{
+    const built_tree *top = &p->top;
+    const bvh_node *node = &top->tree.nodes[n];
+    if (node->count > 0) {
+        for (uint32_t k = 0; k < node->count; k++, item++) {
+            uint32_t slot = top->primitive_base + node->first + k;
+            const uint32_t *sphere = &p->texels[4 * (p->layout.primitive_offset + slot)];   /* (centre, radius) */
+            uint64_t base = list + (uint64_t)item * PACKED_THREADED_ITEM_STRIDE;
+            put_texel(p->texels, base, sphere[0], sphere[1], sphere[2], item + 1);
+            put_texel(p->texels, base + 1, sphere[3], 0, 0, THREADED_SPHERE | slot);
+        }
+        return item;
+    }
+    uint32_t own = item++;
+    bool right_first = right_child_first(&top->tree.nodes[node->first], &top->tree.nodes[node->first + 1], octant);
+    item = write_threaded_subtree(p, node->first + right_first, octant, list, item);
+    item = write_threaded_subtree(p, node->first + !right_first, octant, list, item);
+    uint64_t base = list + (uint64_t)own * PACKED_THREADED_ITEM_STRIDE;
+    put_texel(p->texels, base, float_bits(node->box.min[0]), float_bits(node->box.min[1]), float_bits(node->box.min[2]),
+              item);
+    put_texel(p->texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
+              float_bits(node->box.max[2]), 0);
+    return item;
+}
+
+void pack_write_threaded(packer *p)
+{
+    const pack_layout *layout = &p->layout;
+    for (int octant = 0; octant < PACKED_THREADED_ORDERS && layout->threaded_items > 0; octant++)
+        write_threaded_subtree(p, 0, octant,
+                               layout->threaded_offset
+                                   + (uint64_t)octant * layout->threaded_items * PACKED_THREADED_ITEM_STRIDE,
+                               0);
+}
+
 uint32_t packed_encode_normal(const float normal[3])
 {
     float sum = fabsf(normal[0]) + fabsf(normal[1]) + fabsf(normal[2]);

@@ -86,6 +86,7 @@ typedef struct pack_layout {
     uint64_t environment_offset, environment_texels;
     uint64_t light_tree_offset, light_tree_nodes;   /* PACKED_NONE and 0: no light tree */
     uint64_t pixel_offset;                        /* image pixels, after all the records */
+    uint64_t threaded_offset, threaded_items;     /* 0 and 0: no threaded walk */
     uint64_t texel_count;
 } pack_layout;
 
@@ -158,6 +159,15 @@ rt_status pack_order_vertices(packer *p, uint32_t *vertex_count, rt_error *error
 
 /* Writes every BVH's primitive records, their info and shape records, and its nodes. */
 void pack_write_primitives(packer *p);
+
+/* The number of items of the threaded walk (packed_layout.h "threaded walk") the packer
+ * writes for this scene: its top-level interior nodes and spheres, or 0 when the scene is
+ * not still spheres in one level, the lists would be too long, or the options ask for
+ * none (pack_geometry.c). */
+uint64_t pack_threaded_items(const packer *p);
+
+/* Writes the threaded walk's lists after the primitives and nodes (pack_geometry.c). */
+void pack_write_threaded(packer *p);
 
 /* Whether the scene needs the vertex colour section: a material with vertex_colors used
  * by a mesh with colours (packed_layout.h "colours"). */

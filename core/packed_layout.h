@@ -31,6 +31,8 @@
  *   colours     vertex colours, two vertices to a texel (only when a material uses them)
  *   nodes       PACKED_NODE_STRIDE texels each; the two children of an interior node are
  *               contiguous (left = first, right = first + 1)
+ *   threaded    the BVH again as PACKED_THREADED_ORDERS lists of items, one per ray octant
+ *               (only for scenes of still spheres in one level; see there)
  *   instances   PACKED_INSTANCE_STRIDE texels each
  *   textures    PACKED_TEXTURE_STRIDE texels each
  *   images      PACKED_IMAGE_STRIDE texels each (a record), pixels elsewhere in the section
@@ -43,7 +45,7 @@
 #define RT_PACKED_LAYOUT_H
 
 /* Bumped whenever a record below changes meaning. */
-#define PACKED_LAYOUT_VERSION 6
+#define PACKED_LAYOUT_VERSION 7
 #define PACKED_NONE 4294967295u
 
 /* ---- header (7 texels), field i is component i % 4 of texel i / 4 */
@@ -75,6 +77,8 @@
 #define PACKED_HEADER_VERTEX_COUNT 23
 #define PACKED_HEADER_COLOR_OFFSET 24    /* PACKED_NONE: no vertex colour section */
 #define PACKED_HEADER_LIGHT_TREE_OFFSET 25   /* PACKED_NONE: no light tree */
+#define PACKED_HEADER_THREADED_OFFSET 26     /* the threaded walk (see there); 0 items: none */
+#define PACKED_HEADER_THREADED_ITEMS 27
 
 /* ---- materials: 6 texels
  *   texel 0 = (type tag | flags, albedo.r, albedo.g, albedo.b)    albedo: pbr's base colour
@@ -163,6 +167,27 @@
  * traversal stack keeps first and count in one word (glsl/traverse.glsl). */
 #define PACKED_NODE_STRIDE 2
 #define PACKED_FIRST_BITS 29
+
+/* ---- threaded walk: PACKED_THREADED_ORDERS lists of PACKED_HEADER_THREADED_ITEMS items,
+ * PACKED_THREADED_ITEM_STRIDE texels an item, list o at threaded_offset + o x items x
+ * stride. Written only for a scene of still spheres in one BVH level (no instances, no
+ * other primitive) of at most PACKED_THREADED_MAX_ITEMS items; the tracer's sphere-only
+ * variants walk it instead of the nodes (glsl/traverse.glsl trace_threaded). Each list is
+ * the top-level BVH in depth-first order, with the children of every interior node in the
+ * order a ray of octant o meets them along the axis that separates their centres most
+ * (octant bit k set: direction component k negative), and every leaf replaced by its
+ * spheres. An item:
+ *   interior node: (box_min.xyz, skip), (box_max.xyz, 0)
+ *   sphere:        (centre.xyz, skip), (radius, 0, 0, THREADED_SPHERE | slot)
+ * skip is the index of the item after its subtree (a sphere's: the next item), where a
+ * walk goes on when the box is missed; a box hit goes on at the next item. The walk ends
+ * at index items. slot is the sphere's primitive slot (below 2^PACKED_FIRST_BITS). No
+ * stack: a walk is one index (docs/performance.md, the log). */
+#define PACKED_THREADED_ORDERS 8
+#define PACKED_THREADED_ITEM_STRIDE 2
+#define PACKED_THREADED_MAX_ITEMS 262144
+#define THREADED_SPHERE 2147483648u
+#define THREADED_SLOT_MASK 2147483647u
 
 /* ---- instances: 5 texels
  *   texel 0 = (first, material override or PACKED_NONE, flags, count): first and count

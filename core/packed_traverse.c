@@ -321,6 +321,43 @@ bool packed_shadow_blocked(const packed_scene *packed, const float origin[3], co
     return walk(packed, origin, direction, time, t_max, true, light_slot, volumes, hit);
 }
 
+bool packed_threaded_walk(const packed_scene *packed, const float origin[3], const float direction[3], float t_max,
+                          bool shadow, uint32_t light_slot, packed_hit *hit, uint32_t *items_visited)
+{
+    hit->t = t_max;
+    hit->primitive = PACKED_NONE;
+    hit->instance = PACKED_NONE;
+    if (items_visited != NULL)
+        *items_visited = 0;
+    uint32_t items = packed->threaded_items;
+    if (items == 0)
+        return false;
+    moving_ray ray;
+    ray_set(&ray, (float *)origin, (float *)direction);
+    uint32_t octant = (direction[0] < 0) | (direction[1] < 0) << 1 | (direction[2] < 0) << 2;
+    uint32_t list = packed->threaded_offset + octant * items * PACKED_THREADED_ITEM_STRIDE;
+    for (uint32_t item = 0; item < items;) {
+        uint32_t base = list + item * PACKED_THREADED_ITEM_STRIDE;
+        if (items_visited != NULL)
+            ++*items_visited;
+        uint32_t tag = packed_uint(packed, base + 1, 3);
+        if (!(tag & THREADED_SPHERE)) {
+            item = intersect_box(packed, base, base + 1, &ray, hit->t) < INFINITY ? item + 1 : packed_uint(packed, base, 3);
+            continue;
+        }
+        vec3 center = {packed_float(packed, base, 0), packed_float(packed, base, 1), packed_float(packed, base, 2)};
+        float t = intersect_sphere(center, packed_float(packed, base + 1, 0), ray.origin, ray.direction, hit->t);
+        if (t < hit->t) {
+            hit->t = t;
+            hit->primitive = tag & THREADED_SLOT_MASK;
+            if (shadow && hit->primitive != light_slot)
+                return true;
+        }
+        item++;
+    }
+    return false;
+}
+
 uint32_t packed_media_at(const packed_scene *packed, const float point[3])
 {
     /* Parity along one ray: a closed boundary that the ray from the point crosses an odd

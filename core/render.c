@@ -131,7 +131,7 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
  * is none and the camera is in none, no textures when there is none and no material has a
  * normal map; primitive types, emitters, the pbr material, alpha masks and vertex colours
  * as the packed records (every BVH level) hold them; light and material kinds as the light
- * and material sections hold them. The --full-tracer option asks for 0:
+ * and material sections hold them; the stack's walk where the packer wrote the threaded one. The --full-tracer option asks for 0:
  * everything, read from uniforms. */
 static uint32_t omitted_features(const packed_scene *packed, const render_options *options, uint32_t camera_media)
 {
@@ -174,6 +174,8 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_DIRECT_EMISSION;
     if (!keeps_squares(options))
         omitted |= GPU_OMIT_SQUARES;
+    if (packed->threaded_items > 0)
+        omitted |= GPU_OMIT_STACK_WALK;
     uint32_t lights = contents->light_types;
     if (!(lights & 1u << LIGHT_SPHERE))
         omitted |= GPU_OMIT_SPHERE_LIGHTS;
@@ -577,6 +579,7 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     tracer_parameters(s, &frame, options, traced, &parameters);
     parameters.shader.camera_media = packed_media_at(&packed, s->camera.look_from);
     parameters.omitted_features = omitted_features(&packed, options, parameters.shader.camera_media);
+    result->threaded_walk = (parameters.omitted_features & GPU_OMIT_STACK_WALK) != 0;
     *pass_work_budget = parameters.shader.pass_work_budget;
     *samples_resumed = 0;
     float *sums = NULL;

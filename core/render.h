@@ -191,6 +191,8 @@ typedef struct render_result {
     int culled_passes;           /* passes that skipped finished pixels (gpu.h gpu_tracer_cull_finished) */
     render_stop_reason stop_reason;
     int bvh_depth;
+    bool threaded_walk;          /* the tracer walked the BVH as threaded lists, no stack
+                                  * (packed_layout.h "threaded walk"; still spheres alone) */
     double bvh_build_seconds;
     uint64_t packed_bytes;       /* the whole packed scene, images included */
     uint64_t image_bytes;        /* of which image pixels */

@@ -33,6 +33,7 @@ uint light_count;    // the scene's lights; an integrator narrows it to what it 
 uint environment_offset;
 uint color_offset;   // the vertex colour section, NONE when there is none
 uint light_tree_offset;   // the light tree, NONE when there is none
+uint threaded_offset, threaded_items;   // the threaded walk's lists (glsl/traverse.glsl trace_threaded)
 
 // Reads the packed scene's header (packed_layout.h "header") into the globals above.
 void read_header()
@@ -58,6 +59,8 @@ void read_header()
     uvec4 header6 = packed_texel(6u);
     color_offset = HAS_VERTEX_COLORS ? header6.x : NONE;
     light_tree_offset = HAS_LIGHT_TREE ? header6.y : NONE;
+    threaded_offset = header6.z;
+    threaded_items = header6.w;
 }
 
 // A vertex normal from its octahedral encoding (core/pack.h packed_encode_normal).

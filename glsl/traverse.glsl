@@ -77,6 +77,74 @@ Hit no_hit(float t_max)
     return hit;
 }
 
+// The first texel of the threaded walk's list for rays along direction: its octant's.
+uint threaded_list(vec3 direction)
+{
+    uint octant = (direction.x < 0.0 ? 1u : 0u) | (direction.y < 0.0 ? 2u : 0u) | (direction.z < 0.0 ? 4u : 0u);
+    return threaded_offset + octant * threaded_items * uint(PACKED_THREADED_ITEM_STRIDE);
+}
+
+// One item of the threaded walk (core/packed_layout.h "threaded walk") of the list at
+// list: its box and its sphere both tested (llvmpipe runs both anyway,
+// docs/performance.md), a sphere nearer than hit made the hit (sphere_hit true). Returns
+// the next item: the one after a sphere or a box hit, the item's skip after a box missed.
+uint threaded_step(TraversalRay ray, uint list, uint item, inout Hit hit, out bool sphere_hit)
+{
+    uint base = list + item * uint(PACKED_THREADED_ITEM_STRIDE);
+    uvec4 first_texel = packed_texel(base), second_texel = packed_texel(base + 1u);
+    bool sphere = (second_texel.w & THREADED_SPHERE) != 0u;
+    float box_entry = intersect_box(packed_xyz(first_texel), packed_xyz(second_texel), ray.origin,
+                                    ray.inverse_direction, hit.t);
+    float t = intersect_sphere_along(packed_xyz(first_texel), uintBitsToFloat(second_texel.x), ray.origin, ray.unit,
+                                     ray.direction_length, hit.t);
+    sphere_hit = sphere && t < hit.t;
+    if (sphere_hit) {
+        hit.t = t;
+        hit.primitive = second_texel.w & THREADED_SLOT_MASK;
+    }
+    return sphere || box_entry < INFINITY ? item + 1u : first_texel.w;
+}
+
+// trace_rays for the sphere-only variants with the threaded walk (THREADED_WALK): the
+// shadow ray, then the path ray, each along the list of its direction's octant, one item
+// an iteration (threaded_step). No stack: an iteration is two fetches at one address and
+// the two tests, where the stack's walk makes four fetches, two box tests, a sphere test
+// and a per-lane stack write and read. Two loops, unlike the stack's walk: this loop is
+// short, and one loop for both rays (changing rays inside it) was 5% slower on a lit
+// scene than the stack's walk, two loops 20% faster (docs/performance.md, the log).
+void trace_threaded(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 path_origin, vec3 path_direction,
+                    float path_t_max, out bool blocked, out Hit shadow_hit, out Hit path_hit)
+{
+    blocked = false;
+    shadow_hit = no_hit(shadow.t_max);
+    path_hit = no_hit(path_t_max);
+    bool sphere_hit;
+    // Without light sampling there is never a shadow ray: a constant, so that its loop
+    // is left out.
+    if (HAS_DIRECT_LIGHT && shadow_wanted) {
+        TraversalRay ray = traversal_ray(shadow.origin, shadow.direction);
+        uint list = threaded_list(shadow.direction);
+        uint item = 0u;
+        while (count_work()) {
+            item = threaded_step(ray, list, item, shadow_hit, sphere_hit);
+            // A shadow ray's blocker: any sphere but its light.
+            blocked = sphere_hit && shadow_hit.primitive != shadow.light_slot;
+            if (item >= threaded_items || blocked)
+                break;
+        }
+    }
+    if (path_wanted) {
+        TraversalRay ray = traversal_ray(path_origin, path_direction);
+        uint list = threaded_list(path_direction);
+        uint item = 0u;
+        while (count_work()) {
+            item = threaded_step(ray, list, item, path_hit, sphere_hit);
+            if (item >= threaded_items)
+                break;
+        }
+    }
+}
+
 // Walks the shadow ray (when shadow_wanted) and then the path ray (when path_wanted)
 // through the top-level BVH and, through instance records, the objects' BVHs, nearer
 // child first, with one explicit stack. The path ray gets its nearest hit closer than
@@ -94,6 +162,11 @@ void trace_rays(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 pat
     path_hit = no_hit(path_t_max);
     if (node_count == 0u || !(shadow_wanted || path_wanted))
         return;
+    if (THREADED_WALK) {
+        trace_threaded(shadow_wanted, shadow, path_wanted, path_origin, path_direction, path_t_max, blocked,
+                       shadow_hit, path_hit);
+        return;
+    }
     TraversalRay shadow_world = traversal_ray(shadow.origin, shadow.direction);
     TraversalRay path_world = traversal_ray(path_origin, path_direction);
     uvec4 root_low = packed_texel(node_offset), root_high = packed_texel(node_offset + 1u);

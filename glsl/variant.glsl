@@ -23,6 +23,7 @@ const bool HAS_VERTEX_COLORS = RTSPHERES_OMIT_VERTEX_COLORS == 0; // the vertex 
 const bool HAS_LIGHT_GROUPS = RTSPHERES_OMIT_LIGHT_GROUPS == 0;   // light group layers
 const bool HAS_DIRECT_EMISSION = RTSPHERES_OMIT_DIRECT_EMISSION == 0;   // the denoiser's direct emission sums
 const bool HAS_SQUARES = RTSPHERES_OMIT_SQUARES == 0;   // the sums of squares' state texture (--variance)
+const bool HAS_STACK_WALK = RTSPHERES_OMIT_STACK_WALK == 0;   // the nodes walked with a stack (else the threaded lists)
 const bool HAS_SPHERE_LIGHTS = RTSPHERES_OMIT_SPHERE_LIGHTS == 0;     // emissive spheres
 const bool HAS_TRIANGLE_LIGHTS = RTSPHERES_OMIT_TRIANGLE_LIGHTS == 0; // emissive triangles
 const bool HAS_DELTA_LIGHTS = RTSPHERES_OMIT_DELTA_LIGHTS == 0;       // point, spot and sun lights
@@ -41,6 +42,8 @@ const bool HAS_AREA_LIGHTS = HAS_SPHERE_LIGHTS || HAS_FLAT_LIGHTS;
 const bool ONLY_SPHERES = !HAS_TRIANGLES && !HAS_QUADS && !HAS_MOVING_SPHERES && !HAS_INSTANCES;
 const bool ONLY_TRIANGLES = !HAS_SPHERES && !HAS_QUADS && !HAS_INSTANCES;
 const bool ONLY_QUADS = !HAS_SPHERES && !HAS_TRIANGLES && !HAS_INSTANCES;
+// The packer writes the threaded walk only for still spheres in one level (core/pack.h).
+const bool THREADED_WALK = !HAS_STACK_WALK && ONLY_SPHERES;
 
 // The integrator, the sky kind and the sampler: compiled in as constants (RTSPHERES_FIX_UNIFORMS 1,
 // gpu.h GPU_FIX_UNIFORMS), or read from the parameter block (the full tracer).

@@ -35,8 +35,11 @@ check() {
 }
 
 # Spheres only: no lights, volumes, textures, triangles, moving spheres, instances or
-# emitters; a gradient sky.
+# emitters; a gradient sky. Still spheres in one level: the BVH walked along the threaded
+# lists (core/packed_layout.h), where the full tracer walks it with its stack.
 check weekend scenes/weekend.txt --max-depth 16
+# The same spheres under a sphere light: shadow rays along the threaded lists too.
+check weekend-lamp tests/render/scenes/weekend-lamp.txt --max-depth 16
 # Lights, but light sampling off: the direct-lighting code left out; point, spot and sun
 # lights, quads and emitters kept.
 check lights-without-sampling scenes/lights.txt --light-sampling off

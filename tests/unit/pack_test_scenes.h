@@ -1,8 +1,11 @@
 /* pack_test_scenes.h: the test data the packer's unit tests share (test_pack.c,
- * test_pack_lights.c): a reproducible random number, materials and a random scene of
- * world spheres. Include after support.h. */
+ * test_pack_lights.c, test_pack_threaded.c): a reproducible random number, materials, a
+ * random scene of world spheres, random rays and the brute-force sphere test in double.
+ * Include after support.h. */
 #ifndef RT_PACK_TEST_SCENES_H
 #define RT_PACK_TEST_SCENES_H
+
+#include <math.h>
 
 #include "scene.h"
 
@@ -46,6 +49,53 @@ static inline void random_scene(scene *s, int sphere_count, uint64_t seed)
             .material = i % 4,
         };
         assert_true(scene_add_sphere(s, &sphere) >= 0);
+    }
+}
+
+/* Nearest root in (0, infinity) of a sphere (centre, radius) along a unit direction, in
+ * double, or INFINITY. */
+static inline double sphere_hit(const float *sphere, const double origin[3], const double direction[3])
+{
+    double oc[3], b = 0, c = 0;
+    for (int i = 0; i < 3; i++) {
+        oc[i] = origin[i] - sphere[i];
+        b += oc[i] * direction[i];
+        c += oc[i] * oc[i];
+    }
+    c -= (double)sphere[3] * sphere[3];
+    double discriminant = b * b - c;
+    if (discriminant < 0)
+        return INFINITY;
+    double root = sqrt(discriminant);
+    if (-b - root > 0)
+        return -b - root;
+    if (-b + root > 0)
+        return -b + root;
+    return INFINITY;
+}
+
+/* A random unit ray around random_scene's spheres, in float (of, df) and the same values
+ * in double (o, d); every tenth lies in a coordinate plane or along an axis (zero
+ * direction components, where the box test divides by zero). */
+static inline void random_ray(int r, double o[3], double d[3], float of[3], float df[3])
+{
+    double length = 0;
+    do {
+        length = 0;
+        for (int i = 0; i < 3; i++) {
+            o[i] = random_unit() * 30 - 15;
+            d[i] = random_unit() * 2 - 1;
+            if (r % 10 == 0 && i != r % 3)
+                d[i] = 0;
+            length += d[i] * d[i];
+        }
+    } while (length == 0);
+    length = sqrt(length);
+    for (int i = 0; i < 3; i++) {
+        of[i] = (float)o[i];
+        df[i] = (float)(d[i] / length);
+        o[i] = of[i];
+        d[i] = df[i];
     }
 }
 

@@ -69,8 +69,13 @@ static void header_and_materials_round_trip(void **state)
     assert_true(packed.light_count > LIGHT_LOCAL_CHOICE_MAX);
     assert_int_equal(packed.light_tree_offset, packed.light_offset + packed.light_count * PACKED_LIGHT_STRIDE);
     assert_int_equal(packed_uint(&packed, 6, 1), packed.light_tree_offset);
+    /* Still spheres in one level: the threaded walk's lists follow (packed_layout.h). */
+    uint32_t after_tree = packed.light_tree_offset + (2 * packed.light_count - 1) * PACKED_LIGHT_TREE_NODE_STRIDE;
+    assert_int_equal(packed.threaded_offset, after_tree);
+    assert_int_equal(packed_uint(&packed, 6, 2), packed.threaded_offset);
+    assert_int_equal(packed_uint(&packed, 6, 3), packed.threaded_items);
     assert_int_equal(packed.texel_count,
-                     packed.light_tree_offset + (2 * packed.light_count - 1) * PACKED_LIGHT_TREE_NODE_STRIDE);
+                     after_tree + packed.threaded_items * PACKED_THREADED_ORDERS * PACKED_THREADED_ITEM_STRIDE);
     /* The default material is grey Lambertian. */
     uint32_t default_base = packed.material_offset + 4 * PACKED_MATERIAL_STRIDE;
     assert_int_equal(packed_uint(&packed, default_base, 0), MATERIAL_LAMBERTIAN);
@@ -135,27 +140,6 @@ static void every_sphere_packed_once_in_leaf_order(void **state)
     scene_free(&s);
 }
 
-/* Nearest hit of a sphere in double precision, or INFINITY. */
-static double sphere_hit(const float *sphere, const double origin[3], const double direction[3])
-{
-    double oc[3], b = 0, c = 0;
-    for (int i = 0; i < 3; i++) {
-        oc[i] = origin[i] - sphere[i];
-        b += oc[i] * direction[i];
-        c += oc[i] * oc[i];
-    }
-    c -= (double)sphere[3] * sphere[3];
-    double discriminant = b * b - c;
-    if (discriminant < 0)
-        return INFINITY;
-    double root = sqrt(discriminant);
-    if (-b - root > 0)
-        return -b - root;
-    if (-b + root > 0)
-        return -b + root;
-    return INFINITY;
-}
-
 static void packed_traversal_matches_brute_force(void **state)
 {
     (void)state;
@@ -166,25 +150,9 @@ static void packed_traversal_matches_brute_force(void **state)
         assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
         int hits = 0;
         for (int r = 0; r < 4000; r++) {
-            double origin[3], direction[3], length = 0;
-            for (int i = 0; i < 3; i++) {
-                origin[i] = random_unit() * 30 - 15;
-                direction[i] = random_unit() * 2 - 1;
-                if (r % 10 == 0 && i != r % 3)
-                    direction[i] = 0; /* axis-aligned rays: zero direction components */
-                length += direction[i] * direction[i];
-            }
-            if (length == 0)
-                continue;
-            length = sqrt(length);
+            double origin[3], direction[3];
             float origin_f[3], direction_f[3];
-            for (int i = 0; i < 3; i++) {
-                direction[i] /= length;
-                origin_f[i] = (float)origin[i];
-                direction_f[i] = (float)direction[i];
-                origin[i] = origin_f[i];
-                direction[i] = direction_f[i];
-            }
+            random_ray(r, origin, direction, origin_f, direction_f);
             double best = INFINITY;
             uint32_t best_slot = UINT32_MAX;
             for (uint32_t slot = 0; slot < packed.primitive_count; slot++) {
@@ -452,19 +420,7 @@ static void instanced_scene(scene *s, uint64_t seed)
  * and a unit direction, in float (of, df) and the same values in double (o, d). */
 static void random_test_ray(double o[3], double d[3], float of[3], float df[3])
 {
-    double length = 0;
-    for (int i = 0; i < 3; i++) {
-        o[i] = random_unit() * 30 - 15;
-        d[i] = random_unit() * 2 - 1;
-        length += d[i] * d[i];
-    }
-    length = sqrt(length);
-    for (int i = 0; i < 3; i++) {
-        of[i] = (float)o[i];
-        df[i] = (float)(d[i] / length);
-        o[i] = of[i];
-        d[i] = df[i];
-    }
+    random_ray(1, o, d, of, df);   /* ray 1: not one of the axis-aligned ones */
 }
 
 /* The packed traversal of one packed scene s finds the brute-force nearest hit (in
