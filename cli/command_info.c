@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "gpu.h"
+#include "large_pages.h"
 #include "version.h"
 
 static void print_help(FILE *stream)
@@ -114,6 +115,8 @@ int command_info(int argc, char **argv)
                info.software_threads, info.software_threads == 1 ? "" : "s");
     else if (info.threads_ignored)
         printf("CPU threads:      --threads does nothing on a hardware device\n");
+    printf("huge pages:       %s for large blocks (a 4 KiB page's first touch %.1f us; RTSPHERES_HUGE_PAGES)\n",
+           large_pages_advising() ? "yes" : "no", large_pages_fault_microseconds());
     printf("GL version:       %s\n", info.gl_version);
     printf("GLSL version:     %s\n", info.glsl_version);
     printf("max texture size: %d\n", info.max_texture_size);

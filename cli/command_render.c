@@ -10,6 +10,7 @@
 #include "clock.h"
 #include "commands.h"
 #include "gpu.h"
+#include "large_pages.h"
 #include "display_tev.h"
 #include "paths.h"
 #include "render_arguments.h"
@@ -316,6 +317,9 @@ static int open_gpu(const render_arguments *arguments, gpu_context **context)
     if (arguments->verbose && info.software)
         fprintf(stderr, "rtspheres: %d llvmpipe rasteriser thread%s\n", info.software_threads,
                 info.software_threads == 1 ? "" : "s");
+    if (arguments->verbose)
+        fprintf(stderr, "rtspheres: large blocks on huge pages: %s (a 4 KiB page's first touch %.1f us; core/large_pages.h)\n",
+                large_pages_advising() ? "yes" : "no", large_pages_fault_microseconds());
     return EXIT_OK;
 }
 

@@ -9,19 +9,61 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <time.h>
 
-/* Whether the advice is wanted: not when RTSPHERES_NO_HUGE_PAGES is set to anything but
- * "0" or "". getenv neither allocates nor fails, so this is safe inside an allocator, and
- * cheap next to the blocks it is asked for (a few hundred a render). */
-static int advice_wanted(void)
+/* 0: not measured yet; else the cost of a 4 KiB page's first touch in nanoseconds + 1. */
+static uint64_t fault_cost_code;
+
+double large_pages_fault_microseconds(void)
 {
-    const char *off = getenv("RTSPHERES_NO_HUGE_PAGES");
-    return off == NULL || off[0] == '\0' || strcmp(off, "0") == 0;
+    uint64_t code = __atomic_load_n(&fault_cost_code, __ATOMIC_RELAXED);
+    if (code == 0) {
+        /* Fresh pages of a mapping of our own, kept off huge pages, one write each: what
+         * the kernel charges for the pages a large block would get. Two threads may both
+         * measure; either answer will do. Nothing here allocates (this runs inside
+         * posix_memalign). */
+        enum { PAGES = 256, PAGE = 4096 };
+        double nanoseconds = 0;
+        char *probe = mmap(NULL, PAGES * PAGE, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (probe != MAP_FAILED) {
+            (void)madvise(probe, PAGES * PAGE, MADV_NOHUGEPAGE);
+            struct timespec start, end;
+            clock_gettime(CLOCK_MONOTONIC, &start);
+            for (int page = 0; page < PAGES; page++)
+                ((volatile char *)probe)[page * PAGE] = 1;
+            clock_gettime(CLOCK_MONOTONIC, &end);
+            munmap(probe, PAGES * PAGE);
+            nanoseconds = ((double)(end.tv_sec - start.tv_sec) * 1e9 + (double)(end.tv_nsec - start.tv_nsec)) / PAGES;
+        }
+        code = (uint64_t)(nanoseconds > 0 ? nanoseconds : 0) + 1;
+        __atomic_store_n(&fault_cost_code, code, __ATOMIC_RELAXED);
+    }
+    return (double)(code - 1) / 1000;
+}
+
+/* Whether a setting in the environment says yes (anything but "" and "0"). */
+static bool environment_says(const char *name, bool *value)
+{
+    const char *setting = getenv(name);
+    if (setting == NULL)
+        return false;
+    *value = setting[0] != '\0' && strcmp(setting, "0") != 0;
+    return true;
+}
+
+bool large_pages_advising(void)
+{
+    bool value;
+    if (environment_says("RTSPHERES_HUGE_PAGES", &value))
+        return value;
+    if (environment_says("RTSPHERES_NO_HUGE_PAGES", &value) && value)
+        return false;
+    return large_pages_fault_microseconds() >= LARGE_PAGES_SLOW_FAULT_MICROSECONDS;
 }
 
 void large_pages_advise(void *block, size_t bytes)
 {
-    if (block == NULL || bytes < LARGE_PAGES_MIN_BYTES || !advice_wanted())
+    if (block == NULL || bytes < LARGE_PAGES_MIN_BYTES || !large_pages_advising())
         return;
     const uintptr_t page = 4096;
     uintptr_t start = ((uintptr_t)block + page - 1) & ~(page - 1);
@@ -42,7 +84,7 @@ int posix_memalign(void **out, size_t alignment, size_t bytes)
     if (alignment == 0 || (alignment & (alignment - 1)) != 0 || alignment % sizeof(void *) != 0)
         return EINVAL;
     size_t rounded = (bytes + LARGE_PAGES_HUGE_BYTES - 1) & ~(LARGE_PAGES_HUGE_BYTES - 1);
-    bool whole_pages = bytes >= LARGE_PAGES_ROUNDED_BYTES && rounded >= bytes && advice_wanted();
+    bool whole_pages = bytes >= LARGE_PAGES_ROUNDED_BYTES && rounded >= bytes && large_pages_advising();
     void *block = whole_pages ? memalign(alignment > LARGE_PAGES_HUGE_BYTES ? alignment : LARGE_PAGES_HUGE_BYTES,
                                          rounded)
                               : memalign(alignment, bytes);

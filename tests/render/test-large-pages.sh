@@ -1,7 +1,7 @@
 #!/bin/sh
 # test-large-pages.sh: core/large_pages.h from the outside: the GL driver, loaded by EGL,
 # allocates through rtspheres' posix_memalign (so that its textures get the huge-page
-# advice), and the advice changes no pixel.
+# advice where it is given), and the advice changes no pixel.
 #   usage: sh tests/render/test-large-pages.sh PROGRAM SCRATCH_DIR
 . "$(dirname "$0")/lib.sh"
 
@@ -30,8 +30,8 @@ rm -f "$bindings".*
 
 # 512x512: each state texture (4 MB) is over LARGE_PAGES_MIN_BYTES, so it is advised.
 render_options="--size 512x512 --spp 2 --max-depth 8"
-if render "$scratch/advised.exr" && RTSPHERES_NO_HUGE_PAGES=1 render "$scratch/plain.exr"; then
-    same "huge pages change no pixel (512x512, with and without RTSPHERES_NO_HUGE_PAGES=1)" \
+if RTSPHERES_HUGE_PAGES=1 render "$scratch/advised.exr" && RTSPHERES_HUGE_PAGES=0 render "$scratch/plain.exr"; then
+    same "huge pages change no pixel (512x512, RTSPHERES_HUGE_PAGES=1 and 0)" \
         "$scratch/advised.exr" "$scratch/plain.exr"
 else
     fail "renders with and without huge pages" "a render failed"

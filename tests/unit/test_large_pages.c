@@ -1,6 +1,7 @@
 /* test_large_pages.c: core/large_pages.h: the process's posix_memalign keeps POSIX's
- * contract, and large blocks (only they, and not when turned off) carry the kernel's
- * huge-page advice, as /proc/self/smaps shows it (the "hg" VmFlag). */
+ * contract, and large blocks (only they, and only when asked for or where 4 KiB faults
+ * are slow) carry the kernel's huge-page advice, as /proc/self/smaps shows it (the "hg"
+ * VmFlag). */
 #include "large_pages.h"
 
 #include <sys/mman.h>
@@ -81,7 +82,7 @@ static void large_blocks_are_advised(void **state)
     (void)state;
     if (!kernel_has_huge_pages())
         skip_because(large_blocks_are_advised, "this kernel has no transparent huge pages");
-    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    setenv("RTSPHERES_HUGE_PAGES", "1", 1);
     void *large = NULL;
     assert_int_equal(posix_memalign(&large, 64, OWN_MAPPING_BYTES), 0);
     assert_true(advised((char *)large + OWN_MAPPING_BYTES / 2));
@@ -101,34 +102,71 @@ static void large_blocks_are_advised(void **state)
     large_pages_advise(mapping, 2 * LARGE_PAGES_MIN_BYTES);
     assert_true(advised(mapping));
     munmap(mapping, 2 * LARGE_PAGES_MIN_BYTES);
+    unsetenv("RTSPHERES_HUGE_PAGES");
 }
 
-/* RTSPHERES_NO_HUGE_PAGES=1 turns the advice off; "0" leaves it on. */
-static void advice_can_be_turned_off(void **state)
+/* Whether large_pages_advise advises a fresh mapping of our own. */
+static bool advises_a_mapping(void)
 {
-    (void)state;
-    if (!kernel_has_huge_pages())
-        skip_because(advice_can_be_turned_off, "this kernel has no transparent huge pages");
     size_t bytes = 2 * LARGE_PAGES_MIN_BYTES;
     char *mapping = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     assert_true(mapping != MAP_FAILED);
-    setenv("RTSPHERES_NO_HUGE_PAGES", "1", 1);
     large_pages_advise(mapping, bytes);
-    bool advised_when_off = advised(mapping);
-    setenv("RTSPHERES_NO_HUGE_PAGES", "0", 1);
-    large_pages_advise(mapping, bytes);
-    bool advised_when_on = advised(mapping);
-    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    bool result = advised(mapping);
     munmap(mapping, bytes);
-    assert_false(advised_when_off);
-    assert_true(advised_when_on);
+    return result;
+}
+
+/* RTSPHERES_HUGE_PAGES=1 asks for the advice and =0 forbids it, whatever a fault costs;
+ * RTSPHERES_NO_HUGE_PAGES=1 forbids it too. */
+static void environment_decides_when_set(void **state)
+{
+    (void)state;
+    if (!kernel_has_huge_pages())
+        skip_because(environment_decides_when_set, "this kernel has no transparent huge pages");
+    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    setenv("RTSPHERES_HUGE_PAGES", "1", 1);
+    bool when_asked = advises_a_mapping() && large_pages_advising();
+    setenv("RTSPHERES_NO_HUGE_PAGES", "1", 1);
+    bool asked_over_old_off = advises_a_mapping();
+    setenv("RTSPHERES_HUGE_PAGES", "0", 1);
+    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    bool when_forbidden = advises_a_mapping() || large_pages_advising();
+    unsetenv("RTSPHERES_HUGE_PAGES");
+    setenv("RTSPHERES_NO_HUGE_PAGES", "1", 1);
+    bool when_old_off = advises_a_mapping() || large_pages_advising();
+    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    assert_true(when_asked);
+    assert_true(asked_over_old_off);
+    assert_false(when_forbidden);
+    assert_false(when_old_off);
+}
+
+/* Unset, the measured cost of a 4 KiB fault decides: measured once (the same answer
+ * again), plausible (a fault costs more than nothing and less than a millisecond), and
+ * the advice given exactly from LARGE_PAGES_SLOW_FAULT_MICROSECONDS on. */
+static void fault_cost_decides_when_unset(void **state)
+{
+    (void)state;
+    unsetenv("RTSPHERES_HUGE_PAGES");
+    unsetenv("RTSPHERES_NO_HUGE_PAGES");
+    double cost = large_pages_fault_microseconds();
+    assert_true(cost > 0 && cost < 1000);
+    assert_true(large_pages_fault_microseconds() == cost);
+    bool slow = cost >= LARGE_PAGES_SLOW_FAULT_MICROSECONDS;
+    assert_int_equal(large_pages_advising(), slow);
+    if (kernel_has_huge_pages())
+        assert_int_equal(advises_a_mapping(), slow);
+    print_message("a 4 KiB page's first touch: %.2f us (huge pages %s)\n", cost, slow ? "advised" : "not advised");
 }
 
 /* large_pages_alloc and _calloc: image-sized arrays through the same path (aligned and
- * advised from LARGE_PAGES_ROUNDED_BYTES on), calloc's zeroes, and NULL on overflow. */
+ * advised from LARGE_PAGES_ROUNDED_BYTES on, where huge pages are asked for), calloc's
+ * zeroes, and NULL on overflow. */
 static void image_arrays_take_the_same_path(void **state)
 {
     (void)state;
+    setenv("RTSPHERES_HUGE_PAGES", "1", 1);
     size_t bytes = LARGE_PAGES_ROUNDED_BYTES * 3;
     unsigned char *block = large_pages_alloc(bytes);
     assert_non_null(block);
@@ -148,6 +186,7 @@ static void image_arrays_take_the_same_path(void **state)
         assert_int_equal(small[k], 0);
     free(small);
     assert_null(large_pages_calloc(SIZE_MAX / 2, 3));
+    unsetenv("RTSPHERES_HUGE_PAGES");
 }
 
 int main(void)
@@ -155,7 +194,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(posix_memalign_keeps_its_contract),
         cmocka_unit_test(large_blocks_are_advised),
-        cmocka_unit_test(advice_can_be_turned_off),
+        cmocka_unit_test(environment_decides_when_set),
+        cmocka_unit_test(fault_cost_decides_when_unset),
         cmocka_unit_test(image_arrays_take_the_same_path),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
