@@ -14,7 +14,8 @@
  * Defaults of render_options (zero means default):
  *   pass_work_budget: adaptive: starts at 64 work units per pixel per pass (a unit is
  *     one loop iteration of the tracer, a path segment counts 64: glsl/work.glsl) and is
- *     scaled after each pass so that a pass takes about target_pass_seconds, between 16
+ *     scaled after each pass (by at most 4x on a GPU, 16x on a CPU rasteriser) so that
+ *     a pass takes about target_pass_seconds, between 16
  *     and 16384 units and at most the device's gpu_info.max_pass_work_budget (on
  *     llvmpipe half its work cap, which keeps a SIMD vector under the 65,535-iteration
  *     loop cap: 3,128 units at 8 lanes; core/gpu.c set_work_limits). A non-zero value is

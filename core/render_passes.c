@@ -16,16 +16,24 @@
 #define DEFAULT_TARGET_PASS_SECONDS 0.25
 #define SOFTWARE_TARGET_PASS_SECONDS 2.0
 #define CULL_MIN_PIXELS (512 * 512)
+/* How far the budget may grow from one pass to the next: 4 on a GPU (a draw a watchdog
+ * could kill), 16 on a CPU rasteriser, where nothing kills a draw and the loop cap bounds
+ * the budget anyway (gpu.h max_pass_work_budget): from the first pass's 64 units the
+ * weekend at 1200x675 reaches the cap in its third pass instead of its fourth, 0.06-0.16 s
+ * sooner in all (docs/performance.md, the log). */
+#define DEFAULT_MOST_BUDGET_SCALE 4.0
+#define SOFTWARE_MOST_BUDGET_SCALE 16.0
 
 /* Moves the adaptive pass budget *budget towards a pass of target_seconds after a pass of
- * pass_seconds, within [MINIMUM_ADAPTIVE_BUDGET, most_budget], and gives it to the tracer. */
-static void adapt_pass_budget(gpu_tracer *tracer, double pass_seconds, double target_seconds, double most_budget,
-                              double *budget)
+ * pass_seconds, by at most a factor of most_scale, within [MINIMUM_ADAPTIVE_BUDGET,
+ * most_budget], and gives it to the tracer. */
+static void adapt_pass_budget(gpu_tracer *tracer, double pass_seconds, double target_seconds, double most_scale,
+                              double most_budget, double *budget)
 {
-    /* Pass time grows roughly linearly with the budget; move towards the target by at
-     * most a factor of 4 per pass so one odd pass cannot swing it far. */
-    double scale = pass_seconds > 0 ? target_seconds / pass_seconds : 4.0;
-    scale = scale < 0.5 ? 0.5 : scale > 4.0 ? 4.0 : scale;
+    /* Pass time grows roughly linearly with the budget; move towards the target by a
+     * bounded factor per pass so one odd pass cannot swing it far. */
+    double scale = pass_seconds > 0 ? target_seconds / pass_seconds : most_scale;
+    scale = scale < 0.5 ? 0.5 : scale > most_scale ? most_scale : scale;
     *budget *= scale;
     *budget = *budget < MINIMUM_ADAPTIVE_BUDGET ? MINIMUM_ADAPTIVE_BUDGET : *budget > most_budget ? most_budget : *budget;
     gpu_tracer_set_pass_work_budget(tracer, (uint32_t)*budget);
@@ -184,7 +192,9 @@ rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const rend
             break;
         last_pass_seconds = clock_seconds() - pass_start;
         if (adaptive_budget)
-            adapt_pass_budget(tracer, last_pass_seconds, target_seconds, most_budget, &budget);
+            adapt_pass_budget(tracer, last_pass_seconds, target_seconds,
+                              device.software ? SOFTWARE_MOST_BUDGET_SCALE : DEFAULT_MOST_BUDGET_SCALE, most_budget,
+                              &budget);
         progress->passes++;
         progress->samples_done += report.samples_finished;
         progress->elapsed_seconds = clock_seconds() - start;
