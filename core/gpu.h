@@ -145,8 +145,9 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
  *                            the pass state has 7 textures instead of 8 (TRACER_STATE_SQUARES
  *                            left out), and gpu_tracer_read_squares is an error
  *   GPU_OMIT_STACK_WALK      the packed scene has the threaded walk (packed_layout.h; a
- *                            scene of still spheres in one level): the sphere-only tracer
- *                            walks its lists, with no stack, instead of the nodes
+ *                            scene of still spheres and quads in one level) and no alpha
+ *                            mask: the tracer walks its lists, with no stack, instead of
+ *                            the nodes
  *   GPU_OMIT_SPHERE_LIGHTS, GPU_OMIT_TRIANGLE_LIGHTS, GPU_OMIT_DELTA_LIGHTS (point, spot,
  *   GPU_OMIT_ENVIRONMENT_LIGHT  sun)  no light of that kind in the light section
  *   GPU_OMIT_MANY_LIGHTS     at most one light: no light to choose, no search for a hit

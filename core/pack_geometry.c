@@ -112,13 +112,21 @@ uint64_t pack_threaded_items(const packer *p)
     if (p->options->no_threaded_walk || p->packed_instances > 0 || top->primitives.count == 0)
         return 0;
     for (uint32_t i = 0; i < top->primitives.count; i++)
-        if (top->primitives.items[i].type != PRIMITIVE_SPHERE)
+        if (top->primitives.items[i].type != PRIMITIVE_SPHERE && top->primitives.items[i].type != PRIMITIVE_QUAD)
             return 0;
     uint64_t interior = 0;
     for (uint32_t n = 0; n < top->tree.node_count; n++)
         interior += top->tree.nodes[n].count == 0;
     uint64_t items = interior + top->primitives.count;
-    return items <= PACKED_THREADED_MAX_ITEMS ? items : 0;
+    return items * PACKED_THREADED_ORDERS * pack_threaded_stride(p) <= PACKED_THREADED_MAX_TEXELS ? items : 0;
+}
+
+uint32_t pack_threaded_stride(const packer *p)
+{
+    for (uint32_t i = 0; i < p->top.primitives.count; i++)
+        if (p->top.primitives.items[i].type == PRIMITIVE_QUAD)
+            return PACKED_THREADED_QUAD_ITEM_STRIDE;
+    return PACKED_THREADED_ITEM_STRIDE;
 }
 
 /* Whether a ray of octant (packed_layout.h "threaded walk") meets an interior node's right
@@ -147,13 +155,21 @@ static uint32_t write_threaded_subtree(packer *p, uint32_t n, int octant, uint64
 {
     const built_tree *top = &p->top;
     const bvh_node *node = &top->tree.nodes[n];
+    uint32_t stride = (uint32_t)p->layout.threaded_stride;
     if (node->count > 0) {
         for (uint32_t k = 0; k < node->count; k++, item++) {
             uint32_t slot = top->primitive_base + node->first + k;
-            const uint32_t *sphere = &p->texels[4 * (p->layout.primitive_offset + slot)];   /* (centre, radius) */
-            uint64_t base = list + (uint64_t)item * PACKED_THREADED_ITEM_STRIDE;
-            put_texel(p->texels, base, sphere[0], sphere[1], sphere[2], item + 1);
-            put_texel(p->texels, base + 1, sphere[3], 0, 0, THREADED_SPHERE | slot);
+            const uint32_t *record = &p->texels[4 * (p->layout.primitive_offset + slot)];
+            uint64_t base = list + (uint64_t)item * stride;
+            if (record[3] == PRIMITIVE_RECORD_TAG + PRIMITIVE_QUAD) {
+                const uint32_t *shape = &p->texels[4 * (uint64_t)record[0]];   /* Q, u, v */
+                put_texel(p->texels, base, shape[0], shape[1], shape[2], item + 1);
+                put_texel(p->texels, base + 1, shape[4], shape[5], shape[6], THREADED_QUAD | slot);
+                put_texel(p->texels, base + 2, shape[8], shape[9], shape[10], 0);
+            } else {
+                put_texel(p->texels, base, record[0], record[1], record[2], item + 1);   /* (centre, radius) */
+                put_texel(p->texels, base + 1, record[3], 0, 0, THREADED_SPHERE | slot);
+            }
         }
         return item;
     }
@@ -161,7 +177,7 @@ static uint32_t write_threaded_subtree(packer *p, uint32_t n, int octant, uint64
     bool right_first = right_child_first(&top->tree.nodes[node->first], &top->tree.nodes[node->first + 1], octant);
     item = write_threaded_subtree(p, node->first + right_first, octant, list, item);
     item = write_threaded_subtree(p, node->first + !right_first, octant, list, item);
-    uint64_t base = list + (uint64_t)own * PACKED_THREADED_ITEM_STRIDE;
+    uint64_t base = list + (uint64_t)own * stride;
     put_texel(p->texels, base, float_bits(node->box.min[0]), float_bits(node->box.min[1]), float_bits(node->box.min[2]),
               item);
     put_texel(p->texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
@@ -175,7 +191,7 @@ void pack_write_threaded(packer *p)
     for (int octant = 0; octant < PACKED_THREADED_ORDERS && layout->threaded_items > 0; octant++)
         write_threaded_subtree(p, 0, octant,
                                layout->threaded_offset
-                                   + (uint64_t)octant * layout->threaded_items * PACKED_THREADED_ITEM_STRIDE,
+                                   + (uint64_t)octant * layout->threaded_items * layout->threaded_stride,
                                0);
 }
 

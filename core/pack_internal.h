@@ -87,6 +87,7 @@ typedef struct pack_layout {
     uint64_t light_tree_offset, light_tree_nodes;   /* PACKED_NONE and 0: no light tree */
     uint64_t pixel_offset;                        /* image pixels, after all the records */
     uint64_t threaded_offset, threaded_items;     /* 0 and 0: no threaded walk */
+    uint64_t threaded_stride;                     /* texels an item */
     uint64_t texel_count;
 } pack_layout;
 
@@ -161,10 +162,13 @@ rt_status pack_order_vertices(packer *p, uint32_t *vertex_count, rt_error *error
 void pack_write_primitives(packer *p);
 
 /* The number of items of the threaded walk (packed_layout.h "threaded walk") the packer
- * writes for this scene: its top-level interior nodes and spheres, or 0 when the scene is
- * not still spheres in one level, the lists would be too long, or the options ask for
- * none (pack_geometry.c). */
+ * writes for this scene: its top-level interior nodes and primitives, or 0 when the scene
+ * is not still spheres and quads in one level, the lists would be too long, or the
+ * options ask for none (pack_geometry.c). */
 uint64_t pack_threaded_items(const packer *p);
+
+/* Texels an item of the threaded walk takes in this scene: 3 with quads, else 2. */
+uint32_t pack_threaded_stride(const packer *p);
 
 /* Writes the threaded walk's lists after the primitives and nodes (pack_geometry.c). */
 void pack_write_threaded(packer *p);

@@ -32,7 +32,7 @@
  *   nodes       PACKED_NODE_STRIDE texels each; the two children of an interior node are
  *               contiguous (left = first, right = first + 1)
  *   threaded    the BVH again as PACKED_THREADED_ORDERS lists of items, one per ray octant
- *               (only for scenes of still spheres in one level; see there)
+ *               (only for scenes of still spheres and quads in one level; see there)
  *   instances   PACKED_INSTANCE_STRIDE texels each
  *   textures    PACKED_TEXTURE_STRIDE texels each
  *   images      PACKED_IMAGE_STRIDE texels each (a record), pixels elsewhere in the section
@@ -169,25 +169,31 @@
 #define PACKED_FIRST_BITS 29
 
 /* ---- threaded walk: PACKED_THREADED_ORDERS lists of PACKED_HEADER_THREADED_ITEMS items,
- * PACKED_THREADED_ITEM_STRIDE texels an item, list o at threaded_offset + o x items x
- * stride. Written only for a scene of still spheres in one BVH level (no instances, no
- * other primitive) of at most PACKED_THREADED_MAX_ITEMS items; the tracer's sphere-only
- * variants walk it instead of the nodes (glsl/traverse.glsl trace_threaded). Each list is
- * the top-level BVH in depth-first order, with the children of every interior node in the
- * order a ray of octant o meets them along the axis that separates their centres most
- * (octant bit k set: direction component k negative), and every leaf replaced by its
- * spheres. An item:
+ * stride texels an item (PACKED_THREADED_QUAD_ITEM_STRIDE when the scene has quads, else
+ * PACKED_THREADED_ITEM_STRIDE), list o at threaded_offset + o x items x stride. Written
+ * only for a scene of still spheres and quads in one BVH level (no instances, triangles or
+ * moving spheres) whose lists take at most PACKED_THREADED_MAX_TEXELS texels; the tracer's
+ * variants for such scenes walk it instead of the nodes (glsl/traverse.glsl
+ * trace_threaded), unless a material has an alpha mask (the stack's walk tests it). Each
+ * list is the top-level BVH in depth-first order, with the children of every interior node
+ * in the order a ray of octant o meets them along the axis that separates their centres
+ * most (octant bit k set: direction component k negative), and every leaf replaced by its
+ * primitives. An item (a third texel only with stride 3; 0 where not named):
  *   interior node: (box_min.xyz, skip), (box_max.xyz, 0)
  *   sphere:        (centre.xyz, skip), (radius, 0, 0, THREADED_SPHERE | slot)
- * skip is the index of the item after its subtree (a sphere's: the next item), where a
+ *   quad:          (Q.xyz, skip), (u.xyz, THREADED_QUAD | slot), (v.xyz, 0), as its shape
+ *                  record holds them
+ * skip is the index of the item after its subtree (a primitive's: the next item), where a
  * walk goes on when the box is missed; a box hit goes on at the next item. The walk ends
- * at index items. slot is the sphere's primitive slot (below 2^PACKED_FIRST_BITS). No
- * stack: a walk is one index (docs/performance.md, the log). */
+ * at index items. slot is the primitive's slot (below 2^PACKED_FIRST_BITS). No stack: a
+ * walk is one index (docs/performance.md, the log). */
 #define PACKED_THREADED_ORDERS 8
 #define PACKED_THREADED_ITEM_STRIDE 2
-#define PACKED_THREADED_MAX_ITEMS 262144
+#define PACKED_THREADED_QUAD_ITEM_STRIDE 3
+#define PACKED_THREADED_MAX_TEXELS 4194304   /* 64 MiB */
 #define THREADED_SPHERE 2147483648u
-#define THREADED_SLOT_MASK 2147483647u
+#define THREADED_QUAD 1073741824u
+#define THREADED_SLOT_MASK 1073741823u
 
 /* ---- instances: 5 texels
  *   texel 0 = (first, material override or PACKED_NONE, flags, count): first and count

@@ -321,6 +321,12 @@ bool packed_shadow_blocked(const packed_scene *packed, const float origin[3], co
     return walk(packed, origin, direction, time, t_max, true, light_slot, volumes, hit);
 }
 
+uint32_t packed_threaded_stride(const packed_scene *packed)
+{
+    return packed->summary.primitive_types & 1u << PRIMITIVE_QUAD ? PACKED_THREADED_QUAD_ITEM_STRIDE
+                                                                  : PACKED_THREADED_ITEM_STRIDE;
+}
+
 bool packed_threaded_walk(const packed_scene *packed, const float origin[3], const float direction[3], float t_max,
                           bool shadow, uint32_t light_slot, packed_hit *hit, uint32_t *items_visited)
 {
@@ -329,30 +335,31 @@ bool packed_threaded_walk(const packed_scene *packed, const float origin[3], con
     hit->instance = PACKED_NONE;
     if (items_visited != NULL)
         *items_visited = 0;
-    uint32_t items = packed->threaded_items;
+    uint32_t items = packed->threaded_items, stride = packed_threaded_stride(packed);
     if (items == 0)
         return false;
     moving_ray ray;
     ray_set(&ray, (float *)origin, (float *)direction);
     uint32_t octant = (direction[0] < 0) | (direction[1] < 0) << 1 | (direction[2] < 0) << 2;
-    uint32_t list = packed->threaded_offset + octant * items * PACKED_THREADED_ITEM_STRIDE;
+    uint32_t list = packed->threaded_offset + octant * items * stride;
     for (uint32_t item = 0; item < items;) {
-        uint32_t base = list + item * PACKED_THREADED_ITEM_STRIDE;
+        uint32_t base = list + item * stride;
         if (items_visited != NULL)
             ++*items_visited;
         uint32_t tag = packed_uint(packed, base + 1, 3);
-        if (!(tag & THREADED_SPHERE)) {
+        if (!(tag & (THREADED_SPHERE | THREADED_QUAD))) {
             item = intersect_box(packed, base, base + 1, &ray, hit->t) < INFINITY ? item + 1 : packed_uint(packed, base, 3);
             continue;
         }
-        vec3 center = {packed_float(packed, base, 0), packed_float(packed, base, 1), packed_float(packed, base, 2)};
-        float t = intersect_sphere(center, packed_float(packed, base + 1, 0), ray.origin, ray.direction, hit->t);
-        if (t < hit->t) {
-            hit->t = t;
-            hit->primitive = tag & THREADED_SLOT_MASK;
-            if (shadow && hit->primitive != light_slot)
-                return true;
-        }
+        packed_primitive primitive = {.type = tag & THREADED_QUAD ? PRIMITIVE_QUAD : PRIMITIVE_SPHERE};
+        for (int k = 0; k < (tag & THREADED_QUAD ? 3 : 2); k++)
+            for (int c = 0; c < 4; c++)
+                primitive.data[k][c] = packed_float(packed, base + k, c);
+        if (primitive.type == PRIMITIVE_SPHERE)
+            primitive.data[0][3] = primitive.data[1][0];   /* (centre, radius) */
+        if (test_primitive(packed, &primitive, tag & THREADED_SLOT_MASK, &ray, 0, PACKED_NONE, hit) && shadow
+            && hit->primitive != light_slot)
+            return true;
         item++;
     }
     return false;

@@ -75,12 +75,16 @@ bool packed_shadow_blocked(const packed_scene *packed, const float origin[3], co
  * trace_threaded for one world ray, step for step: the list of the direction's octant,
  * item by item. Nearest hit (shadow false): fills *hit (t = t_max and primitive PACKED_NONE
  * when nothing) and returns false. Shadow ray (shadow true): returns true at the first
- * sphere met, in the list's order, nearer than the nearest so far and other than
+ * sphere or quad met, in the list's order, nearer than the nearest so far and other than
  * light_slot (blocked); else false, with *hit the nearest light_slot hit or none.
  * items_visited (NULL: not wanted) gets the number of items the walk tested. With no
  * threaded walk in the scene (threaded_items 0), nothing is hit. */
 bool packed_threaded_walk(const packed_scene *packed, const float origin[3], const float direction[3], float t_max,
                           bool shadow, uint32_t light_slot, packed_hit *hit, uint32_t *items_visited);
+
+/* Texels an item of the threaded walk takes in packed (packed_layout.h): 3 when the scene
+ * has quads, else 2. */
+uint32_t packed_threaded_stride(const packed_scene *packed);
 
 /* The volumes containing point, packed as the shader keeps a path's media: the volume
  * instance number + 1 of the innermost in the low 16 bits, of the next one out in the high

@@ -131,8 +131,9 @@ static void tracer_parameters(const scene *s, const camera_frame *frame, const r
  * is none and the camera is in none, no textures when there is none and no material has a
  * normal map; primitive types, emitters, the pbr material, alpha masks and vertex colours
  * as the packed records (every BVH level) hold them; light and material kinds as the light
- * and material sections hold them; the stack's walk where the packer wrote the threaded one. The --full-tracer option asks for 0:
- * everything, read from uniforms. */
+ * and material sections hold them; the stack's walk where the packer wrote the threaded
+ * one and no alpha mask needs the stack's walk's test. The --full-tracer option asks for
+ * 0: everything, read from uniforms. */
 static uint32_t omitted_features(const packed_scene *packed, const render_options *options, uint32_t camera_media)
 {
     if (options->full_tracer)
@@ -174,7 +175,7 @@ static uint32_t omitted_features(const packed_scene *packed, const render_option
         omitted |= GPU_OMIT_DIRECT_EMISSION;
     if (!keeps_squares(options))
         omitted |= GPU_OMIT_SQUARES;
-    if (packed->threaded_items > 0)
+    if (packed->threaded_items > 0 && !contents->alpha_mask)
         omitted |= GPU_OMIT_STACK_WALK;
     uint32_t lights = contents->light_types;
     if (!(lights & 1u << LIGHT_SPHERE))

@@ -193,7 +193,8 @@ typedef struct render_result {
     render_stop_reason stop_reason;
     int bvh_depth;
     bool threaded_walk;          /* the tracer walked the BVH as threaded lists, no stack
-                                  * (packed_layout.h "threaded walk"; still spheres alone) */
+                                  * (packed_layout.h "threaded walk"; still spheres and
+                                  * quads in one level) */
     double bvh_build_seconds;
     uint64_t packed_bytes;       /* the whole packed scene, images included */
     uint64_t image_bytes;        /* of which image pixels */

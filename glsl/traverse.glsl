@@ -77,48 +77,68 @@ Hit no_hit(float t_max)
     return hit;
 }
 
+// Texels a threaded walk's item takes: a quad's three, else two (core/packed_layout.h).
+const uint THREADED_STRIDE = uint(HAS_QUADS ? PACKED_THREADED_QUAD_ITEM_STRIDE : PACKED_THREADED_ITEM_STRIDE);
+
 // The first texel of the threaded walk's list for rays along direction: its octant's.
 uint threaded_list(vec3 direction)
 {
     uint octant = (direction.x < 0.0 ? 1u : 0u) | (direction.y < 0.0 ? 2u : 0u) | (direction.z < 0.0 ? 4u : 0u);
-    return threaded_offset + octant * threaded_items * uint(PACKED_THREADED_ITEM_STRIDE);
+    return threaded_offset + octant * threaded_items * THREADED_STRIDE;
 }
 
 // One item of the threaded walk (core/packed_layout.h "threaded walk") of the list at
-// list: its box and its sphere both tested (llvmpipe runs both anyway,
-// docs/performance.md), a sphere nearer than hit made the hit (sphere_hit true). Returns
-// the next item: the one after a sphere or a box hit, the item's skip after a box missed.
-uint threaded_step(TraversalRay ray, uint list, uint item, inout Hit hit, out bool sphere_hit)
+// list: its box and its primitive tests all run (llvmpipe runs every branch anyway,
+// docs/performance.md), a sphere or quad nearer than hit made the hit (primitive_hit
+// true). Returns the next item: the one after a primitive or a box hit, the item's skip
+// after a box missed.
+uint threaded_step(TraversalRay ray, uint list, uint item, inout Hit hit, out bool primitive_hit)
 {
-    uint base = list + item * uint(PACKED_THREADED_ITEM_STRIDE);
+    uint base = list + item * THREADED_STRIDE;
     uvec4 first_texel = packed_texel(base), second_texel = packed_texel(base + 1u);
-    bool sphere = (second_texel.w & THREADED_SPHERE) != 0u;
+    uvec4 third_texel = HAS_QUADS ? packed_texel(base + 2u) : uvec4(0u);
+    bool sphere = HAS_SPHERES && (second_texel.w & THREADED_SPHERE) != 0u;
+    bool quad = HAS_QUADS && (second_texel.w & THREADED_QUAD) != 0u;
     float box_entry = intersect_box(packed_xyz(first_texel), packed_xyz(second_texel), ray.origin,
                                     ray.inverse_direction, hit.t);
-    float t = intersect_sphere_along(packed_xyz(first_texel), uintBitsToFloat(second_texel.x), ray.origin, ray.unit,
-                                     ray.direction_length, hit.t);
-    sphere_hit = sphere && t < hit.t;
-    if (sphere_hit) {
+    float t = INFINITY;
+    vec2 coordinates = vec2(0.0);
+    if (HAS_SPHERES)
+        t = intersect_sphere_along(packed_xyz(first_texel), uintBitsToFloat(second_texel.x), ray.origin, ray.unit,
+                                   ray.direction_length, hit.t);
+    if (HAS_QUADS) {
+        vec2 quad_coordinates;
+        float quad_t = intersect_flat(packed_xyz(first_texel), packed_xyz(second_texel), packed_xyz(third_texel), true,
+                                      ray.origin, ray.direction, hit.t, quad_coordinates);
+        t = quad ? quad_t : sphere ? t : INFINITY;
+        coordinates = quad ? quad_coordinates : vec2(0.0);
+    } else {
+        t = sphere ? t : INFINITY;
+    }
+    primitive_hit = t < hit.t;
+    if (primitive_hit) {
         hit.t = t;
         hit.primitive = second_texel.w & THREADED_SLOT_MASK;
+        hit.barycentric = coordinates;
     }
-    return sphere || box_entry < INFINITY ? item + 1u : first_texel.w;
+    return sphere || quad || box_entry < INFINITY ? item + 1u : first_texel.w;
 }
 
-// trace_rays for the sphere-only variants with the threaded walk (THREADED_WALK): the
-// shadow ray, then the path ray, each along the list of its direction's octant, one item
-// an iteration (threaded_step). No stack: an iteration is two fetches at one address and
-// the two tests, where the stack's walk makes four fetches, two box tests, a sphere test
-// and a per-lane stack write and read. Two loops, unlike the stack's walk: this loop is
-// short, and one loop for both rays (changing rays inside it) was 5% slower on a lit
-// scene than the stack's walk, two loops 20% faster (docs/performance.md, the log).
+// trace_rays for the variants with the threaded walk (THREADED_WALK: still spheres and
+// quads in one level): the shadow ray, then the path ray, each along the list of its
+// direction's octant, one item an iteration (threaded_step). No stack: an iteration is two
+// or three fetches at one address and the tests, where the stack's walk makes four
+// fetches in a chain, two box tests, a primitive test and a per-lane stack write and read.
+// Two loops, unlike the stack's walk: this loop is short, and one loop for both rays
+// (changing rays inside it) was 5% slower on a lit scene than the stack's walk, two loops
+// 20% faster (docs/performance.md, the log).
 void trace_threaded(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3 path_origin, vec3 path_direction,
                     float path_t_max, out bool blocked, out Hit shadow_hit, out Hit path_hit)
 {
     blocked = false;
     shadow_hit = no_hit(shadow.t_max);
     path_hit = no_hit(path_t_max);
-    bool sphere_hit;
+    bool primitive_hit;
     // Without light sampling there is never a shadow ray: a constant, so that its loop
     // is left out.
     if (HAS_DIRECT_LIGHT && shadow_wanted) {
@@ -126,9 +146,9 @@ void trace_threaded(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3
         uint list = threaded_list(shadow.direction);
         uint item = 0u;
         while (count_work()) {
-            item = threaded_step(ray, list, item, shadow_hit, sphere_hit);
-            // A shadow ray's blocker: any sphere but its light.
-            blocked = sphere_hit && shadow_hit.primitive != shadow.light_slot;
+            item = threaded_step(ray, list, item, shadow_hit, primitive_hit);
+            // A shadow ray's blocker: any primitive but its light.
+            blocked = primitive_hit && shadow_hit.primitive != shadow.light_slot;
             if (item >= threaded_items || blocked)
                 break;
         }
@@ -138,7 +158,7 @@ void trace_threaded(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3
         uint list = threaded_list(path_direction);
         uint item = 0u;
         while (count_work()) {
-            item = threaded_step(ray, list, item, path_hit, sphere_hit);
+            item = threaded_step(ray, list, item, path_hit, primitive_hit);
             if (item >= threaded_items)
                 break;
         }

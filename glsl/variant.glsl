@@ -42,8 +42,11 @@ const bool HAS_AREA_LIGHTS = HAS_SPHERE_LIGHTS || HAS_FLAT_LIGHTS;
 const bool ONLY_SPHERES = !HAS_TRIANGLES && !HAS_QUADS && !HAS_MOVING_SPHERES && !HAS_INSTANCES;
 const bool ONLY_TRIANGLES = !HAS_SPHERES && !HAS_QUADS && !HAS_INSTANCES;
 const bool ONLY_QUADS = !HAS_SPHERES && !HAS_TRIANGLES && !HAS_INSTANCES;
-// The packer writes the threaded walk only for still spheres in one level (core/pack.h).
-const bool THREADED_WALK = !HAS_STACK_WALK && ONLY_SPHERES;
+// The packer writes the threaded walk only for still spheres and quads in one level, and
+// core/render.c asks for it only without alpha masks (the stack's walk tests them); the
+// conditions here say the same, so that no other variant compiles it.
+const bool THREADED_WALK = !HAS_STACK_WALK && !HAS_TRIANGLES && !HAS_MOVING_SPHERES && !HAS_INSTANCES
+                           && !HAS_ALPHA_MASK;
 
 // The integrator, the sky kind and the sampler: compiled in as constants (RTSPHERES_FIX_UNIFORMS 1,
 // gpu.h GPU_FIX_UNIFORMS), or read from the parameter block (the full tracer).

@@ -47,7 +47,8 @@ check lights scenes/lights.txt
 # Lights and a volume (the smoke boxes are instances), quads, no textures, no spheres.
 check cornell-smoke scenes/cornell-smoke.txt
 # One quad light (rectangles by solid angle, no light to choose), lambertian and emissive
-# materials only; one sphere light with metal and glass; triangle lights (a mesh).
+# materials only; one sphere light with metal and glass; triangle lights (a mesh). The
+# Cornell box (quads), three balls and lights.txt (spheres and quads) walk threaded lists.
 check cornell scenes/cornell.txt
 check three-balls scenes/three-balls.txt
 check mesh-light tests/render/scenes/mesh-light.txt

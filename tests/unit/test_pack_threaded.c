@@ -1,8 +1,9 @@
 /* test_pack_threaded.c: the threaded walk (packed_layout.h "threaded walk", written by
  * core/pack_geometry.c): which scenes get it, that each octant's list is the BVH in depth
- * first order with every sphere once and skips that jump over whole subtrees, and that
- * its walk (packed_traverse.h packed_threaded_walk, glsl/traverse.glsl trace_threaded in
- * C) finds the brute-force nearest hit and the blockers of shadow rays. */
+ * first order with every sphere and quad once and skips that jump over whole subtrees,
+ * and that its walk (packed_traverse.h packed_threaded_walk, glsl/traverse.glsl
+ * trace_threaded in C) finds the brute-force nearest hit (what the stack's walk finds,
+ * with quads) and the blockers of shadow rays. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -24,7 +25,7 @@
 /* The first texel of octant's list. */
 static uint32_t list_of(const packed_scene *packed, int octant)
 {
-    return packed->threaded_offset + (uint32_t)octant * packed->threaded_items * PACKED_THREADED_ITEM_STRIDE;
+    return packed->threaded_offset + (uint32_t)octant * packed->threaded_items * packed_threaded_stride(packed);
 }
 
 static void header_names_the_lists(void **state)
@@ -45,10 +46,119 @@ static void header_names_the_lists(void **state)
     /* The lists lie inside the packed scene, after the node section. */
     assert_true(packed.threaded_offset >= packed.node_offset + packed.node_count * PACKED_NODE_STRIDE);
     assert_true((uint64_t)packed.threaded_offset
-                    + (uint64_t)PACKED_THREADED_ORDERS * packed.threaded_items * PACKED_THREADED_ITEM_STRIDE
+                    + (uint64_t)PACKED_THREADED_ORDERS * packed.threaded_items * packed_threaded_stride(&packed)
                 <= packed.texel_count);
     packed_scene_free(&packed);
     scene_free(&s);
+}
+
+/* Adds count random quads, each an object placed with the identity (copied into the top
+ * level), to s. */
+static void add_random_quads(scene *s, int count)
+{
+    for (int q = 0; q < count; q++) {
+        scene_object object = {.first_shape = s->shape_count, .shape_count = 1, .mesh = -1};
+        scene_shape shape = {.type = SHAPE_QUAD, .material = q % 3};
+        for (int i = 0; i < 3; i++) {
+            shape.points[0][i] = (float)(random_unit() * 20 - 10);
+            shape.points[1][i] = (float)(random_unit() * 4 - 2);
+            shape.points[2][i] = (float)(random_unit() * 4 - 2);
+        }
+        assert_true(scene_add_shape(s, &shape) >= 0);
+        int index = scene_add_object(s, &object);
+        assert_true(index >= 0);
+        scene_instance placed = {.object = index, .material = -1};
+        scene_identity_transform(placed.object_to_world);
+        assert_true(scene_add_instance(s, &placed) >= 0);
+    }
+}
+
+/* Whether the box of item (texels box_base, box_base + 1) holds the primitive item at
+ * base: a sphere's box, or a quad's four corners (within float rounding of the sums). */
+static bool box_holds(const packed_scene *packed, uint32_t box_base, uint32_t base)
+{
+    uint32_t tag = packed_uint(packed, base + 1, 3);
+    for (int k = 0; k < 3; k++) {
+        float lo = packed_float(packed, box_base, k), hi = packed_float(packed, box_base + 1, k);
+        if (tag & THREADED_SPHERE) {
+            float centre = packed_float(packed, base, k), radius = packed_float(packed, base + 1, 0);
+            if (!(lo <= centre - radius && hi >= centre + radius))
+                return false;
+            continue;
+        }
+        float q = packed_float(packed, base, k), u = packed_float(packed, base + 1, k), v = packed_float(packed, base + 2, k);
+        float corners[4] = {q, q + u, q + v, q + u + v}, slack = 1e-5f * (1 + fabsf(q) + fabsf(u) + fabsf(v));
+        for (int c = 0; c < 4; c++)
+            if (!(lo <= corners[c] + slack && hi >= corners[c] - slack))
+                return false;
+    }
+    return true;
+}
+
+/* Every list of packed (scene s) is its BVH depth first: each primitive once, as its
+ * record (a sphere) or shape record (a quad) holds it; skips nested and past their own
+ * subtree; each box holding its subtree's primitives; and the octants' orders differ. */
+static void check_lists(const packed_scene *packed)
+{
+    uint32_t items = packed->threaded_items, stride = packed_threaded_stride(packed);
+    assert_true(items > packed->primitive_count);
+    uint32_t *seen = calloc(packed->primitive_count, sizeof *seen);
+    uint32_t *open_until = malloc(items * sizeof *open_until);   /* skips of the boxes around an item */
+    assert_non_null(seen);
+    assert_non_null(open_until);
+    bool lists_differ = false;
+    for (int octant = 0; octant < PACKED_THREADED_ORDERS; octant++) {
+        uint32_t list = list_of(packed, octant);
+        memset(seen, 0, packed->primitive_count * sizeof *seen);
+        int depth = 0;
+        for (uint32_t item = 0; item < items; item++) {
+            uint32_t base = list + item * stride;
+            while (depth > 0 && open_until[depth - 1] == item)
+                depth--;
+            uint32_t skip = packed_uint(packed, base, 3), tag = packed_uint(packed, base + 1, 3);
+            /* Nested: an item's subtree ends within every subtree around it. */
+            assert_true(skip > item && skip <= items);
+            if (depth > 0)
+                assert_true(skip <= open_until[depth - 1]);
+            if (tag & (THREADED_SPHERE | THREADED_QUAD)) {
+                uint32_t slot = tag & THREADED_SLOT_MASK;
+                assert_true(slot < packed->primitive_count);
+                assert_int_equal(skip, item + 1);
+                seen[slot]++;
+                packed_primitive primitive = packed_primitive_at(packed, slot);
+                if (tag & THREADED_SPHERE) {
+                    /* The sphere as its record holds it. */
+                    assert_int_equal(primitive.type, PRIMITIVE_SPHERE);
+                    for (int k = 0; k < 3; k++)
+                        assert_true(packed_float(packed, base, k) == primitive.data[0][k]);
+                    assert_true(packed_float(packed, base + 1, 0) == primitive.data[0][3]);
+                } else {
+                    /* The quad's corner and edges as its shape record holds them. */
+                    assert_int_equal(primitive.type, PRIMITIVE_QUAD);
+                    for (int t = 0; t < 3; t++)
+                        for (int k = 0; k < 3; k++)
+                            assert_true(packed_float(packed, base + (uint32_t)t, k) == primitive.data[t][k]);
+                }
+            } else {
+                assert_int_equal(tag, 0);
+                assert_true(skip > item + 2);   /* two children at least */
+                for (uint32_t inner = item + 1; inner < skip; inner++) {
+                    uint32_t inner_base = list + inner * stride;
+                    if (packed_uint(packed, inner_base + 1, 3) & (THREADED_SPHERE | THREADED_QUAD))
+                        assert_true(box_holds(packed, base, inner_base));
+                }
+                open_until[depth++] = skip;
+            }
+        }
+        for (uint32_t slot = 0; slot < packed->primitive_count; slot++)
+            assert_int_equal(seen[slot], 1);
+        if (octant > 0)
+            lists_differ |= memcmp(&packed->texels[4 * list_of(packed, 0)], &packed->texels[4 * list],
+                                   (size_t)items * stride * 16) != 0;
+    }
+    assert_true(lists_differ);
+    free(open_until);
+    free(seen);
 }
 
 static void every_list_is_the_tree_depth_first(void **state)
@@ -58,65 +168,62 @@ static void every_list_is_the_tree_depth_first(void **state)
     random_scene(&s, 500, 5);
     packed_scene packed;
     assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
-    uint32_t items = packed.threaded_items;
-    assert_true(items > 500);
-    uint32_t *seen = calloc(packed.primitive_count, sizeof *seen);
-    uint32_t *open_until = malloc(items * sizeof *open_until);   /* skips of the boxes around an item */
-    assert_non_null(seen);
-    assert_non_null(open_until);
-    bool lists_differ = false;
-    for (int octant = 0; octant < PACKED_THREADED_ORDERS; octant++) {
-        uint32_t list = list_of(&packed, octant);
-        memset(seen, 0, packed.primitive_count * sizeof *seen);
-        int depth = 0;
-        for (uint32_t item = 0; item < items; item++) {
-            uint32_t base = list + item * PACKED_THREADED_ITEM_STRIDE;
-            while (depth > 0 && open_until[depth - 1] == item)
-                depth--;
-            uint32_t skip = packed_uint(&packed, base, 3), tag = packed_uint(&packed, base + 1, 3);
-            /* Nested: an item's subtree ends within every subtree around it. */
-            assert_true(skip > item && skip <= items);
-            if (depth > 0)
-                assert_true(skip <= open_until[depth - 1]);
-            if (tag & THREADED_SPHERE) {
-                uint32_t slot = tag & THREADED_SLOT_MASK;
-                assert_true(slot < packed.primitive_count);
-                assert_int_equal(skip, item + 1);
-                seen[slot]++;
-                /* The sphere as its primitive record holds it. */
-                for (int k = 0; k < 3; k++)
-                    assert_int_equal(packed_uint(&packed, base, k),
-                                     packed_uint(&packed, packed.primitive_offset + slot, k));
-                assert_int_equal(packed_uint(&packed, base + 1, 0), packed_uint(&packed, packed.primitive_offset + slot, 3));
-            } else {
-                assert_int_equal(tag, 0);
-                assert_true(skip > item + 2);   /* two children at least */
-                /* The box holds the spheres of its subtree. */
-                for (uint32_t inner = item + 1; inner < skip; inner++) {
-                    uint32_t inner_base = list + inner * PACKED_THREADED_ITEM_STRIDE;
-                    if (!(packed_uint(&packed, inner_base + 1, 3) & THREADED_SPHERE))
-                        continue;
-                    float radius = packed_float(&packed, inner_base + 1, 0);
-                    for (int k = 0; k < 3; k++) {
-                        float centre = packed_float(&packed, inner_base, k);
-                        assert_true(packed_float(&packed, base, k) <= centre - radius);
-                        assert_true(packed_float(&packed, base + 1, k) >= centre + radius);
-                    }
-                }
-                open_until[depth++] = skip;
-            }
-        }
-        for (uint32_t slot = 0; slot < packed.primitive_count; slot++)
-            assert_int_equal(seen[slot], 1);
-        if (octant > 0)
-            lists_differ |= memcmp(&packed.texels[4 * list_of(&packed, 0)], &packed.texels[4 * list],
-                                   (size_t)items * PACKED_THREADED_ITEM_STRIDE * 16) != 0;
-    }
-    assert_true(lists_differ);
-    free(open_until);
-    free(seen);
+    assert_int_equal(packed_threaded_stride(&packed), PACKED_THREADED_ITEM_STRIDE);
+    check_lists(&packed);
     packed_scene_free(&packed);
     scene_free(&s);
+    /* Spheres and quads: three texels an item. */
+    random_scene(&s, 200, 6);
+    add_random_quads(&s, 60);
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_int_equal(packed_threaded_stride(&packed), PACKED_THREADED_QUAD_ITEM_STRIDE);
+    assert_int_equal(packed.primitive_count, 260);
+    check_lists(&packed);
+    packed_scene_free(&packed);
+    scene_free(&s);
+}
+
+/* With quads among the spheres, the walk finds what the stack's walk finds (which
+ * tests/unit/test_pack.c holds against brute force), bit for bit, and a shadow ray with
+ * no light is blocked exactly when something is hit within t_max. */
+static void walk_with_quads_matches_the_stack_walk(void **state)
+{
+    (void)state;
+    for (uint64_t seed = 40; seed < 43; seed++) {
+        scene s;
+        random_scene(&s, 100, seed);
+        add_random_quads(&s, 80);
+        packed_scene packed;
+        assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+        assert_true(packed.threaded_items > 0);
+        int quad_hits = 0, sphere_hits = 0, blocked_count = 0, through = 0;
+        for (int r = 0; r < 4000; r++) {
+            double o[3], d[3];
+            float of[3], df[3];
+            random_ray(r, o, d, of, df);
+            packed_hit hit, stack_hit;
+            packed_threaded_walk(&packed, of, df, INFINITY, false, PACKED_NONE, &hit, NULL);
+            packed_intersect_nearest(&packed, of, df, 0, INFINITY, &stack_hit);
+            assert_true(hit.t == stack_hit.t || (isinf(hit.t) && isinf(stack_hit.t)));
+            if (hit.primitive != stack_hit.primitive)   /* a tie: the same t */
+                assert_true(hit.t == stack_hit.t);
+            if (hit.primitive != PACKED_NONE) {
+                bool quad = packed_primitive_type(&packed, hit.primitive) == PRIMITIVE_QUAD;
+                quad_hits += quad;
+                sphere_hits += !quad;
+            }
+            float t_max = (float)(random_unit() * 30);
+            bool blocked = packed_threaded_walk(&packed, of, df, t_max, true, PACKED_NONE, &hit, NULL);
+            if (fabsf(stack_hit.t - t_max) < 1e-4f * (1 + t_max))
+                continue;
+            assert_int_equal(blocked, stack_hit.t < t_max);
+            blocked_count += blocked;
+            through += !blocked;
+        }
+        assert_true(quad_hits > 100 && sphere_hits > 300 && blocked_count > 300 && through > 300);
+        packed_scene_free(&packed);
+        scene_free(&s);
+    }
 }
 
 static void walk_finds_the_nearest_hit(void **state)
@@ -289,16 +396,21 @@ static void only_still_spheres_in_one_level_get_lists(void **state)
     assert_int_equal(packed.threaded_offset, 0);
     packed_scene_free(&packed);
     scene_free(&s);
-    /* A quad or a moving sphere among the spheres, or a second level: none. */
-    int types[] = {SHAPE_QUAD, SHAPE_MOVING_SPHERE};
-    for (int k = 0; k < 2; k++) {
-        random_scene(&s, 50, 8);
-        add_placed_shape(&s, types[k]);
-        assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
-        assert_int_equal(packed.threaded_items, 0);
-        packed_scene_free(&packed);
-        scene_free(&s);
-    }
+    /* A quad among the spheres: lists of three texels an item. */
+    random_scene(&s, 50, 8);
+    add_placed_shape(&s, SHAPE_QUAD);
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_true(packed.threaded_items > 51);
+    assert_int_equal(packed_threaded_stride(&packed), PACKED_THREADED_QUAD_ITEM_STRIDE);
+    packed_scene_free(&packed);
+    scene_free(&s);
+    /* A moving sphere among them, or a second level: none. */
+    random_scene(&s, 50, 8);
+    add_placed_shape(&s, SHAPE_MOVING_SPHERE);
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    assert_int_equal(packed.threaded_items, 0);
+    packed_scene_free(&packed);
+    scene_free(&s);
     random_scene(&s, 50, 9);
     add_placed_shape(&s, SHAPE_SPHERE);   /* a placed sphere: copied into the top level */
     assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
@@ -323,10 +435,10 @@ static void only_still_spheres_in_one_level_get_lists(void **state)
 static void too_many_spheres_get_no_lists(void **state)
 {
     (void)state;
-    /* More spheres than PACKED_THREADED_MAX_ITEMS items can list (a sphere is an item,
-     * and so is each interior node): the lists would take 8 x 32 bytes an item. */
+    /* More spheres than lists of PACKED_THREADED_MAX_TEXELS texels hold (8 lists of 2
+     * texels an item; a sphere is an item, and so is each interior node). */
     scene s;
-    random_scene(&s, PACKED_THREADED_MAX_ITEMS + 1, 11);
+    random_scene(&s, PACKED_THREADED_MAX_TEXELS / (PACKED_THREADED_ORDERS * PACKED_THREADED_ITEM_STRIDE) + 1, 11);
     packed_scene packed;
     assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
     assert_int_equal(packed.threaded_items, 0);
@@ -340,6 +452,7 @@ int main(void)
         cmocka_unit_test(header_names_the_lists),
         cmocka_unit_test(every_list_is_the_tree_depth_first),
         cmocka_unit_test(walk_finds_the_nearest_hit),
+        cmocka_unit_test(walk_with_quads_matches_the_stack_walk),
         cmocka_unit_test(shadow_walk_stops_at_blockers_only),
         cmocka_unit_test(only_still_spheres_in_one_level_get_lists),
         cmocka_unit_test(too_many_spheres_get_no_lists),
