@@ -52,24 +52,39 @@ static void header_names_the_lists(void **state)
     scene_free(&s);
 }
 
-/* Adds count random quads, each an object placed with the identity (copied into the top
- * level), to s. */
+/* Adds shape as an object of its own placed with the identity, which the packer copies
+ * into the top level (pack_collect.c). */
+static void add_placed(scene *s, scene_shape shape)
+{
+    scene_object object = {.first_shape = s->shape_count, .shape_count = 1, .mesh = -1};
+    assert_true(scene_add_shape(s, &shape) >= 0);
+    int index = scene_add_object(s, &object);
+    assert_true(index >= 0);
+    scene_instance placed = {.object = index, .material = -1};
+    scene_identity_transform(placed.object_to_world);
+    assert_true(scene_add_instance(s, &placed) >= 0);
+}
+
+/* Adds a shape of type (a unit quad or a sphere of radius 0.5 at the origin), placed. */
+static void add_placed_shape(scene *s, int type)
+{
+    scene_shape shape = {.type = type, .material = 0, .radius = 0.5f};
+    shape.points[1][0] = 1;
+    shape.points[2][1] = 1;
+    add_placed(s, shape);
+}
+
+/* Adds count random quads, each placed. */
 static void add_random_quads(scene *s, int count)
 {
     for (int q = 0; q < count; q++) {
-        scene_object object = {.first_shape = s->shape_count, .shape_count = 1, .mesh = -1};
         scene_shape shape = {.type = SHAPE_QUAD, .material = q % 3};
         for (int i = 0; i < 3; i++) {
             shape.points[0][i] = (float)(random_unit() * 20 - 10);
             shape.points[1][i] = (float)(random_unit() * 4 - 2);
             shape.points[2][i] = (float)(random_unit() * 4 - 2);
         }
-        assert_true(scene_add_shape(s, &shape) >= 0);
-        int index = scene_add_object(s, &object);
-        assert_true(index >= 0);
-        scene_instance placed = {.object = index, .material = -1};
-        scene_identity_transform(placed.object_to_world);
-        assert_true(scene_add_instance(s, &placed) >= 0);
+        add_placed(s, shape);
     }
 }
 
@@ -360,22 +375,6 @@ static void shadow_walk_stops_at_blockers_only(void **state)
         packed_scene_free(&packed);
         scene_free(&s);
     }
-}
-
-/* Adds an object of one shape of type placed with the identity, which the packer copies
- * into the top level (pack_collect.c). */
-static void add_placed_shape(scene *s, int type)
-{
-    scene_object object = {.first_shape = s->shape_count, .shape_count = 1, .mesh = -1};
-    scene_shape shape = {.type = type, .material = 0, .radius = 0.5f};
-    shape.points[1][0] = 1;
-    shape.points[2][1] = 1;
-    assert_true(scene_add_shape(s, &shape) >= 0);
-    int index = scene_add_object(s, &object);
-    assert_true(index >= 0);
-    scene_instance placed = {.object = index, .material = -1};
-    scene_identity_transform(placed.object_to_world);
-    assert_true(scene_add_instance(s, &placed) >= 0);
 }
 
 static void only_still_spheres_in_one_level_get_lists(void **state)
