@@ -125,7 +125,7 @@ static rt_status plan_layout(packer *p, rt_error *error)
     layout->threaded_items = pack_threaded_items(p);
     layout->threaded_stride = pack_threaded_stride(p);
     layout->threaded_offset = layout->threaded_items ? after_lights : 0;
-    after_lights += layout->threaded_items * PACKED_THREADED_ORDERS * pack_threaded_stride(p);
+    after_lights += layout->threaded_items * PACKED_THREADED_ORDERS * layout->threaded_stride;
     layout->pixel_offset = after_lights;
     uint64_t image_pixels = 0;
     for (int i = 0; i < s->image_count; i++)
