@@ -177,11 +177,18 @@ static uint32_t write_threaded_subtree(packer *p, uint32_t n, int octant, uint64
     bool right_first = right_child_first(&top->tree.nodes[node->first], &top->tree.nodes[node->first + 1], octant);
     item = write_threaded_subtree(p, node->first + right_first, octant, list, item);
     item = write_threaded_subtree(p, node->first + !right_first, octant, list, item);
+    /* The corners in the order the octant's rays meet them (packed_layout.h): the shader's
+     * slab test then takes no minimum and maximum per axis, which llvmpipe compiles to three
+     * instructions each (docs/performance.md, the log). */
+    float near[3], far[3];
+    for (int axis = 0; axis < 3; axis++) {
+        bool negative = (octant >> axis) & 1;
+        near[axis] = negative ? node->box.max[axis] : node->box.min[axis];
+        far[axis] = negative ? node->box.min[axis] : node->box.max[axis];
+    }
     uint64_t base = list + (uint64_t)own * stride;
-    put_texel(p->texels, base, float_bits(node->box.min[0]), float_bits(node->box.min[1]), float_bits(node->box.min[2]),
-              item);
-    put_texel(p->texels, base + 1, float_bits(node->box.max[0]), float_bits(node->box.max[1]),
-              float_bits(node->box.max[2]), 0);
+    put_texel(p->texels, base, float_bits(near[0]), float_bits(near[1]), float_bits(near[2]), item);
+    put_texel(p->texels, base + 1, float_bits(far[0]), float_bits(far[1]), float_bits(far[2]), 0);
     return item;
 }
 

@@ -45,7 +45,7 @@
 #define RT_PACKED_LAYOUT_H
 
 /* Bumped whenever a record below changes meaning. */
-#define PACKED_LAYOUT_VERSION 7
+#define PACKED_LAYOUT_VERSION 8
 #define PACKED_NONE 4294967295u
 
 /* ---- header (7 texels), field i is component i % 4 of texel i / 4 */
@@ -177,9 +177,15 @@
  * trace_threaded), unless a material has an alpha mask (the stack's walk tests it). Each
  * list is the top-level BVH in depth-first order, with the children of every interior node
  * in the order a ray of octant o meets them along the axis that separates their centres
- * most (octant bit k set: direction component k negative), and every leaf replaced by its
- * primitives. An item (a third texel only with stride 3; 0 where not named):
- *   interior node: (box_min.xyz, skip), (box_max.xyz, 0)
+ * most, and every leaf replaced by its primitives. A ray's octant has bit k set when
+ * component k of its inverse direction is negative, the inverse taken of a direction whose
+ * components have a magnitude of at least TRAVERSAL_SMALLEST_DIRECTION (smaller ones become
+ * that with their sign, -0 as +0: glsl/intersect.glsl traversal_ray), so that the box test
+ * sees no infinity and no NaN. An item (a third texel only with stride 3; 0 where not
+ * named):
+ *   interior node: (near.xyz, skip), (far.xyz, 0): the box's corners as a ray of octant o
+ *                  meets them: near.k = box_min.k, far.k = box_max.k, swapped where bit k
+ *                  is set; so the slab test needs no minimum and maximum per axis
  *   sphere:        (centre.xyz, skip), (radius, 0, 0, THREADED_SPHERE | slot)
  *   quad:          (Q.xyz, skip), (u.xyz, THREADED_QUAD | slot), (v.xyz, 0), as its shape
  *                  record holds them
@@ -194,6 +200,7 @@
 #define THREADED_SPHERE 2147483648u
 #define THREADED_QUAD 1073741824u
 #define THREADED_SLOT_MASK 1073741823u
+#define TRAVERSAL_SMALLEST_DIRECTION 1e-30
 
 /* ---- instances: 5 texels
  *   texel 0 = (first, material override or PACKED_NONE, flags, count): first and count

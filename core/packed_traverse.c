@@ -165,21 +165,54 @@ static void ray_set(moving_ray *ray, vec3 origin, vec3 direction)
 {
     glm_vec3_copy(origin, ray->origin);
     glm_vec3_copy(direction, ray->direction);
-    glm_vec3_div(GLM_VEC3_ONE, direction, ray->inverse_direction);
+    /* As glsl/intersect.glsl traversal_ray: no infinities (packed_layout.h
+     * TRAVERSAL_SMALLEST_DIRECTION). */
+    const float smallest = (float)TRAVERSAL_SMALLEST_DIRECTION;
+    for (int axis = 0; axis < 3; axis++) {
+        float component = fabsf(direction[axis]) < smallest ? (direction[axis] < 0 ? -smallest : smallest)
+                                                            : direction[axis];
+        ray->inverse_direction[axis] = 1.0f / component;
+    }
 }
 
-/* glsl/intersect.glsl intersect_box, the slab test: where the ray enters the box (texels lo, hi) within
- * (0, t_max), or INFINITY when it misses. */
-static float intersect_box(const packed_scene *packed, uint32_t lo, uint32_t hi, const moving_ray *ray, float t_max)
+/* A float's bits as a signed integer (glsl floatBitsToInt). */
+static int32_t float_order(float value)
 {
-    float enter = 0, leave = t_max;
+    int32_t bits;
+    memcpy(&bits, &value, sizeof bits);
+    return bits;
+}
+
+/* glsl/intersect.glsl intersect_ordered_box: where the ray enters the box with corners
+ * near and far in the order it meets them, within (0, t_max), or INFINITY when it misses;
+ * its minima and maxima taken of the distances' bits as the shader takes them. */
+static float ordered_box_entry(const float near[3], const float far[3], const moving_ray *ray, float t_max)
+{
+    int32_t enter = 0, leave = float_order(t_max);
     for (int axis = 0; axis < 3; axis++) {
-        float t0 = (packed_float(packed, lo, axis) - ray->origin[axis]) * ray->inverse_direction[axis];
-        float t1 = (packed_float(packed, hi, axis) - ray->origin[axis]) * ray->inverse_direction[axis];
-        enter = fmaxf(enter, fminf(t0, t1));
-        leave = fminf(leave, fmaxf(t0, t1));
+        int32_t t_near = float_order((near[axis] - ray->origin[axis]) * ray->inverse_direction[axis]);
+        int32_t t_far = float_order((far[axis] - ray->origin[axis]) * ray->inverse_direction[axis]);
+        enter = t_near > enter ? t_near : enter;
+        leave = t_far < leave ? t_far : leave;
     }
-    return enter <= leave ? enter : INFINITY;
+    float entry;
+    memcpy(&entry, &enter, sizeof entry);
+    return enter <= leave ? entry : INFINITY;
+}
+
+/* The slab test of a box of packed at texels lo and hi: as they are (ordered true: a
+ * threaded walk's near and far corners), or ordered by the signs of the ray's inverse
+ * direction as glsl/intersect.glsl intersect_box orders them (lo: the minimum). */
+static float intersect_box(const packed_scene *packed, uint32_t lo, uint32_t hi, bool ordered, const moving_ray *ray,
+                           float t_max)
+{
+    float near[3], far[3];
+    for (int axis = 0; axis < 3; axis++) {
+        bool down = !ordered && ray->inverse_direction[axis] < 0;
+        near[axis] = packed_float(packed, down ? hi : lo, axis);
+        far[axis] = packed_float(packed, down ? lo : hi, axis);
+    }
+    return ordered_box_entry(near, far, ray, t_max);
 }
 
 /* The shader's stack entries (glsl/traverse.glsl): a node record's (first, count) pair, or
@@ -287,8 +320,8 @@ static bool walk(const packed_scene *packed, const float origin[3], const float 
                 }
             } else {
                 uint32_t base = packed->node_offset + item.first * PACKED_NODE_STRIDE;
-                float left = intersect_box(packed, base, base + 1, &ray, hit->t);
-                float right = intersect_box(packed, base + 2, base + 3, &ray, hit->t);
+                float left = intersect_box(packed, base, base + 1, false, &ray, hit->t);
+                float right = intersect_box(packed, base + 2, base + 3, false, &ray, hit->t);
                 bool right_nearer = right < left;
                 walk_item near = {packed_uint(packed, base + (right_nearer ? 2 : 0), 3),
                                   packed_uint(packed, base + (right_nearer ? 3 : 1), 3), fminf(left, right)};
@@ -340,7 +373,8 @@ bool packed_threaded_walk(const packed_scene *packed, const float origin[3], con
         return false;
     moving_ray ray;
     ray_set(&ray, (float *)origin, (float *)direction);
-    uint32_t octant = (direction[0] < 0) | (direction[1] < 0) << 1 | (direction[2] < 0) << 2;
+    uint32_t octant = (ray.inverse_direction[0] < 0) | (ray.inverse_direction[1] < 0) << 1
+                      | (ray.inverse_direction[2] < 0) << 2;
     uint32_t list = packed->threaded_offset + octant * items * stride;
     for (uint32_t item = 0; item < items;) {
         uint32_t base = list + item * stride;
@@ -348,7 +382,8 @@ bool packed_threaded_walk(const packed_scene *packed, const float origin[3], con
             ++*items_visited;
         uint32_t tag = packed_uint(packed, base + 1, 3);
         if (!(tag & (THREADED_SPHERE | THREADED_QUAD))) {
-            item = intersect_box(packed, base, base + 1, &ray, hit->t) < INFINITY ? item + 1 : packed_uint(packed, base, 3);
+            item = intersect_box(packed, base, base + 1, true, &ray, hit->t) < INFINITY ? item + 1
+                                                                                     : packed_uint(packed, base, 3);
             continue;
         }
         packed_primitive primitive = {.type = tag & THREADED_QUAD ? PRIMITIVE_QUAD : PRIMITIVE_SPHERE};

@@ -24,7 +24,14 @@ TraversalRay traversal_ray(vec3 origin, vec3 direction)
     TraversalRay ray;
     ray.origin = origin;
     ray.direction = direction;
-    ray.inverse_direction = 1.0 / direction;
+    // No infinities: a component smaller than TRAVERSAL_SMALLEST_DIRECTION (core/packed_layout.h)
+    // becomes that, with its sign (-0 as +0), so that a slab test multiplies no zero by an
+    // infinity, and the threaded walk's octant (its inverse's signs) matches its boxes.
+    const float smallest = TRAVERSAL_SMALLEST_DIRECTION;
+    vec3 safe = vec3(abs(direction.x) < smallest ? (direction.x < 0.0 ? -smallest : smallest) : direction.x,
+                     abs(direction.y) < smallest ? (direction.y < 0.0 ? -smallest : smallest) : direction.y,
+                     abs(direction.z) < smallest ? (direction.z < 0.0 ? -smallest : smallest) : direction.z);
+    ray.inverse_direction = 1.0 / safe;
     ray.direction_length = length(direction);
     ray.unit = direction / ray.direction_length;
     return ray;
@@ -87,16 +94,34 @@ float intersect_flat(vec3 corner, vec3 edge1, vec3 edge2, bool quad, vec3 origin
     return t > 0.0 && t < t_max ? t : INFINITY;
 }
 
-// Entry distance of the ray into a box, or INFINITY when it misses or enters beyond t_max.
+// The slab test for a box given by its corners in the order the ray meets them (near: the
+// corner whose planes it enters by, far: the one it leaves by; core/packed_layout.h
+// "threaded walk"): the entry distance of the ray into the box, or INFINITY when it misses
+// or enters beyond t_max. The minima and maxima are taken of the distances' bits as
+// integers: for floats that are not NaN (with traversal_ray's inverse none is) integer
+// order is float order wherever it matters here, since the entry is at least +0 and any
+// negative exit (sign bit: a negative integer) is a miss either way. llvmpipe compiles a
+// float min or max to three instructions, to return the operand that is not NaN, an
+// integer one to one (docs/performance.md, the log); NIR turns a select written as a
+// float min back into that.
+float intersect_ordered_box(vec3 near, vec3 far, vec3 origin, vec3 inverse_direction, float t_max)
+{
+    ivec3 t_near = floatBitsToInt((near - origin) * inverse_direction);
+    ivec3 t_far = floatBitsToInt((far - origin) * inverse_direction);
+    int enter = max(max(t_near.x, t_near.y), max(t_near.z, 0));
+    int leave = min(min(t_far.x, t_far.y), min(t_far.z, floatBitsToInt(t_max)));
+    return enter <= leave ? intBitsToFloat(enter) : INFINITY;
+}
+
+// Entry distance of the ray into a box, or INFINITY when it misses or enters beyond t_max:
+// intersect_ordered_box with the corners ordered by the signs of the inverse direction,
+// by selects (one instruction each on llvmpipe) rather than a minimum and a maximum per
+// axis (three each).
 float intersect_box(vec3 box_min, vec3 box_max, vec3 origin, vec3 inverse_direction, float t_max)
 {
-    vec3 t0 = (box_min - origin) * inverse_direction;
-    vec3 t1 = (box_max - origin) * inverse_direction;
-    vec3 t_small = min(t0, t1);
-    vec3 t_large = max(t0, t1);
-    float enter = max(max(t_small.x, t_small.y), max(t_small.z, 0.0));
-    float leave = min(min(t_large.x, t_large.y), min(t_large.z, t_max));
-    return enter <= leave ? enter : INFINITY;
+    bvec3 down = lessThan(inverse_direction, vec3(0.0));
+    return intersect_ordered_box(mix(box_min, box_max, down), mix(box_max, box_min, down), origin, inverse_direction,
+                                 t_max);
 }
 
 // Whether the hit at distance t along the ray (in the primitive's own coordinates; edge

@@ -80,10 +80,12 @@ Hit no_hit(float t_max)
 // Texels a threaded walk's item takes: a quad's three, else two (core/packed_layout.h).
 const uint THREADED_STRIDE = uint(HAS_QUADS ? PACKED_THREADED_QUAD_ITEM_STRIDE : PACKED_THREADED_ITEM_STRIDE);
 
-// The first texel of the threaded walk's list for rays along direction: its octant's.
-uint threaded_list(vec3 direction)
+// The first texel of the threaded walk's list for ray: its octant's, by the signs of its
+// inverse direction, which its boxes' corners are ordered for (core/packed_layout.h).
+uint threaded_list(TraversalRay ray)
 {
-    uint octant = (direction.x < 0.0 ? 1u : 0u) | (direction.y < 0.0 ? 2u : 0u) | (direction.z < 0.0 ? 4u : 0u);
+    vec3 inverse = ray.inverse_direction;
+    uint octant = (inverse.x < 0.0 ? 1u : 0u) | (inverse.y < 0.0 ? 2u : 0u) | (inverse.z < 0.0 ? 4u : 0u);
     return threaded_offset + octant * threaded_items * THREADED_STRIDE;
 }
 
@@ -99,8 +101,8 @@ uint threaded_step(TraversalRay ray, uint list, uint item, inout Hit hit, out bo
     uvec4 third_texel = HAS_QUADS ? packed_texel(base + 2u) : uvec4(0u);
     bool sphere = HAS_SPHERES && (second_texel.w & THREADED_SPHERE) != 0u;
     bool quad = HAS_QUADS && (second_texel.w & THREADED_QUAD) != 0u;
-    float box_entry = intersect_box(packed_xyz(first_texel), packed_xyz(second_texel), ray.origin,
-                                    ray.inverse_direction, hit.t);
+    float box_entry = intersect_ordered_box(packed_xyz(first_texel), packed_xyz(second_texel), ray.origin,
+                                            ray.inverse_direction, hit.t);
     float t = INFINITY;
     vec2 coordinates = vec2(0.0);
     if (HAS_SPHERES)
@@ -143,7 +145,7 @@ void trace_threaded(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3
     // is left out.
     if (HAS_DIRECT_LIGHT && shadow_wanted) {
         TraversalRay ray = traversal_ray(shadow.origin, shadow.direction);
-        uint list = threaded_list(shadow.direction);
+        uint list = threaded_list(ray);
         uint item = 0u;
         while (count_work()) {
             item = threaded_step(ray, list, item, shadow_hit, primitive_hit);
@@ -155,7 +157,7 @@ void trace_threaded(bool shadow_wanted, ShadowRay shadow, bool path_wanted, vec3
     }
     if (path_wanted) {
         TraversalRay ray = traversal_ray(path_origin, path_direction);
-        uint list = threaded_list(path_direction);
+        uint list = threaded_list(ray);
         uint item = 0u;
         while (count_work()) {
             item = threaded_step(ray, list, item, path_hit, primitive_hit);

@@ -88,13 +88,16 @@ static void add_random_quads(scene *s, int count)
     }
 }
 
-/* Whether the box of item (texels box_base, box_base + 1) holds the primitive item at
- * base: a sphere's box, or a quad's four corners (within float rounding of the sums). */
-static bool box_holds(const packed_scene *packed, uint32_t box_base, uint32_t base)
+/* Whether the box of item (texels box_base, box_base + 1: its near and far corners for
+ * octant) holds the primitive item at base: a sphere's box, or a quad's four corners
+ * (within float rounding of the sums). */
+static bool box_holds(const packed_scene *packed, int octant, uint32_t box_base, uint32_t base)
 {
     uint32_t tag = packed_uint(packed, base + 1, 3);
     for (int k = 0; k < 3; k++) {
-        float lo = packed_float(packed, box_base, k), hi = packed_float(packed, box_base + 1, k);
+        float near = packed_float(packed, box_base, k), far = packed_float(packed, box_base + 1, k);
+        bool negative = (octant >> k) & 1;
+        float lo = negative ? far : near, hi = negative ? near : far;
         if (tag & THREADED_SPHERE) {
             float centre = packed_float(packed, base, k), radius = packed_float(packed, base + 1, 0);
             if (!(lo <= centre - radius && hi >= centre + radius))
@@ -157,10 +160,16 @@ static void check_lists(const packed_scene *packed)
             } else {
                 assert_int_equal(tag, 0);
                 assert_true(skip > item + 2);   /* two children at least */
+                /* The corners in the order the octant's rays meet them: min first where
+                 * they go up the axis, max first where they go down. */
+                for (int k = 0; k < 3; k++) {
+                    float near = packed_float(packed, base, k), far = packed_float(packed, base + 1, k);
+                    assert_true((octant >> k) & 1 ? near >= far : near <= far);
+                }
                 for (uint32_t inner = item + 1; inner < skip; inner++) {
                     uint32_t inner_base = list + inner * stride;
                     if (packed_uint(packed, inner_base + 1, 3) & (THREADED_SPHERE | THREADED_QUAD))
-                        assert_true(box_holds(packed, base, inner_base));
+                        assert_true(box_holds(packed, octant, base, inner_base));
                 }
                 open_until[depth++] = skip;
             }
@@ -299,6 +308,58 @@ static void walk_finds_the_nearest_hit(void **state)
         packed_scene_free(&packed);
         scene_free(&s);
     }
+}
+
+/* Rays along an axis or in a plane, their zero components +0 or -0: a ray walks the list
+ * its inverse direction's signs choose, which its boxes' corners are ordered for, and that
+ * inverse takes -0 as +0 (packed_layout.h TRAVERSAL_SMALLEST_DIRECTION); so both find the
+ * nearest sphere brute force finds. (With 1 / -0 = -infinity and the list chosen by the
+ * direction's own signs, a -0 ray would miss every box it starts inside.) */
+static void rays_with_zero_components_find_the_nearest_hit(void **state)
+{
+    (void)state;
+    scene s;
+    random_scene(&s, 300, 50);
+    packed_scene packed;
+    assert_int_equal(pack_scene(&s, NULL, &packed, NULL), RT_OK);
+    int hits = 0, negative_zeros = 0;
+    for (int r = 0; r < 6000; r += 10) {   /* random_ray: every tenth ray along an axis */
+        for (int variant = 0; variant < 2; variant++) {
+            double o[3], d[3];
+            float of[3], df[3];
+            random_ray(r + variant * 5, o, d, of, df);
+            int zero_axis = (r / 10) % 3;   /* one more zero: rays in a plane as well */
+            if (variant == 1) {   /* unit again, as sphere_hit wants it */
+                df[zero_axis] = 0;
+                float length = sqrtf(df[0] * df[0] + df[1] * df[1] + df[2] * df[2]);
+                for (int k = 0; k < 3; k++) {
+                    df[k] /= length;
+                    d[k] = df[k];
+                }
+            }
+            double best = INFINITY;
+            for (uint32_t slot = 0; slot < packed.primitive_count; slot++)
+                best = fmin(best, sphere_hit(packed_primitive_at(&packed, slot).data[0], o, d));
+            packed_hit positive, negative;
+            packed_threaded_walk(&packed, of, df, INFINITY, false, PACKED_NONE, &positive, NULL);
+            for (int k = 0; k < 3; k++)
+                if (df[k] == 0) {
+                    df[k] = -0.0f;
+                    negative_zeros++;
+                }
+            packed_threaded_walk(&packed, of, df, INFINITY, false, PACKED_NONE, &negative, NULL);
+            assert_true(positive.t == negative.t || (isinf(positive.t) && isinf(negative.t)));
+            if (isinf(best)) {
+                assert_true(isinf(positive.t));
+                continue;
+            }
+            hits++;
+            assert_true(fabs(positive.t - best) <= 1e-4 * (1 + best));
+        }
+    }
+    assert_true(hits > 100 && negative_zeros > 1000);
+    packed_scene_free(&packed);
+    scene_free(&s);
 }
 
 static void shadow_walk_stops_at_blockers_only(void **state)
@@ -452,6 +513,7 @@ int main(void)
         cmocka_unit_test(every_list_is_the_tree_depth_first),
         cmocka_unit_test(walk_finds_the_nearest_hit),
         cmocka_unit_test(walk_with_quads_matches_the_stack_walk),
+        cmocka_unit_test(rays_with_zero_components_find_the_nearest_hit),
         cmocka_unit_test(shadow_walk_stops_at_blockers_only),
         cmocka_unit_test(only_still_spheres_in_one_level_get_lists),
         cmocka_unit_test(too_many_spheres_get_no_lists),
