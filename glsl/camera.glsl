@@ -15,13 +15,14 @@ void begin_pixel()
     film_pixel = vec2(float(image_pixel.x), float(full_size.y - 1 - image_pixel.y));
     rng_pixel = uvec2(image_pixel);
     rng_seed_hash = random_seed_hash(seed);
+    begin_pixel_streams();
 }
 
 // The current sample's camera ray: through a jittered point of the pixel, from a random
 // point of the lens (thin-lens defocus).
 void camera_ray(out vec3 origin, out vec3 direction)
 {
-    vec4 u = random4(0u, 0u);
+    vec4 u = random4_camera();
     vec2 film = (film_pixel + u.xy) / vec2(full_size);
     vec2 lens = lens_radius * random_in_unit_disk(u.zw);
     origin = camera_origin + lens.x * camera_u + lens.y * camera_v;
@@ -31,5 +32,5 @@ void camera_ray(out vec3 origin, out vec3 direction)
 // The current sample's moment within the shutter: the same for all its segments.
 float ray_time()
 {
-    return mix(shutter_open, shutter_close, random4(0u, 3u).x);
+    return mix(shutter_open, shutter_close, random4_time().x);
 }

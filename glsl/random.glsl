@@ -75,16 +75,41 @@ vec2 sobol_pair(uint sample_index, uvec3 seeds)
     return vec2(uvec2(first, second) >> 8u) * (1.0 / 16777216.0);
 }
 
-// Four numbers in [0, 1) (24-bit resolution) for one dimension of one sample: with the
-// Sobol sampler, (x, y) and (z, w) are two independent stratified 2D pairs, so a 2D
-// sampling routine should take one pair, never (y, z).
-vec4 random_numbers(uvec2 pixel, uint sample_index, uint seed_hash, uint dimension, int sampler_kind)
+// What random_numbers hashes from (pixel, seed, dimension) alone, apart from the sample:
+// the Sobol sampler's seeds of the dimension's two pairs (shuffle, first and second
+// coordinate's scramble). A dimension that every sample of a pixel draws (the camera's)
+// takes them once per pixel (glsl/sampling.glsl): LLVM does not hoist them out of the
+// tracer's loop, where they cost 70 instructions a segment (docs/performance.md, the log).
+struct DimensionSeeds {
+    uvec3 first_pair;
+    uvec3 second_pair;
+};
+
+DimensionSeeds dimension_seeds(uvec2 pixel, uint seed_hash, uint dimension)
+{
+    DimensionSeeds seeds;
+    seeds.first_pair = hash4(uvec4(pixel.x, pixel.y, seed_hash, 2u * dimension)).xyz;
+    seeds.second_pair = hash4(uvec4(pixel.x, pixel.y, seed_hash, 2u * dimension + 1u)).xyz;
+    return seeds;
+}
+
+// random_numbers with the dimension's seeds given (dimension_seeds of the same pixel,
+// seed_hash and dimension): the same four numbers.
+vec4 random_numbers_seeded(DimensionSeeds seeds, uvec2 pixel, uint sample_index, uint seed_hash, uint dimension,
+                           int sampler_kind)
 {
     if (sampler_kind == SAMPLER_INDEPENDENT) {
         uvec4 h = hash4(uvec4(pixel.x, pixel.y, sample_index, seed_hash ^ dimension));
         return vec4(h >> 8u) * (1.0 / 16777216.0);
     }
-    uvec4 a = hash4(uvec4(pixel.x, pixel.y, seed_hash, 2u * dimension));
-    uvec4 b = hash4(uvec4(pixel.x, pixel.y, seed_hash, 2u * dimension + 1u));
-    return vec4(sobol_pair(sample_index, a.xyz), sobol_pair(sample_index, b.xyz));
+    return vec4(sobol_pair(sample_index, seeds.first_pair), sobol_pair(sample_index, seeds.second_pair));
+}
+
+// Four numbers in [0, 1) (24-bit resolution) for one dimension of one sample: with the
+// Sobol sampler, (x, y) and (z, w) are two independent stratified 2D pairs, so a 2D
+// sampling routine should take one pair, never (y, z).
+vec4 random_numbers(uvec2 pixel, uint sample_index, uint seed_hash, uint dimension, int sampler_kind)
+{
+    return random_numbers_seeded(dimension_seeds(pixel, seed_hash, dimension), pixel, sample_index, seed_hash,
+                                 dimension, sampler_kind);
 }

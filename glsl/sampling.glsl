@@ -13,10 +13,33 @@ uvec2 rng_pixel;     // pixel in image coordinates (row 0 at the top)
 uint rng_sample;     // absolute sample index
 uint rng_seed_hash;
 
+// The seeds of the streams every sample of the pixel draws at bounce 0 (glsl/random.glsl
+// dimension_seeds), set once per pixel by begin_pixel_streams: the camera ray's (stream 0)
+// and the ray time's (stream 3).
+DimensionSeeds camera_stream_seeds, time_stream_seeds;
+
+// Sets the per-pixel seeds above, once rng_pixel and rng_seed_hash are set.
+void begin_pixel_streams()
+{
+    camera_stream_seeds = dimension_seeds(rng_pixel, rng_seed_hash, 0u);
+    time_stream_seeds = dimension_seeds(rng_pixel, rng_seed_hash, 3u);
+}
+
 // Four uniform numbers in [0, 1) for one (bounce, stream) of the current sample.
 vec4 random4(uint bounce, uint stream)
 {
     return random_numbers(rng_pixel, rng_sample, rng_seed_hash, bounce * 8u + stream, sampler_kind());
+}
+
+// random4(0u, 0u) and random4(0u, 3u), from the pixel's seeds (begin_pixel_streams).
+vec4 random4_camera()
+{
+    return random_numbers_seeded(camera_stream_seeds, rng_pixel, rng_sample, rng_seed_hash, 0u, sampler_kind());
+}
+
+vec4 random4_time()
+{
+    return random_numbers_seeded(time_stream_seeds, rng_pixel, rng_sample, rng_seed_hash, 3u, sampler_kind());
 }
 
 vec3 random_unit_vector(vec2 u)
