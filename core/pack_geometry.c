@@ -117,7 +117,8 @@ uint64_t pack_threaded_items(const packer *p)
     uint64_t interior = 0;
     for (uint32_t n = 0; n < top->tree.node_count; n++)
         interior += top->tree.nodes[n].count == 0;
-    uint64_t items = interior + top->primitives.count;
+    /* Every interior node's box but the root's (packed_layout.h), and every primitive. */
+    uint64_t items = interior - (interior > 0) + top->primitives.count;
     return items * PACKED_THREADED_ORDERS * pack_threaded_stride(p) <= PACKED_THREADED_MAX_TEXELS ? items : 0;
 }
 
@@ -148,6 +149,18 @@ static bool right_child_first(const bvh_node *left, const bvh_node *right, int o
     return right_above == negative;
 }
 
+static uint32_t write_threaded_subtree(packer *p, uint32_t n, int octant, uint64_t list, uint32_t item);
+
+/* Writes the subtrees of interior node's two children into octant's list at list from
+ * item on, in the order the octant's rays meet them; returns the item after them. */
+static uint32_t write_threaded_children(packer *p, const bvh_node *node, int octant, uint64_t list, uint32_t item)
+{
+    const bvh_node *nodes = p->top.tree.nodes;
+    bool right_first = right_child_first(&nodes[node->first], &nodes[node->first + 1], octant);
+    item = write_threaded_subtree(p, node->first + right_first, octant, list, item);
+    return write_threaded_subtree(p, node->first + !right_first, octant, list, item);
+}
+
 /* Writes node n's subtree of the top BVH into octant's list at list (its first texel) from
  * item on, depth first; returns the item after it. Recursion is as deep as the BVH
  * (BVH_MAX_DEPTH). */
@@ -174,9 +187,7 @@ static uint32_t write_threaded_subtree(packer *p, uint32_t n, int octant, uint64
         return item;
     }
     uint32_t own = item++;
-    bool right_first = right_child_first(&top->tree.nodes[node->first], &top->tree.nodes[node->first + 1], octant);
-    item = write_threaded_subtree(p, node->first + right_first, octant, list, item);
-    item = write_threaded_subtree(p, node->first + !right_first, octant, list, item);
+    item = write_threaded_children(p, node, octant, list, item);
     /* The corners in the order the octant's rays meet them (packed_layout.h): the shader's
      * slab test then takes no minimum and maximum per axis, which llvmpipe compiles to three
      * instructions each (docs/performance.md, the log). */
@@ -195,11 +206,17 @@ static uint32_t write_threaded_subtree(packer *p, uint32_t n, int octant, uint64
 void pack_write_threaded(packer *p)
 {
     const pack_layout *layout = &p->layout;
-    for (int octant = 0; octant < PACKED_THREADED_ORDERS && layout->threaded_items > 0; octant++)
-        write_threaded_subtree(p, 0, octant,
-                               layout->threaded_offset
-                                   + (uint64_t)octant * layout->threaded_items * layout->threaded_stride,
-                               0);
+    const bvh_node *root = &p->top.tree.nodes[0];
+    for (int octant = 0; octant < PACKED_THREADED_ORDERS && layout->threaded_items > 0; octant++) {
+        uint64_t list = layout->threaded_offset + (uint64_t)octant * layout->threaded_items * layout->threaded_stride;
+        /* No item for the root's box: nearly every ray starts inside it (the scene's
+         * bounds), so its test is an iteration of every walk that culls nothing; a ray
+         * that misses it misses its children's boxes as well. */
+        if (root->count == 0)
+            write_threaded_children(p, root, octant, list, 0);
+        else
+            write_threaded_subtree(p, 0, octant, list, 0);
+    }
 }
 
 uint32_t packed_encode_normal(const float normal[3])

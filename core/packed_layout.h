@@ -45,7 +45,7 @@
 #define RT_PACKED_LAYOUT_H
 
 /* Bumped whenever a record below changes meaning. */
-#define PACKED_LAYOUT_VERSION 8
+#define PACKED_LAYOUT_VERSION 9
 #define PACKED_NONE 4294967295u
 
 /* ---- header (7 texels), field i is component i % 4 of texel i / 4 */
@@ -177,7 +177,8 @@
  * trace_threaded), unless a material has an alpha mask (the stack's walk tests it). Each
  * list is the top-level BVH in depth-first order, with the children of every interior node
  * in the order a ray of octant o meets them along the axis that separates their centres
- * most, and every leaf replaced by its primitives. A ray's octant has bit k set when
+ * most, and every leaf replaced by its primitives; the root's own box has no item (nearly
+ * every ray starts inside it, and one that misses it misses every box in it). A ray's octant has bit k set when
  * component k of its inverse direction is negative, the inverse taken of a direction whose
  * components have a magnitude of at least TRAVERSAL_SMALLEST_DIRECTION (smaller ones become
  * that with their sign, -0 as +0: glsl/intersect.glsl traversal_ray), so that the box test
