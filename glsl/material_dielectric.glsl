@@ -6,7 +6,8 @@ float schlick_reflectance(float cosine, float eta_ratio)
 {
     float r0 = (1.0 - eta_ratio) / (1.0 + eta_ratio);
     r0 = r0 * r0;
-    return r0 + (1.0 - r0) * pow(1.0 - cosine, 5.0);
+    float m = 1.0 - cosine, m2 = m * m;
+    return r0 + (1.0 - r0) * (m2 * m2 * m);
 }
 
 // Reflects when refraction is impossible (total internal reflection) or with the Fresnel

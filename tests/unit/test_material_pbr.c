@@ -20,6 +20,7 @@ enum {
     METAL_WHITE_01, METAL_WHITE_04, METAL_WHITE_07, METAL_WHITE_10,                    /* furnaces */
     GLASS_WHITE_01, GLASS_WHITE_04, GLASS_WHITE_07, GLASS_WHITE_10,
     SMOOTH_METAL, SMOOTH_GLASS, FUZZLESS_METAL, DIELECTRIC_15,                         /* the limit */
+    FUZZY_METAL,                                                                       /* fuzz 1 */
     MATERIAL_COUNT
 };
 
@@ -113,6 +114,8 @@ static int set_up(void **state)
     glass.index_of_refraction = 1.5f;
     assert_true(scene_add_material(&s, &metal) == FUZZLESS_METAL);
     assert_true(scene_add_material(&s, &glass) == DIELECTRIC_15);
+    metal.fuzz = 1;
+    assert_true(scene_add_material(&s, &metal) == FUZZY_METAL);
     rt_status status = pack_scene(&s, NULL, &packed, &error);
     scene_free(&s);
     return status == RT_OK ? 0 : -1;
@@ -613,6 +616,112 @@ static void roughness_zero_is_the_metal_and_the_dielectric(void **state)
     free(queries);
 }
 
+/* ---- the Ray Tracing books' metal and glass ---------------------------------------------- */
+
+/* A fuzzy metal (fuzz 1) sends the path along the mirror direction plus a point of the unit
+ * ball drawn from u (glsl/sampling.glsl random_in_unit_sphere: a direction from u.xy, the
+ * radius the cube root of u.z, which glsl/sampling.glsl cube_root computes without pow),
+ * normalised; below the surface it absorbs. Checked against that construction in double
+ * for each query, and the radii's distribution against the ball's (a mean radius of 3/4). */
+static void fuzzy_metal_moves_the_mirror_direction_by_a_point_in_the_ball(void **state)
+{
+    (void)state;
+    enum { COUNT = 4000 };
+    gpu_material_query *queries = calloc(COUNT, sizeof *queries);
+    assert_non_null(queries);
+    frame f = frame_around(normalized(make_vec(0.2, 0.3, 1)));
+    uint64_t seed = 900;
+    for (int i = 0; i < COUNT; i++) {
+        gpu_material_query *q = &queries[i];
+        double angle = acos(0.05 + 0.95 * uniform(&seed)), phi = 2 * M_PI * uniform(&seed);
+        vec view = to_world(&f, make_vec(sin(angle) * cos(phi), sin(angle) * sin(phi), cos(angle)));
+        *q = (gpu_material_query){.front_face = true, .material = FUZZY_METAL};
+        store(q->direction, scale(view, -1));
+        store(q->normal, f.n);
+        store(q->shading, f.n);
+        store(q->to_light, f.n);
+        for (int k = 0; k < 4; k++)
+            q->u[k] = (float)uniform(&seed);
+    }
+    gpu_material_result *r = run(queries, COUNT);
+    int compared = 0;
+    double radius_sum = 0;
+    for (int i = 0; i < COUNT; i++) {
+        const gpu_material_query *q = &queries[i];
+        vec d = make_vec(q->direction[0], q->direction[1], q->direction[2]);
+        vec mirror = add(d, scale(f.n, -2 * dot(d, f.n)));
+        double z = 1 - 2.0 * q->u[0], ring = sqrt(fmax(0, 1 - z * z)), turn = 2 * M_PI * q->u[1];
+        double radius = cbrt((double)q->u[2]);
+        radius_sum += radius;
+        vec moved = add(mirror, scale(make_vec(ring * cos(turn), ring * sin(turn), z), radius));
+        double length = sqrt(dot(moved, moved));
+        vec expected = scale(moved, 1 / length);
+        /* Near the surface's plane or a near-zero sum float rounding may decide either way. */
+        if (length < 0.05 || fabs(dot(expected, f.n)) < 1e-4)
+            continue;
+        compared++;
+        assert_int_equal(r[i].absorbed, dot(expected, f.n) <= 0);
+        assert_close(r[i].direction[0], expected.x, 2e-5 / length);
+        assert_close(r[i].direction[1], expected.y, 2e-5 / length);
+        assert_close(r[i].direction[2], expected.z, 2e-5 / length);
+    }
+    assert_true(compared > COUNT * 9 / 10);
+    /* The radii are the ball's: their mean is 3/4 (density 3 r^2). */
+    assert_close(radius_sum / COUNT, 0.75, 0.01);
+    free(r);
+    free(queries);
+}
+
+/* Glass reflects where Schlick's approximation of the Fresnel reflectance, computed here in
+ * double, exceeds u.w (and under total internal reflection), and refracts otherwise
+ * (glsl/material_dielectric.glsl, its fifth power now by multiplication). */
+static void glass_reflects_with_schlick_probability(void **state)
+{
+    (void)state;
+    enum { COUNT = 4000 };
+    gpu_material_query *queries = calloc(COUNT, sizeof *queries);
+    bool *expect_reflect = calloc(COUNT, sizeof *expect_reflect);
+    assert_non_null(queries);
+    assert_non_null(expect_reflect);
+    frame f = frame_around(normalized(make_vec(-0.1, 0.4, 1)));
+    uint64_t seed = 901;
+    int used = 0, reflections = 0, refractions = 0;
+    while (used < COUNT) {
+        bool inside = uniform(&seed) < 0.5;
+        double cosine = 0.01 + 0.99 * uniform(&seed), phi = 2 * M_PI * uniform(&seed);
+        double eta = inside ? 1.5 : 1 / 1.5, sine = sqrt(1 - cosine * cosine);
+        double r0 = (1 - eta) / (1 + eta);
+        r0 *= r0;
+        double schlick = r0 + (1 - r0) * pow(1 - cosine, 5);
+        float u3 = (float)uniform(&seed);
+        if (fabs(u3 - schlick) < 1e-4 || fabs(eta * sine - 1) < 1e-4)
+            continue;
+        gpu_material_query *q = &queries[used];
+        vec view = to_world(&f, make_vec(sine * cos(phi), sine * sin(phi), cosine));
+        /* From inside, the ray leaves through the surface the normal faces away from. */
+        *q = (gpu_material_query){.front_face = !inside, .material = DIELECTRIC_15};
+        store(q->direction, scale(view, -1));
+        store(q->normal, f.n);
+        store(q->shading, f.n);
+        store(q->to_light, f.n);
+        q->u[3] = u3;
+        expect_reflect[used] = eta * sine > 1 || schlick > u3;
+        used++;
+    }
+    gpu_material_result *r = run(queries, COUNT);
+    for (int i = 0; i < COUNT; i++) {
+        vec got = make_vec(r[i].direction[0], r[i].direction[1], r[i].direction[2]);
+        bool reflected = dot(got, f.n) > 0;   /* the view is on the normal's side */
+        assert_int_equal(reflected, expect_reflect[i]);
+        reflections += reflected;
+        refractions += !reflected;
+    }
+    assert_true(reflections > 200 && refractions > 200);
+    free(r);
+    free(expect_reflect);
+    free(queries);
+}
+
 /* ---- vertex colours ------------------------------------------------------------------ */
 
 /* A scene of one triangle mesh in front of the camera under a white sky: a pbr material
@@ -707,6 +816,8 @@ int main(void)
         cmocka_unit_test(rough_glass_furnace_loses_what_single_scattering_loses),
         cmocka_unit_test(evaluate_is_reciprocal),
         cmocka_unit_test(roughness_zero_is_the_metal_and_the_dielectric),
+        cmocka_unit_test(fuzzy_metal_moves_the_mirror_direction_by_a_point_in_the_ball),
+        cmocka_unit_test(glass_reflects_with_schlick_probability),
         cmocka_unit_test(vertex_colours_multiply_the_base_colour),
     };
     return cmocka_run_group_tests(tests, set_up, tear_down);
