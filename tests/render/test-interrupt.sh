@@ -6,9 +6,11 @@
 #   usage: sh tests/render/test-interrupt.sh PROGRAM SCRATCH_DIR
 . "$(dirname "$0")/lib.sh"
 scene=scenes/materials/lambertian.txt
-# About 2.7 million samples (docs/performance.md has how long they take on llvmpipe); the
-# tests wait for the first checkpoint before signalling, so a fast device is fine too.
-options="--size 48x27 --spp 2048 --seed 3"
+# About 10.6 million samples, about a second on llvmpipe (docs/performance.md); the tests
+# wait for the first checkpoint, written every 0.05 s, before signalling, so most of the
+# render is still to come on a faster device too.
+spp=8192
+options="--size 48x27 --spp $spp --seed 3"
 
 # wait_for_file FILE: waits (at most 60 s) until FILE exists; false on time-out.
 wait_for_file() {
@@ -28,7 +30,7 @@ interrupt_running() {
     signal=$1 output=$2
     shift 2
     # shellcheck disable=SC2086
-    "$program" render $scene -o "$output" $options --checkpoint 0.2 "$@" 2>"$scratch/interrupt.err" &
+    "$program" render $scene -o "$output" $options --checkpoint 0.05 "$@" 2>"$scratch/interrupt.err" &
     pid=$!
     wait_for_file "${output%.*}.partial.exr"
     kill -s "$signal" "$pid" 2>/dev/null
@@ -48,13 +50,13 @@ fi
 if [ "$(cat "$scratch/out.png")" = "previous image" ]; then pass "SIGINT leaves the existing output as it was"
 else fail "SIGINT leaves the existing output as it was" "out.png changed"; fi
 range=$(channel_range "$partial" samples)
-if awk -v r="$range" 'BEGIN { split(r, v, " "); exit !(v[1] >= 0 && v[2] <= 2048 && v[1] < 2048) }'; then
+if awk -v r="$range" -v s="$spp" 'BEGIN { split(r, v, " "); exit !(v[1] >= 0 && v[2] <= s && v[1] < s) }'; then
     pass "partial records real per-pixel sample counts ($range)"
 else fail "partial sample counts" "samples channel range '$range'"; fi
 # Its metadata agree with the channel: samples_finished is the channel's sum.
 finished=$(metadata "$partial" samples_finished)
 channel_sum=$(awk -v m="$(channel_mean "$partial" samples)" 'BEGIN { printf "%.0f", m * 48 * 27 }')
-if [ -n "$finished" ] && [ "$finished" = "$channel_sum" ] && [ "$finished" -lt $((48 * 27 * 2048)) ]; then
+if [ -n "$finished" ] && [ "$finished" = "$channel_sum" ] && [ "$finished" -lt $((48 * 27 * spp)) ]; then
     pass "the partial's samples_finished ($finished) is the sum of its samples channel"
 else fail "the partial's samples_finished" "metadata '$finished', channel sum '$channel_sum'"; fi
 
@@ -73,7 +75,7 @@ if "$program" render $scene -o "$scratch/out.exr" $options --resume "$partial" -
         pass "resumed render equals the uninterrupted one"
     else fail "resumed render equals the uninterrupted one" "$(tr '\n' ' ' <"$scratch/diff.txt")"; fi
     samples=$(channel_range "$scratch/out.exr" samples)
-    if [ "$samples" = "2048 2048" ]; then pass "resumed render has every sample"
+    if [ "$samples" = "$spp $spp" ]; then pass "resumed render has every sample"
     else fail "resumed render has every sample" "samples $samples"; fi
 else
     fail "resume" "the resumed render failed"
@@ -108,12 +110,12 @@ else fail "a resumed --blur render to a PNG equals the uninterrupted one" "$(tr 
 # A partial of another render is refused: different seed, different size.
 code=$(interrupt_running INT "$scratch/other.exr")
 # shellcheck disable=SC2086
-"$program" render $scene -o "$scratch/x.exr" --size 48x27 --spp 2048 --seed 4 --resume "$scratch/other.partial.exr" \
+"$program" render $scene -o "$scratch/x.exr" --size 48x27 --spp $spp --seed 4 --resume "$scratch/other.partial.exr" \
     2>"$scratch/err" >/dev/null
 code=$?
 if [ "$code" = 2 ] && grep -q "seed" "$scratch/err"; then pass "resume refuses another seed"
 else fail "resume refuses another seed" "exit $code: $(cat "$scratch/err")"; fi
-"$program" render $scene -o "$scratch/x.exr" --size 32x18 --spp 2048 --seed 3 --resume "$scratch/other.partial.exr" \
+"$program" render $scene -o "$scratch/x.exr" --size 32x18 --spp $spp --seed 3 --resume "$scratch/other.partial.exr" \
     2>"$scratch/err" >/dev/null
 code=$?
 if [ "$code" = 2 ]; then pass "resume refuses another size"
@@ -133,14 +135,15 @@ wait "$pid" 2>/dev/null
 
 # A second signal ends the render at once (the default action): death by SIGINT.
 # shellcheck disable=SC2086
-# Long passes (the largest budget the device allows, over a 640x360 image: about a
-# second a pass): the first signal must still be waiting for its pass to end when the
-# second one comes.
-"$program" render $scene -o "$scratch/twice.exr" --size 640x360 --spp 100000 --checkpoint 0.2 --pass-budget 50000 --quiet &
+# Long passes (the largest budget the device allows, over a 1280x720 image: about 0.45 s
+# a pass on llvmpipe; at 640x360 a pass had come down to about 0.25 s, not always longer
+# than the 0.2 s the signals were apart): the first signal must still be waiting for its
+# pass to end when the second one comes, 0.1 s later.
+"$program" render $scene -o "$scratch/twice.exr" --size 1280x720 --spp 100000 --checkpoint 0.2 --pass-budget 50000 --quiet &
 pid=$!
 wait_for_file "$scratch/twice.partial.exr"
 kill -s INT "$pid"
-sleep 0.2
+sleep 0.1
 kill -s INT "$pid"
 wait "$pid"
 code=$?
