@@ -129,6 +129,18 @@ static int tear_down(void **state)
     return 0;
 }
 
+/* A query of material at a surface of normal n (also its shading normal and the light's
+ * direction), seen from view (unit, on the side front_face says), with no numbers drawn. */
+static gpu_material_query query_from(uint32_t material, vec view, vec n, bool front_face)
+{
+    gpu_material_query q = {.front_face = front_face, .material = material};
+    store(q.direction, scale(view, -1));
+    store(q.normal, n);
+    store(q.shading, n);
+    store(q.to_light, n);
+    return q;
+}
+
 /* Runs count queries on the device; the caller frees the results. */
 static gpu_material_result *run(const gpu_material_query *queries, int count)
 {
@@ -590,12 +602,8 @@ static void roughness_zero_is_the_metal_and_the_dielectric(void **state)
             continue;
         for (int k = 0; k < 2; k++) {
             gpu_material_query *q = &queries[2 * used + k];
-            *q = (gpu_material_query){.front_face = !inside};
-            q->material = (uint32_t)(glass ? (k ? DIELECTRIC_15 : SMOOTH_GLASS) : (k ? FUZZLESS_METAL : SMOOTH_METAL));
-            store(q->direction, scale(view, -1));
-            store(q->normal, f.n);
-            store(q->shading, f.n);
-            store(q->to_light, f.n);
+            uint32_t material = glass ? (k ? DIELECTRIC_15 : SMOOTH_GLASS) : (k ? FUZZLESS_METAL : SMOOTH_METAL);
+            *q = query_from(material, view, f.n, !inside);
             memcpy(q->u, u, sizeof u);
         }
         used++;
@@ -635,11 +643,7 @@ static void fuzzy_metal_moves_the_mirror_direction_by_a_point_in_the_ball(void *
         gpu_material_query *q = &queries[i];
         double angle = acos(0.05 + 0.95 * uniform(&seed)), phi = 2 * M_PI * uniform(&seed);
         vec view = to_world(&f, make_vec(sin(angle) * cos(phi), sin(angle) * sin(phi), cos(angle)));
-        *q = (gpu_material_query){.front_face = true, .material = FUZZY_METAL};
-        store(q->direction, scale(view, -1));
-        store(q->normal, f.n);
-        store(q->shading, f.n);
-        store(q->to_light, f.n);
+        *q = query_from(FUZZY_METAL, view, f.n, true);
         for (int k = 0; k < 4; k++)
             q->u[k] = (float)uniform(&seed);
     }
@@ -699,11 +703,7 @@ static void glass_reflects_with_schlick_probability(void **state)
         gpu_material_query *q = &queries[used];
         vec view = to_world(&f, make_vec(sine * cos(phi), sine * sin(phi), cosine));
         /* From inside, the ray leaves through the surface the normal faces away from. */
-        *q = (gpu_material_query){.front_face = !inside, .material = DIELECTRIC_15};
-        store(q->direction, scale(view, -1));
-        store(q->normal, f.n);
-        store(q->shading, f.n);
-        store(q->to_light, f.n);
+        *q = query_from(DIELECTRIC_15, view, f.n, !inside);
         q->u[3] = u3;
         expect_reflect[used] = eta * sine > 1 || schlick > u3;
         used++;
