@@ -178,12 +178,12 @@
  * list is the top-level BVH in depth-first order, with the children of every interior node
  * in the order a ray of octant o meets them along the axis that separates their centres
  * most, and every leaf replaced by its primitives; the root's own box has no item (nearly
- * every ray starts inside it, and one that misses it misses every box in it). A ray's octant has bit k set when
- * component k of its inverse direction is negative, the inverse taken of a direction whose
- * components have a magnitude of at least TRAVERSAL_SMALLEST_DIRECTION (smaller ones become
- * that with their sign, -0 as +0: glsl/intersect.glsl traversal_ray), so that the box test
- * sees no infinity and no NaN. An item (a third texel only with stride 3; 0 where not
- * named):
+ * every ray starts inside it, and one that misses it misses every box in it). A ray's
+ * octant has bit k set when component k of its inverse direction is negative, the inverse
+ * taken of a direction whose components have a magnitude of at least
+ * TRAVERSAL_SMALLEST_DIRECTION (smaller ones become that with their sign, -0 as +0:
+ * glsl/intersect.glsl traversal_ray), so that the box test sees no infinity and no NaN. An
+ * item (a third texel only with stride 3; 0 where not named):
  *   interior node: (near.xyz, skip), (far.xyz, 0): the box's corners as a ray of octant o
  *                  meets them: near.k = box_min.k, far.k = box_max.k, swapped where bit k
  *                  is set; so the slab test needs no minimum and maximum per axis
