@@ -22,7 +22,7 @@ void begin_pixel()
 // point of the lens (thin-lens defocus).
 void camera_ray(out vec3 origin, out vec3 direction)
 {
-    vec4 u = random4_camera();
+    vec4 u = random4_seeded(camera_stream_seeds);
     vec2 film = (film_pixel + u.xy) / vec2(full_size);
     vec2 lens = lens_radius * random_in_unit_disk(u.zw);
     origin = camera_origin + lens.x * camera_u + lens.y * camera_v;
@@ -32,5 +32,5 @@ void camera_ray(out vec3 origin, out vec3 direction)
 // The current sample's moment within the shutter: the same for all its segments.
 float ray_time()
 {
-    return mix(shutter_open, shutter_close, random4_time().x);
+    return mix(shutter_open, shutter_close, random4_seeded(time_stream_seeds).x);
 }

@@ -28,10 +28,8 @@ TraversalRay traversal_ray(vec3 origin, vec3 direction)
     // becomes that, with its sign (-0 as +0), so that a slab test multiplies no zero by an
     // infinity, and the threaded walk's octant (its inverse's signs) matches its boxes.
     const float smallest = TRAVERSAL_SMALLEST_DIRECTION;
-    vec3 safe = vec3(abs(direction.x) < smallest ? (direction.x < 0.0 ? -smallest : smallest) : direction.x,
-                     abs(direction.y) < smallest ? (direction.y < 0.0 ? -smallest : smallest) : direction.y,
-                     abs(direction.z) < smallest ? (direction.z < 0.0 ? -smallest : smallest) : direction.z);
-    ray.inverse_direction = 1.0 / safe;
+    vec3 smallest_signed = mix(vec3(smallest), vec3(-smallest), lessThan(direction, vec3(0.0)));
+    ray.inverse_direction = 1.0 / mix(direction, smallest_signed, lessThan(abs(direction), vec3(smallest)));
     ray.direction_length = length(direction);
     ray.unit = direction / ray.direction_length;
     return ray;

@@ -81,6 +81,7 @@ vec2 sobol_pair(uint sample_index, uvec3 seeds)
 // takes them once per pixel (glsl/sampling.glsl): LLVM does not hoist them out of the
 // tracer's loop, where they cost 70 instructions a segment (docs/performance.md, the log).
 struct DimensionSeeds {
+    uint dimension;
     uvec3 first_pair;
     uvec3 second_pair;
 };
@@ -88,18 +89,18 @@ struct DimensionSeeds {
 DimensionSeeds dimension_seeds(uvec2 pixel, uint seed_hash, uint dimension)
 {
     DimensionSeeds seeds;
+    seeds.dimension = dimension;
     seeds.first_pair = hash4(uvec4(pixel.x, pixel.y, seed_hash, 2u * dimension)).xyz;
     seeds.second_pair = hash4(uvec4(pixel.x, pixel.y, seed_hash, 2u * dimension + 1u)).xyz;
     return seeds;
 }
 
-// random_numbers with the dimension's seeds given (dimension_seeds of the same pixel,
-// seed_hash and dimension): the same four numbers.
-vec4 random_numbers_seeded(DimensionSeeds seeds, uvec2 pixel, uint sample_index, uint seed_hash, uint dimension,
-                           int sampler_kind)
+// random_numbers for the dimension whose seeds are given (dimension_seeds of the same
+// pixel and seed_hash): the same four numbers.
+vec4 random_numbers_seeded(DimensionSeeds seeds, uvec2 pixel, uint sample_index, uint seed_hash, int sampler_kind)
 {
     if (sampler_kind == SAMPLER_INDEPENDENT) {
-        uvec4 h = hash4(uvec4(pixel.x, pixel.y, sample_index, seed_hash ^ dimension));
+        uvec4 h = hash4(uvec4(pixel.x, pixel.y, sample_index, seed_hash ^ seeds.dimension));
         return vec4(h >> 8u) * (1.0 / 16777216.0);
     }
     return vec4(sobol_pair(sample_index, seeds.first_pair), sobol_pair(sample_index, seeds.second_pair));
@@ -111,5 +112,5 @@ vec4 random_numbers_seeded(DimensionSeeds seeds, uvec2 pixel, uint sample_index,
 vec4 random_numbers(uvec2 pixel, uint sample_index, uint seed_hash, uint dimension, int sampler_kind)
 {
     return random_numbers_seeded(dimension_seeds(pixel, seed_hash, dimension), pixel, sample_index, seed_hash,
-                                 dimension, sampler_kind);
+                                 sampler_kind);
 }

@@ -31,15 +31,12 @@ vec4 random4(uint bounce, uint stream)
     return random_numbers(rng_pixel, rng_sample, rng_seed_hash, bounce * 8u + stream, sampler_kind());
 }
 
-// random4(0u, 0u) and random4(0u, 3u), from the pixel's seeds (begin_pixel_streams).
-vec4 random4_camera()
+// random4 of the current sample for a stream whose seeds the pixel keeps
+// (begin_pixel_streams): camera_stream_seeds is random4(0u, 0u), time_stream_seeds
+// random4(0u, 3u).
+vec4 random4_seeded(DimensionSeeds seeds)
 {
-    return random_numbers_seeded(camera_stream_seeds, rng_pixel, rng_sample, rng_seed_hash, 0u, sampler_kind());
-}
-
-vec4 random4_time()
-{
-    return random_numbers_seeded(time_stream_seeds, rng_pixel, rng_sample, rng_seed_hash, 3u, sampler_kind());
+    return random_numbers_seeded(seeds, rng_pixel, rng_sample, rng_seed_hash, sampler_kind());
 }
 
 vec3 random_unit_vector(vec2 u)

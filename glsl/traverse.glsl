@@ -128,8 +128,8 @@ uint threaded_step(TraversalRay ray, uint list, uint item, inout Hit hit, out bo
 
 // trace_rays for the variants with the threaded walk (THREADED_WALK: still spheres and
 // quads in one level): the shadow ray, then the path ray, each along the list of its
-// direction's octant, one item an iteration (threaded_step). No stack: an iteration is two
-// or three fetches at one address and the tests, where the stack's walk makes four
+// octant (threaded_list), one item an iteration (threaded_step). No stack: an iteration
+// is two or three fetches at one address and the tests, where the stack's walk makes four
 // fetches in a chain, two box tests, a primitive test and a per-lane stack write and read.
 // Two loops, unlike the stack's walk: this loop is short, and one loop for both rays
 // (changing rays inside it) was 5% slower on a lit scene than the stack's walk, two loops
