@@ -166,6 +166,20 @@ static GLuint build_fragment_program(uintptr_t program, const char *defines, rt_
     return gpu_build_program(shader_source_fullscreen_vertex, program, defines, error);
 }
 
+/* The light group layers the variant holds in registers through a pass
+ * (TRACER_LIGHT_GROUP_REGISTERS_MAX of core/tracer_interface.h; glsl/light_groups.glsl):
+ * all of them when there are that few, else none (settings NULL: none). The environment's
+ * RTSPHERES_TEST_LIGHT_GROUP_IMAGE=1 makes it none, so that a test can hold the two ways'
+ * layers against each other (tests/render/test-light-groups.sh). */
+static uint32_t light_group_registers(uint32_t omitted, const tracer_parameter_block *settings)
+{
+    if (settings == NULL || (omitted & GPU_OMIT_LIGHT_GROUPS)
+        || settings->light_group_count > TRACER_LIGHT_GROUP_REGISTERS_MAX)
+        return 0;
+    const char *image_way = getenv("RTSPHERES_TEST_LIGHT_GROUP_IMAGE");
+    return image_way != NULL && strcmp(image_way, "1") == 0 ? 0 : settings->light_group_count;
+}
+
 void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *settings, char *defines, size_t size)
 {
     static const struct {
@@ -208,18 +222,23 @@ void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *setting
         used += (size_t)snprintf(defines + used, size - used, "#define %s %d\n", features[i].name,
                                  (omitted & features[i].bit) != 0);
     if (used < size)
-        snprintf(defines + used, size - used,
-                 "#define RTSPHERES_INTEGRATOR %d\n#define RTSPHERES_SKY_TYPE %d\n#define RTSPHERES_SAMPLER %d\n",
-                 fixed ? settings->integrator : 0, fixed ? settings->sky_type : 0, fixed ? settings->sampler : 0);
+        used += (size_t)snprintf(
+            defines + used, size - used,
+            "#define RTSPHERES_INTEGRATOR %d\n#define RTSPHERES_SKY_TYPE %d\n#define RTSPHERES_SAMPLER %d\n",
+            fixed ? settings->integrator : 0, fixed ? settings->sky_type : 0, fixed ? settings->sampler : 0);
+    if (used < size)
+        snprintf(defines + used, size - used, "#define RTSPHERES_LIGHT_GROUP_REGISTERS %u\n",
+                 light_group_registers(omitted, settings));
 }
 
 _Static_assert(GPU_OMIT_STACK_WALK << 1 == 1u << GPU_VARIANT_BITS, "GPU_VARIANT_BITS must cover every GPU_OMIT_* bit");
 
-/* The key of a variant in the context's program cache: the bits, and the constants
- * compiled in with GPU_FIX_UNIFORMS. */
+/* The key of a variant in the context's program cache: the bits, the light group layers
+ * held in registers, and the constants compiled in with GPU_FIX_UNIFORMS. */
 static uint64_t variant_key(uint32_t omitted, const tracer_parameter_block *settings)
 {
     uint64_t key = omitted & ((1u << GPU_VARIANT_BITS) - 1u);
+    key |= (uint64_t)light_group_registers(omitted, settings) << 44;
     if (omitted & GPU_FIX_UNIFORMS)
         return key | (uint64_t)(settings->integrator & 3) << 32 | (uint64_t)(settings->sky_type & 15) << 36
                | (uint64_t)(settings->sampler & 3) << 40;

@@ -97,6 +97,10 @@
 #define TRACER_COUNTER_BINDING 0
 /* image unit of the light group layers (glsl/light_groups.glsl): an rgba32f 2D array */
 #define TRACER_LIGHT_GROUP_IMAGE_UNIT 0
+/* with this many light groups or fewer, a variant holds the pixel's layers in registers
+ * through a pass instead of adding to the image in every segment (glsl/light_groups.glsl;
+ * the count is compiled in and tells variants apart: core/gpu_tracer.c) */
+#define TRACER_LIGHT_GROUP_REGISTERS_MAX 8
 /* image unit of the direct emission sums (glsl/direct_emission.glsl): an rgba32f 2D image */
 #define TRACER_DIRECT_EMISSION_IMAGE_UNIT 1
 /* image unit of the packed scene (core/packed_layout.h): its RGBA32UI buffer texture bound

@@ -20,11 +20,60 @@ layout(binding = TRACER_LIGHT_GROUP_IMAGE_UNIT, rgba32f) uniform image2DArray li
 // Whether this pass collects light groups: the variant has the code and the render asked.
 bool collects_light_groups() { return HAS_LIGHT_GROUPS && light_group_count > 0u; }
 
+// With at most TRACER_LIGHT_GROUP_REGISTERS_MAX groups (core/tracer_interface.h), the
+// pixel's layers are held in registers through the pass: loaded before the segment loop
+// (load_light_groups), added to there, stored after it (store_light_groups): llvmpipe runs
+// an image load and store in the loop in every iteration, and on a GPU each is a trip to
+// memory; a select per group is a few instructions (lights.txt's segment loop 8,284 ->
+// 8,173 instructions, docs/performance.md, the log). The sums receive the same additions
+// in the same order either way, and a float keeps its bits through the image, so the
+// layers are bit for bit those of the image's way. More groups keep the image's way
+// (LIGHT_GROUP_REGISTERS 0). Each layer is written out for every k below, not as a loop:
+// NIR keeps a loop over the layers a loop, and an array indexed by a loop's counter in
+// memory, which llvmpipe reads and writes lane by lane.
+const uint LIGHT_GROUP_REGISTERS = uint(RTSPHERES_LIGHT_GROUP_REGISTERS);
+vec3 held_layers[TRACER_LIGHT_GROUP_REGISTERS_MAX];
+#define RTSPHERES_FOR_EACH_HELD_LAYER(step) \
+    step(0) step(1) step(2) step(3) step(4) step(5) step(6) step(7)
+#if TRACER_LIGHT_GROUP_REGISTERS_MAX != 8
+#error "RTSPHERES_FOR_EACH_HELD_LAYER names TRACER_LIGHT_GROUP_REGISTERS_MAX layers"
+#endif
+
 // Adds value to group's layer at this pixel.
 void add_to_layer(uint group, vec3 value)
 {
-    ivec3 at = ivec3(frame_pixel, int(min(group, light_group_count - 1u)));
-    imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(value, 0.0));
+    if (LIGHT_GROUP_REGISTERS > 0u) {
+        uint layer = min(group, LIGHT_GROUP_REGISTERS - 1u);
+#define RTSPHERES_ADD_TO_HELD_LAYER(k) \
+        if (uint(k) < LIGHT_GROUP_REGISTERS) \
+            held_layers[k] = layer == uint(k) ? held_layers[k] + value : held_layers[k];
+        RTSPHERES_FOR_EACH_HELD_LAYER(RTSPHERES_ADD_TO_HELD_LAYER)
+    } else {
+        ivec3 at = ivec3(frame_pixel, int(min(group, light_group_count - 1u)));
+        imageStore(light_group_sums, at, imageLoad(light_group_sums, at) + vec4(value, 0.0));
+    }
+}
+
+// Before the pass's segment loop: the pixel's layers into the registers that hold them.
+void load_light_groups()
+{
+    if (!collects_light_groups())
+        return;
+#define RTSPHERES_LOAD_HELD_LAYER(k) \
+    if (uint(k) < LIGHT_GROUP_REGISTERS) \
+        held_layers[k] = imageLoad(light_group_sums, ivec3(frame_pixel, k)).rgb;
+    RTSPHERES_FOR_EACH_HELD_LAYER(RTSPHERES_LOAD_HELD_LAYER)
+}
+
+// After the pass's segment loop: the held layers back into the image (a unused, 0).
+void store_light_groups()
+{
+    if (!collects_light_groups())
+        return;
+#define RTSPHERES_STORE_HELD_LAYER(k) \
+    if (uint(k) < LIGHT_GROUP_REGISTERS) \
+        imageStore(light_group_sums, ivec3(frame_pixel, k), vec4(held_layers[k], 0.0));
+    RTSPHERES_FOR_EACH_HELD_LAYER(RTSPHERES_STORE_HELD_LAYER)
 }
 
 // Adds value (radiance the path gathered, throughput included) to group's layer at this

@@ -88,7 +88,12 @@ void main()
     rng_sample = first_sample + s.samples_started - 1u;   // the sample of the path in flight
     work = 0;
     overflow = false;
+    // Sums beside the pass state, held in registers through the pass.
+    load_light_groups();
+    load_direct_emission();
     integrate(s);
+    store_light_groups();
+    store_direct_emission();
     if (overflow) {
         s.statistics.y += 1.0;
         s.bounce = 0u;     // drop the broken path; the host reports the overflow as an error

@@ -47,6 +47,40 @@ for options in "" "--light-sampling off" "--integrator whitted" "--sampler indep
     sums "every kind of light in a group ${options:-(defaults)}" "$scratch/groups.exr"
 done
 
+# Layers held in registers through a pass (glsl/light_groups.glsl: up to 8 groups) are bit
+# for bit the layers of the image's way (RTSPHERES_TEST_LIGHT_GROUP_IMAGE=1), here with
+# passes of a few segments against passes as long as the device allows, so that every
+# pass's load and store is on the way: the image and each group alone (relight with the
+# others at 0), for both integrators (Whitted adds its lights inside a loop of its own).
+same_layers() {
+    name=$1
+    shift
+    RTSPHERES_TEST_LIGHT_GROUP_IMAGE=1 "$program" render "$scene" -o "$scratch/image-way.exr" --quiet --light-groups \
+        --pass-budget 50000 "$@"
+    "$program" render "$scene" -o "$scratch/held.exr" --quiet --light-groups --pass-budget 300 "$@"
+    differing=""
+    for group in "" default sky panel key fill sun; do
+        for way in image-way held; do
+            if [ -z "$group" ]; then
+                cp "$scratch/$way.exr" "$scratch/$way-layer.exr"
+            else
+                weights=""
+                for other in default sky panel key fill sun; do
+                    [ "$other" = "$group" ] || weights="$weights --group $other=0"
+                done
+                # shellcheck disable=SC2086 # $weights is a list of options
+                "$program" relight "$scratch/$way.exr" -o "$scratch/$way-layer.exr" --quiet $weights
+            fi
+        done
+        "$program" diff "$scratch/image-way-layer.exr" "$scratch/held-layer.exr" --fail 0 --failpercent 0 --quiet \
+            >/dev/null 2>&1 || differing="$differing ${group:-image}"
+    done
+    if [ -z "$differing" ]; then pass "$name: the layers held in registers are the image's way's, bit for bit"
+    else fail "$name: the layers held in registers are the image's way's" "differing:$differing"; fi
+}
+same_layers "path tracing"
+same_layers "Whitted" --integrator whitted
+
 # The layers are named by the scene's groups, default first, and listed in the metadata.
 "$program" render "$scene" -o "$scratch/groups.exr" --quiet --light-groups
 groups=$(metadata "$scratch/groups.exr" light_groups)
