@@ -187,7 +187,7 @@ void gpu_get_info(const gpu_context *context, gpu_info *info);
 #define GPU_OMIT_DIRECT_EMISSION (1u << 25)
 #define GPU_OMIT_SQUARES (1u << 26)
 #define GPU_OMIT_STACK_WALK (1u << 27)
-/* The bits a program variant is told apart by (core/gpu_tracer.c variant_key): every bit
+/* The bits a program variant is told apart by (core/gpu_program.c gpu_variant_key): every bit
  * above, GPU_FIX_UNIFORMS with them. */
 #define GPU_VARIANT_BITS 28
 

@@ -1,7 +1,7 @@
-/* gpu_internal.h: what core/gpu.c (the EGL context), core/gpu_tracer.c (the tracer on it),
- * core/gpu_compact.c (its compacted passes), core/gpu_cull.c (full passes that skip
- * finished pixels) and core/gpu_test_programs.c (the programs only tests use) share; no
- * other file includes it. */
+/* gpu_internal.h: what core/gpu.c (the EGL context), core/gpu_program.c (GLSL programs),
+ * core/gpu_tracer.c (the tracer on it), core/gpu_compact.c (its compacted passes),
+ * core/gpu_cull.c (full passes that skip finished pixels) and core/gpu_test_programs.c
+ * (the programs only tests use) share; no other file includes it. */
 #ifndef RT_GPU_INTERNAL_H
 #define RT_GPU_INTERNAL_H
 
@@ -145,13 +145,30 @@ void gpu_compact_destroy(gpu_tracer *tracer);
 GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], int count, GLuint *framebuffer, int width,
                             int height);
 
-/* Shared by gpu_tracer.c (where they are) and gpu_test_programs.c: */
+/* ---- core/gpu_program.c: programs from the modules of core/shader_sources.S ---------- */
+
 /* Writes the #defines of a tracer variant into defines (size bytes): every
  * RTSPHERES_OMIT_* as 1 when its GPU_OMIT_* bit is in omitted, else 0 (glsl/variant.glsl
- * reads them), and RTSPHERES_FIX_UNIFORMS with the integrator, sky type and sampler of
+ * reads them), RTSPHERES_FIX_UNIFORMS with the integrator, sky type and sampler of
  * settings it compiles in (0 when not fixed, so the source does not vary with the
- * parameters; settings may then be NULL). */
+ * parameters; settings may then be NULL), and RTSPHERES_LIGHT_GROUP_REGISTERS, the light
+ * group layers a pass holds in registers (glsl/light_groups.glsl; 0 without settings). */
 void gpu_variant_defines(uint32_t omitted, const tracer_parameter_block *settings, char *defines, size_t size);
+
+/* The key of a variant in a context's program cache (gpu_tracer.c): everything
+ * gpu_variant_defines writes for omitted and settings, so that two keys are equal when
+ * their defines are. */
+uint64_t gpu_variant_key(uint32_t omitted, const tracer_parameter_block *settings);
+
+/* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
+rt_status gpu_check_gl(const char *step, rt_error *error);
+
+/* Builds a program of the vertex shader vertex_source and the fragment program program
+ * (SHADER_PROGRAM_* of core/shader_sources.h), both after "#version 450 core" and defines.
+ * Returns the program or 0 with error set (the compiler's messages naming the modules). */
+GLuint gpu_build_program(const char *vertex_source, uintptr_t program, const char *defines, rt_error *error);
+
+/* ---- core/gpu_tracer.c -------------------------------------------------------------- */
 
 /* Creates a buffer object holding bytes bytes of data (at least 16, so that an empty one
  * is still a valid texture store) and a buffer texture of format over it. */
@@ -164,14 +181,6 @@ void gpu_bind_packed_scene(GLuint texture);
 /* The error for a packed scene of texel_count texels on a device whose buffer textures
  * hold fewer, or RT_OK. */
 rt_status gpu_check_packed_size(const gpu_context *context, uint32_t texel_count, rt_error *error);
-
-/* Checks glGetError and turns any error into RT_ERROR_RUNTIME naming the step. */
-rt_status gpu_check_gl(const char *step, rt_error *error);
-
-/* Builds a program of the vertex shader vertex_source and the fragment program program
- * (SHADER_PROGRAM_* of core/shader_sources.h), both after "#version 450 core" and defines.
- * Returns the program or 0 with error set (the compiler's messages naming the modules). */
-GLuint gpu_build_program(const char *vertex_source, uintptr_t program, const char *defines, rt_error *error);
 
 /* Frees what the tracer keeps on the context (compiled programs, the packed scene);
  * gpu_destroy() calls it while the context is still current. In gpu_tracer.c. */

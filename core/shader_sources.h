@@ -1,6 +1,6 @@
 /* shader_sources.h: the GLSL sources embedded by shader_sources.S (NUL-terminated).
  *
- * The fragment programs are made of modules: core/gpu_tracer.c (compile_fragment_program) joins
+ * The fragment programs are made of modules: core/gpu_program.c (compile_fragment_program) joins
  * "#version 450 core", the program's defines and, in the order of the module table of
  * shader_sources.S, every module whose programs include that program. The vertex shader
  * (one triangle over the viewport) is shared by all programs.

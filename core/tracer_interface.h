@@ -99,7 +99,7 @@
 #define TRACER_LIGHT_GROUP_IMAGE_UNIT 0
 /* with this many light groups or fewer, a variant holds the pixel's layers in registers
  * through a pass instead of adding to the image in every segment (glsl/light_groups.glsl;
- * the count is compiled in and tells variants apart: core/gpu_tracer.c) */
+ * the count is compiled in and tells variants apart: core/gpu_program.c) */
 #define TRACER_LIGHT_GROUP_REGISTERS_MAX 8
 /* image unit of the direct emission sums (glsl/direct_emission.glsl): an rgba32f 2D image */
 #define TRACER_DIRECT_EMISSION_IMAGE_UNIT 1

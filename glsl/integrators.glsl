@@ -22,7 +22,7 @@
 //
 // Adding an integrator:
 //   1. its id INTEGRATOR_NAME in core/tracer_interface.h (INTEGRATOR_COUNT one more;
-//      core/gpu_tracer.c variant_key keeps two bits for it);
+//      core/gpu_program.c gpu_variant_key keeps two bits for it);
 //   2. glsl/integrator_NAME.glsl with the four functions above;
 //   3. one line in the module table of core/shader_sources.S, before this file;
 //   4. one line in each of the four functions below;

@@ -3,7 +3,7 @@
 //
 // The tracer is one GLSL source made of the files of the module table in
 // core/shader_sources.S, in its order, after "#version 450 core" and the variant's
-// defines (core/gpu_tracer.c compile_fragment_program). core/tracer_interface.h and
+// defines (core/gpu_program.c compile_fragment_program). core/tracer_interface.h and
 // core/packed_layout.h come first, so every id, tag and record offset below is the one C
 // uses too.
 

@@ -1,6 +1,6 @@
 // variant.glsl: which parts of the tracer this program has, defined once.
 //
-// core/gpu_tracer.c (variant_defines) defines every RTSPHERES_OMIT_* as 0 or 1 from the GPU_OMIT_*
+// core/gpu_program.c (gpu_variant_defines) defines every RTSPHERES_OMIT_* as 0 or 1 from the GPU_OMIT_*
 // bits of core/gpu.h, which core/render.c computes from the scene: code for what the scene
 // cannot reach is left out, because llvmpipe runs both sides of every branch and so pays
 // for all the code in a loop (docs/performance.md). Code that needs a feature says so with
