@@ -124,8 +124,9 @@ static float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direc
         t_near = t_far;
         t_far = swap;
     }
-    t_near /= length;
-    t_far /= length;
+    float inverse_length = 1 / length;   /* as the shader: one division, then products */
+    t_near *= inverse_length;
+    t_far *= inverse_length;
     if (t_near > 0 && t_near < t_max)
         return t_near;
     if (t_far > 0 && t_far < t_max)

@@ -15,8 +15,8 @@ struct TraversalRay {
     vec3 origin;
     vec3 direction;
     vec3 inverse_direction;   // 1 / direction, for the box tests
-    vec3 unit;                // direction / direction_length, for the sphere tests
-    float direction_length;
+    vec3 unit;                // direction / |direction|, for the sphere tests
+    float inverse_length;     // 1 / |direction|: the sphere tests' distances along unit scaled
 };
 
 TraversalRay traversal_ray(vec3 origin, vec3 direction)
@@ -30,14 +30,17 @@ TraversalRay traversal_ray(vec3 origin, vec3 direction)
     const float smallest = TRAVERSAL_SMALLEST_DIRECTION;
     vec3 smallest_signed = mix(vec3(smallest), vec3(-smallest), lessThan(direction, vec3(0.0)));
     ray.inverse_direction = 1.0 / mix(direction, smallest_signed, lessThan(abs(direction), vec3(smallest)));
-    ray.direction_length = length(direction);
-    ray.unit = direction / ray.direction_length;
+    float direction_length = length(direction);
+    ray.unit = direction / direction_length;
+    ray.inverse_length = 1.0 / direction_length;
     return ray;
 }
 
-// intersect_sphere for a direction given as its unit vector and length: a traversal
-// computes those once per ray (TraversalRay), not once per sphere.
-float intersect_sphere_along(vec3 center, float radius, vec3 origin, vec3 unit, float direction_length, float t_max)
+// intersect_sphere for a direction given as its unit vector and the inverse of its length:
+// a traversal computes those once per ray (TraversalRay), not once per sphere, and a
+// sphere test then divides once (a division is the dearest instruction of the threaded
+// walk's iteration: docs/performance.md, the log).
+float intersect_sphere_along(vec3 center, float radius, vec3 origin, vec3 unit, float inverse_length, float t_max)
 {
     vec3 to_origin = origin - center;
     float b = dot(to_origin, unit);
@@ -48,8 +51,8 @@ float intersect_sphere_along(vec3 center, float radius, vec3 origin, vec3 unit, 
     float root = sqrt(discriminant);
     float c = dot(to_origin, to_origin) - radius * radius;
     float q = -b - (b >= 0.0 ? root : -root);
-    float t_near = c / q / direction_length;
-    float t_far = q / direction_length;
+    float t_near = c / q * inverse_length;
+    float t_far = q * inverse_length;
     if (t_near > t_far) { float swap = t_near; t_near = t_far; t_far = swap; }
     if (t_near > 0.0 && t_near < t_max)
         return t_near;
@@ -66,7 +69,8 @@ float intersect_sphere_along(vec3 center, float radius, vec3 origin, vec3 unit, 
 float intersect_sphere(vec3 center, float radius, vec3 origin, vec3 direction, float t_max)
 {
     float direction_length = length(direction);
-    return intersect_sphere_along(center, radius, origin, direction / direction_length, direction_length, t_max);
+    return intersect_sphere_along(center, radius, origin, direction / direction_length, 1.0 / direction_length,
+                                  t_max);
 }
 
 // Moller-Trumbore for a triangle (corner, edge1, edge2), or the parallelogram spanned by
@@ -168,13 +172,13 @@ void intersect_primitive(uint slot, uvec4 record, uint type, uvec4 g0, uvec4 g1,
     float t = INFINITY;
     vec2 coordinates = vec2(0.0);
     if (ONLY_SPHERES) {
-        t = intersect_sphere_along(a.xyz, a.w, ray.origin, ray.unit, ray.direction_length, hit.t);
+        t = intersect_sphere_along(a.xyz, a.w, ray.origin, ray.unit, ray.inverse_length, hit.t);
     } else {
         bool flat_primitive = type == uint(PRIMITIVE_TRIANGLE) || type == uint(PRIMITIVE_QUAD);
         if (HAS_MOVING_SPHERES && type == uint(PRIMITIVE_MOVING_SPHERE))
             a.xyz = mix(a.xyz, b.xyz, time);
         if (HAS_SPHERES && !flat_primitive)
-            t = intersect_sphere_along(a.xyz, a.w, ray.origin, ray.unit, ray.direction_length, hit.t);
+            t = intersect_sphere_along(a.xyz, a.w, ray.origin, ray.unit, ray.inverse_length, hit.t);
         if (HAS_FLAT && flat_primitive)
             t = intersect_flat(a.xyz, b.xyz, c.xyz, type == uint(PRIMITIVE_QUAD), ray.origin, ray.direction, hit.t,
                                coordinates);

@@ -107,7 +107,7 @@ uint threaded_step(TraversalRay ray, uint list, uint item, inout Hit hit, out bo
     vec2 coordinates = vec2(0.0);
     if (HAS_SPHERES)
         t = intersect_sphere_along(packed_xyz(first_texel), uintBitsToFloat(second_texel.x), ray.origin, ray.unit,
-                                   ray.direction_length, hit.t);
+                                   ray.inverse_length, hit.t);
     if (HAS_QUADS) {
         vec2 quad_coordinates;
         float quad_t = intersect_flat(packed_xyz(first_texel), packed_xyz(second_texel), packed_xyz(third_texel), true,
