@@ -1,6 +1,6 @@
-/* gpu.c: the EGL context: devices, context creation, what the device offers. With
- * core/gpu_tracer.c (the tracer) the only files that call egl* and gl*. See gpu.h for the
- * order of set-up and how failures are told apart. */
+/* gpu.c: the EGL context: devices, context creation, what the device offers. With the
+ * tracer's files (core/gpu_tracer.c and those gpu_internal.h names) the only files that
+ * call egl* and gl*. See gpu.h for the order of set-up and how failures are told apart. */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,5 +1,6 @@
 /* gpu.h: the only module that talks to EGL and OpenGL: core/gpu.c (the context) and
- * core/gpu_tracer.c (the tracer on it) implement it.
+ * core/gpu_tracer.c (the tracer on it, with core/gpu_program.c, core/gpu_state.c,
+ * core/gpu_compact.c and core/gpu_cull.c) implement it.
  *
  * Context set-up, in order (as piglit does it): check EGL client extensions; try the
  * EGL devices of EGL_EXT_platform_device (hardware devices first, so a real GPU wins;

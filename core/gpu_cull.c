@@ -3,7 +3,7 @@
  * Why: at the end of a render a few slow pixels (long paths through glass) keep passes
  * going, and a full pass reads and writes every pixel's state whether it traces or not
  * (0.045 s at 1200x675 on llvmpipe, docs/performance.md). How: both state sets'
- * framebuffers share a depth buffer (core/gpu_tracer.c create_state, all 1);
+ * framebuffers share a depth buffer (core/gpu_state.c gpu_state_create, all 1);
  * glsl/cull.frag writes 0 where both sets say a pixel is done, and full passes test the
  * depth early (layout(early_fragment_tests) in glsl/main.glsl), so the marked pixels'
  * shader never runs. A pass leaves a finished pixel's state as it is, so both sets already

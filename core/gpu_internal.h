@@ -1,5 +1,6 @@
 /* gpu_internal.h: what core/gpu.c (the EGL context), core/gpu_program.c (GLSL programs),
- * core/gpu_tracer.c (the tracer on it), core/gpu_compact.c (its compacted passes),
+ * core/gpu_tracer.c (the tracer on it), core/gpu_state.c (its pass state),
+ * core/gpu_compact.c (its compacted passes),
  * core/gpu_cull.c (full passes that skip finished pixels) and core/gpu_test_programs.c
  * (the programs only tests use) share; no other file includes it. */
 #ifndef RT_GPU_INTERNAL_H
@@ -82,7 +83,7 @@ struct gpu_tracer {
     GLuint parameter_buffer;     /* the parameter block (tracer_parameter_block) */
     GLuint sample_limits;        /* R32UI per-pixel sample limits (TRACER_SAMPLE_LIMITS_UNIT) */
     GLuint no_pixel_map;         /* RGBA32UI, 1 or 3 texels a side, on the pixel map's unit in full
-                                  * passes (core/gpu_tracer.c create_state says why) */
+                                  * passes (core/gpu_state.c gpu_state_create says why) */
     gpu_compact compact;         /* compacted passes (gpu_compact.c) */
     GLuint light_group_texture;  /* the light group layers (2D array, rgba32f), or 0 when the
                                   * program has no light group code */
@@ -136,14 +137,36 @@ rt_status gpu_read_full_state(gpu_tracer *tracer, int state, float *out, rt_erro
 /* Frees the tracer's compact state. */
 void gpu_compact_destroy(gpu_tracer *tracer);
 
+/* ---- core/gpu_state.c: the pass state on the device --------------------------------- */
+
 /* Creates one set of pass-state textures (the first count of TRACER_STATE_COUNT, width x
  * height, nearest filtering; RGBA32F, the counters RGBA32UI; the others' names 0) and a
  * framebuffer drawing to them (attachment TRACER_STATE_* for each) into textures and
- * *framebuffer, left bound. Returns
- * the framebuffer's status: GL_FRAMEBUFFER_COMPLETE, or incomplete where the device could
- * not allocate a texture. In gpu_tracer.c; the caller deletes them. */
+ * *framebuffer, left bound. Returns the framebuffer's status: GL_FRAMEBUFFER_COMPLETE, or
+ * incomplete where the device could not allocate a texture. The caller deletes them. */
 GLenum gpu_create_state_set(GLuint textures[TRACER_STATE_COUNT], int count, GLuint *framebuffer, int width,
                             int height);
+
+/* Creates the tracer's two state sets (tracer->state_count textures each, zeroed) with
+ * their framebuffers, the depth buffer both share (all 1: no pixel skipped), the sample
+ * limits (none) and the stand-in pixel map, into the tracer's fields; the tracer's
+ * width, height, state_count and image_units must be set. RT_ERROR_INPUT for an image
+ * larger than the device's textures; RT_ERROR_RUNTIME when the device lacks the outputs
+ * or the memory (a message that says how big the state is and what to do). What was
+ * created stays in the tracer for gpu_tracer_destroy. */
+rt_status gpu_state_create(gpu_tracer *tracer, rt_error *error);
+
+/* Creates the sum layers the tracer's program adds into: one per light group
+ * (shader.light_group_count) and the direct emission's, each only when the program has
+ * the code (a single texel when nothing is asked for). RT_ERROR_INPUT when the device's
+ * memory does not hold them. */
+rt_status gpu_state_create_sums(gpu_tracer *tracer, rt_error *error);
+
+/* Loads a partial result (resume: width x height x 4 floats, rows top to bottom, the sums
+ * of R, G, B and the finished samples: gpu.h gpu_tracer_parameters) into state set 0, which the first pass reads: the sums, and the
+ * finished counts as "samples started" (a path that was in flight is traced again: its
+ * random numbers are the same). RT_ERROR_RUNTIME when memory runs out. */
+rt_status gpu_state_load_resume(gpu_tracer *tracer, const float *resume, rt_error *error);
 
 /* ---- core/gpu_program.c: programs from the modules of core/shader_sources.S ---------- */
 
