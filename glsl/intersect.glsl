@@ -51,9 +51,12 @@ float intersect_sphere_along(vec3 center, float radius, vec3 origin, vec3 unit, 
     float root = sqrt(discriminant);
     float c = dot(to_origin, to_origin) - radius * radius;
     float q = -b - (b >= 0.0 ? root : -root);
-    float t_near = c / q * inverse_length;
-    float t_far = q * inverse_length;
-    if (t_near > t_far) { float swap = t_near; t_near = t_far; t_far = swap; }
+    // The roots in order, by the integer order of their bits (one instruction each; a float
+    // minimum or maximum is three on llvmpipe, docs/performance.md): that is their order
+    // unless both are negative, and then neither is a hit whichever comes first.
+    int root_bits = floatBitsToInt(c / q * inverse_length), other_bits = floatBitsToInt(q * inverse_length);
+    float t_near = intBitsToFloat(min(root_bits, other_bits));
+    float t_far = intBitsToFloat(max(root_bits, other_bits));
     if (t_near > 0.0 && t_near < t_max)
         return t_near;
     if (t_far > 0.0 && t_far < t_max)
