@@ -15,7 +15,9 @@
  * be slots: the pixel map (RGBA32UI, core/tracer_interface.h) gives each slot its pixel
  * and its run of sample indices. Slot k + r * count holds run r of the list's pixel k;
  * eight consecutive slots take a 4 x 2 block, which is what llvmpipe shades as one vector
- * (and a quarter of a GPU's 8 x 4 warp). Every run starts with no path in flight and sums
+ * (and a quarter of a GPU's 8 x 4 warp), and on llvmpipe the blocks are dealt to as many
+ * 64-wide tile columns as it has rasteriser threads, so that the threads finish together
+ * (slot_of). Every run starts with no path in flight and sums
  * of zero (the map's round number, glsl/main.glsl read_state), and the host adds the
  * runs' sums to the pixel's, run after run in order: so a pixel's result depends on its
  * samples and runs, never on how many pixels the list has or where their slots are, and
@@ -29,19 +31,55 @@
 #include "gpu_internal.h"
 #include "large_pages.h"
 
+/* llvmpipe's rasteriser threads take the framebuffer's 64 x 64 tiles one at a time, so a
+ * pass is done when the tile that started last is: slots laid row by row across a width of
+ * 200 fill tiles 64, 64, 64 and 8 wide, and in a pass of one band of tiles one of two
+ * threads does 128 columns' work, the other 72 (docs/performance.md, the log: compacted
+ * passes in balanced tiles). */
+#define RASTER_TILE 64
+
 /* The slot (x, y) of slot index k in the state textures (width x height): in 4 x 2 blocks
- * of 8 slots, block after block along the rows (blocks), which is what llvmpipe shades as
- * one vector (and a quarter of a GPU's 8 x 4 warp); else row by row. */
-static void slot_of(int k, int width, bool blocks, int *x, int *y)
+ * of 8 slots (blocks), which is what llvmpipe shades as one vector (and a quarter of a
+ * GPU's 8 x 4 warp), else row by row. Blocks go along the rows, or, with tile_columns
+ * (>= 2), dealt in turn to that many RASTER_TILE-wide columns, each filled along its
+ * rows, so that every column, and so every tile of a band, takes the same share. */
+static void slot_of(int k, int width, bool blocks, int tile_columns, int *x, int *y)
 {
     if (!blocks) {
         *x = k % width;
         *y = k / width;
         return;
     }
-    int block = k >> 3, lane = k & 7, blocks_per_row = width / 4;
+    int block = k >> 3, lane = k & 7;
+    if (tile_columns >= 2) {
+        int column = block % tile_columns, index = block / tile_columns, column_blocks = RASTER_TILE / 4;
+        *x = column * RASTER_TILE + (index % column_blocks) * 4 + (lane & 3);
+        *y = (index / column_blocks) * 2 + (lane >> 2);
+        return;
+    }
+    int blocks_per_row = width / 4;
     *x = (block % blocks_per_row) * 4 + (lane & 3);
     *y = (block / blocks_per_row) * 2 + (lane >> 2);
+}
+
+/* The tile columns (slot_of) for slot_count slots in blocks in a width x height texture:
+ * as many as the device has rasteriser threads, when it is llvmpipe with two or more,
+ * the texture is that wide, every column takes at least a whole row of blocks and the
+ * columns hold all the slots; else 0 (along the whole rows). RTSPHERES_TEST_TILE_COLUMNS
+ * sets the columns wanted in place of the threads, for the test that the layout changes
+ * no pixel (tests/render/test-adaptive.sh). */
+static int balanced_tile_columns(const gpu_tracer *tracer, int slot_count, int width, int height)
+{
+    gpu_info device;
+    gpu_get_info(tracer->context, &device);
+    const char *test_columns = getenv("RTSPHERES_TEST_TILE_COLUMNS");
+    int columns = test_columns != NULL ? atoi(test_columns) : device.software ? device.software_threads : 0;
+    columns = columns > width / RASTER_TILE ? width / RASTER_TILE : columns;
+    if (columns < 2 || slot_count < columns * RASTER_TILE * 2)
+        return 0;
+    int column_blocks = ((slot_count + 7) / 8 + columns - 1) / columns;
+    int rows = (column_blocks + RASTER_TILE / 4 - 1) / (RASTER_TILE / 4) * 2;
+    return rows <= (height & ~1) ? columns : 0;
 }
 
 /* Gives the bound 2D texture nearest filtering: an integer texture with the default
@@ -88,7 +126,7 @@ static rt_status add_round(gpu_tracer *tracer, int state, float *target, rt_erro
     int slot_count = c->round_runs * c->count;
     for (int k = 0; k < slot_count; k++) {
         int x, y;
-        slot_of(k, tracer->width, c->blocks, &x, &y);
+        slot_of(k, tracer->width, c->blocks, c->tile_columns, &x, &y);
         if (c->slot_map[((size_t)y * tracer->width + x) * 4] == TRACER_NO_PIXEL)
             continue;
         size_t texel = (size_t)y * c->used_width + x, pixel = c->pixels[k % c->count];
@@ -137,14 +175,19 @@ static rt_status start_round(gpu_tracer *tracer, int first_run, rt_error *error)
      * read_state): cheaper than clearing them (8 textures: about 8 ms on llvmpipe). */
     c->round = c->round == UINT32_MAX ? 1 : c->round + 1;
     /* The region the slots take: rows from the bottom (a block row is 2), the whole width
-     * once they fill a row. Only its rows of the map are written and uploaded: nothing
-     * outside it is drawn or read. */
+     * (or the tile columns) once they fill a row. Only its rows of the map are written and
+     * uploaded: nothing outside it is drawn or read. */
+    c->tile_columns = c->blocks ? balanced_tile_columns(tracer, slot_count, width, height) : 0;
     int row_slots = c->blocks ? (width / 4) * 8 : width, used_x, used_y;
-    if (slot_count >= row_slots)
+    if (c->tile_columns >= 2)
+        used_x = c->tile_columns * RASTER_TILE;
+    else if (slot_count >= row_slots)
         used_x = c->blocks ? (width / 4) * 4 : width;
     else
         used_x = c->blocks ? (slot_count + 7) / 8 * 4 : slot_count;
-    slot_of(slot_count - 1, width, c->blocks, &(int){0}, &used_y);
+    /* Slot 0's column is the tallest (blocks are dealt to it first). */
+    int tallest_last = c->tile_columns >= 2 ? (slot_count - 1) / 8 / c->tile_columns * c->tile_columns * 8 : slot_count - 1;
+    slot_of(tallest_last, width, c->blocks, c->tile_columns, &(int){0}, &used_y);
     used_y = c->blocks ? (used_y | 1) + 1 : used_y + 1;
     for (size_t i = 0; i < (size_t)width * used_y; i++) {
         c->slot_map[i * 4] = TRACER_NO_PIXEL;
@@ -152,7 +195,7 @@ static rt_status start_round(gpu_tracer *tracer, int first_run, rt_error *error)
     }
     for (int k = 0; k < slot_count; k++) {
         int sx, sy;
-        slot_of(k, width, c->blocks, &sx, &sy);
+        slot_of(k, width, c->blocks, c->tile_columns, &sx, &sy);
         uint64_t run = (uint64_t)(first_run + k / c->count);
         uint64_t start = c->list_start[k % c->count], limit = c->list_limit[k % c->count];
         if (limit <= start)

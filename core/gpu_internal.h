@@ -55,6 +55,8 @@ typedef struct gpu_compact {
                                   * once would not fit, rounds follow one another) */
     uint32_t round;              /* the round's number (core/tracer_interface.h), from 1 */
     bool blocks;                 /* the round's slots go in 4 x 2 blocks (else row by row) */
+    int tile_columns;            /* >= 2: the blocks dealt to that many 64-wide columns
+                                  * (gpu_compact.c slot_of); 0: along the whole rows */
     int used_width, used_height; /* the slots of the round: drawn (a scissor), the rest not */
     GLuint pixel_map;            /* RGBA32UI, the state textures' size (core/tracer_interface.h) */
     uint32_t *slot_map;          /* the pixel map's texels as uploaded, rows from the bottom */
