@@ -188,8 +188,8 @@ ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a == "-" || b == "-" || b <= 0) p
 
 # Time to quality on SCENE (LABEL) at SIZE and DEPTH: the references, the ladders of
 # rtspheres and Cycles (rows LABEL@SPP and cycles:LABEL@SPP), the adaptive ladder
-# (LABEL@ntT) when rtspheres has --noise-threshold, with two more rounds of its rungs around
-# the fixed ladder's RMSE (LABEL@rNntT, LABEL@SPP-rN), and the comparison at Cycles'
+# (LABEL@ntT) when rtspheres has --noise-threshold, with more rounds (BENCH_ROUNDS in all) of
+# its rungs around the fixed ladder's RMSE (LABEL@rNntT, LABEL@SPP-rN), and the comparison at Cycles'
 # $quality_point spp (quality_compare).
 quality_scene() {
     label=$1 scene=$2 size=$3 depth=$4
@@ -209,18 +209,19 @@ quality_scene() {
                 --seed 1 --noise-threshold "$threshold"
         done
         quality_fact "$label" adaptive yes
-        # Two more rounds of the fixed $quality_point-spp render and of the two adaptive rungs
-        # around its RMSE (rows LABEL@SPP-rN, LABEL@rNntT): the ratio of such 1-2 s renders
-        # moved by 10% between runs of one binary (docs/performance.md), so the target takes
-        # the median of three rounds' ratios (quality_compare). The images are the same in
-        # every round (same seed; adaptive decisions do not depend on the passes), only
-        # the times differ.
+        # More rounds of the fixed $quality_point-spp render and of the two adaptive rungs
+        # around its RMSE (rows LABEL@SPP-rN, LABEL@rNntT; $rounds rounds in all with the
+        # ladder's, BENCH_ROUNDS in run.sh): the ratio of such 1-2 s renders moved by 10%
+        # between runs of one binary and by 0.405-0.533 within one run (docs/performance.md),
+        # so the target takes the median of the rounds' ratios (quality_compare). The
+        # images are the same in every round (same seed; adaptive decisions do not depend
+        # on the passes), only the times differ.
         point_rmse=$(value "$label@$quality_point" 19)
         bracket=$(awk -F '\t' -v prefix="$label@nt" 'index($1, prefix) == 1 && $19 != "-" {
             print substr($1, length(prefix) + 1), $19 }' "$rows" | sort -g -k 2 | awk -v r="$point_rmse" '
             r == "-" { exit } $2 <= r { below = $1 } $2 > r && above == "" { above = $1 }
             END { if (below != "" && above != "") print below, above }')
-        for round in 2 3; do
+        for round in $(seq 2 "$rounds"); do
             [ -n "$bracket" ] || break
             bench "$label@$quality_point-r$round" "$scene" "$size" "$quality_point" "round $round" \
                 --max-depth "$depth" --seed 1
@@ -293,10 +294,10 @@ quality_compare() {
     adaptive_time=$(awk -F '\t' -v prefix="$label@nt" 'index($1, prefix) == 1 && $7 != "-" && $19 != "-" {
         print $19, $7 }' "$rows" | loglog_at "$own_rmse")
     quality_fact "$label" adaptive_seconds_for_point_rmse "$adaptive_time"
-    # The adaptive target: the median of the rounds' ratios (quality_scene's rounds 2 and 3
+    # The adaptive target: the median of the rounds' ratios (quality_scene's rounds 2 and on
     # time the fixed render and the two rungs around its RMSE again).
     adaptive_ratios=$(ratio "$adaptive_time" "$own_time")
-    for round in 2 3; do
+    for round in $(seq 2 "$rounds"); do
         round_time=$(awk -F '\t' -v prefix="$label@r${round}nt" 'index($1, prefix) == 1 && $7 != "-" && $19 != "-" {
             print $19, $7 }' "$rows" | loglog_at "$own_rmse")
         adaptive_ratios="$adaptive_ratios $(ratio "$round_time" "$(value "$label@$quality_point-r$round" 7)")"

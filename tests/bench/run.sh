@@ -19,7 +19,8 @@
 #   three-balls    640x360, 16 spp; three-balls-whitted the same frame, 4 spp, Whitted
 #   three-balls-anim  24 frames (--frames 0-23) at 320x180, 4 spp, one GPU context
 #   lights, lights-groups  scenes/lights.txt 640x360, 16 spp, without and with
-#                  --light-groups, three rounds (rows -2, -3: issue 15's ratio is their median)
+#                  --light-groups, BENCH_ROUNDS rounds (rows -2, -3, ...: issue 15's ratio
+#                  is the median of the pairs' ratios)
 #   cornell        600x600, 4 spp; next-week 400x400 (half the book's), 2 spp;
 #   crystal-ball   640x480, 4 spp
 #   pbr-chart      scenes/pbr-chart.txt 640x360, 16 spp: the pbr material, every
@@ -71,6 +72,11 @@
 #   BENCH_LARGE          0: leave out the large images of issue 17 (panorama-20000,
 #                        square-16384, full-hd, full-hd-untiled), which take most of the
 #                        run's memory and, at 1 spp, a few minutes on idle cores
+#   BENCH_ROUNDS         rounds of the renders behind the targets that are ratios of two
+#                        renders of a second or two (light groups; adaptive sampling,
+#                        tests/bench/peers.sh), whose median the target takes (default 5:
+#                        within one run of three the adaptive Cornell box's rounds spread
+#                        from 0.405 to 0.533, docs/performance.md)
 set -eu
 program=$1
 weekend_spp=${BENCH_SPP:-32}
@@ -78,6 +84,10 @@ reference_spp=${BENCH_REFERENCE_SPP:-8}
 scale=${BENCH_SCALE:-1}
 mesh_levels=${BENCH_MESH_LEVELS:-3 5 6 8}
 large=${BENCH_LARGE:-1}
+rounds=${BENCH_ROUNDS:-5}
+case $rounds in
+    '' | *[!0-9]* | 0) echo "run.sh: BENCH_ROUNDS must be a whole number of at least 1, not '$rounds'" >&2; exit 2 ;;
+esac
 CC=${CC:-cc}
 CXX=${CXX:-c++}
 work=build/bench
@@ -376,10 +386,10 @@ if peer_ready povray; then
 fi
 bench_animation three-balls-anim scenes/three-balls.txt 320x180 "$(scaled 4)" 24
 # Light groups (issue 15): lights.txt's four lights in four groups (and the sky in
-# default), with and without their layers, back to back, three rounds: the ratio of one
+# default), with and without their layers, back to back, $rounds rounds: the ratio of one
 # pair of these 2-second renders moved from 0.94 to 1.20 between runs of the same binary
-# (docs/performance.md), so the target takes the median of three pairs' ratios.
-for round in 1 2 3; do
+# (docs/performance.md), so the target takes the median of the pairs' ratios.
+for round in $(seq 1 "$rounds"); do
     suffix=$([ "$round" = 1 ] || echo "-$round")
     bench "lights$suffix" scenes/lights.txt 640x360 "$(scaled 16)" ""
     bench "lights-groups$suffix" scenes/lights.txt 640x360 "$(scaled 16)" "--light-groups, 5 layers" --light-groups
@@ -524,9 +534,9 @@ targets=$work/targets.tsv
             "$(value "$label-1M" 12)" "$label"
     done
     # issue 15: light groups and sweeps
-    printf 'light_groups_time_per_sample_ratio\t%s\t<=\t1.1\tx\tlights.txt time per sample, --light-groups / none (median of 3 pairs)\n' \
-        "$(for suffix in "" -2 -3; do echo "$(ratio "$(value "lights-groups$suffix" 10)" "$(value "lights$suffix" 10)")"; done |
-            grep -v '^-$' | sort -g | awk '{ v[NR] = $1 } END { print NR == 0 ? "-" : v[int((NR + 1) / 2)] }')"
+    printf 'light_groups_time_per_sample_ratio\t%s\t<=\t1.1\tx\tlights.txt time per sample, --light-groups / none (median of %s pairs)\n' \
+        "$(for suffix in "" $(seq 2 "$rounds" | sed 's/^/-/'); do echo "$(ratio "$(value "lights-groups$suffix" 10)" "$(value "lights$suffix" 10)")"; done |
+            grep -v '^-$' | sort -g | awk '{ v[NR] = $1 } END { print NR == 0 ? "-" : v[int((NR + 1) / 2)] }')" "$rounds"
     printf 'sweep_saving_per_row_over_startup\t%s\t>=\t1\tx\t%s\n' \
         "$(awk -v s="$(value sweep-12 6)" -v p="$(value sweep-12-separate 6)" -v u="$(value startup-cached 13)" 'BEGIN {
             if (s == "-" || p == "-" || u == "-" || u <= 0) print "-"; else printf "%.3g", (p - s) / 11 / u }')" \
