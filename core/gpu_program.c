@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "gpu_internal.h"
 #include "shader_sources.h"
@@ -25,26 +26,67 @@ rt_status gpu_check_gl(const char *step, rt_error *error)
     return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s failed (%s, 0x%04x)", step, name, code);
 }
 
+/* Removes from log (a compiler's or linker's, one message a line) every line that does
+ * not say "error" (in any case), when some line does: Mesa puts a warning before the
+ * errors for every global the tracer reads before it writes, and those alone would fill
+ * the message (rt_error's 1,024 bytes) before the error that failed the build. */
+static void keep_error_lines(char *log)
+{
+    bool any_error = false;
+    for (const char *line = log; *line != '\0' && !any_error;) {
+        size_t length = strcspn(line, "\n");
+        for (size_t i = 0; i + 5 <= length && !any_error; i++)
+            any_error = strncasecmp(line + i, "error", 5) == 0;
+        line += length + (line[length] == '\n');
+    }
+    if (!any_error)
+        return;
+    char *kept = log;
+    for (const char *line = log; *line != '\0';) {
+        size_t length = strcspn(line, "\n"), whole = length + (line[length] == '\n');
+        bool error_line = false;
+        for (size_t i = 0; i + 5 <= length && !error_line; i++)
+            error_line = strncasecmp(line + i, "error", 5) == 0;
+        if (error_line) {
+            memmove(kept, line, whole);
+            kept += whole;
+        }
+        line += whole;
+    }
+    *kept = '\0';
+}
+
 /* True when a shader compiled (program false) or a program linked (program true);
- * otherwise deletes it and sets error to "GPU: WHAT: " and its info log. */
+ * otherwise deletes it and sets error to "GPU: WHAT: " and its info log, error lines
+ * only when it has any (keep_error_lines). */
 static bool gl_object_built(GLuint object, bool program, const char *what, rt_error *error)
 {
-    GLint ok = 0;
-    if (program)
+    GLint ok = 0, length = 0;
+    if (program) {
         glGetProgramiv(object, GL_LINK_STATUS, &ok);
-    else
+        glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length);
+    } else {
         glGetShaderiv(object, GL_COMPILE_STATUS, &ok);
+        glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
+    }
     if (ok)
         return true;
-    char log[800];
-    if (program) {
-        glGetProgramInfoLog(object, sizeof log, NULL, log);
-        glDeleteProgram(object);
-    } else {
-        glGetShaderInfoLog(object, sizeof log, NULL, log);
-        glDeleteShader(object);
+    char fallback[1] = "";
+    char *log = length > 0 ? malloc((size_t)length + 1) : NULL;
+    if (log != NULL) {
+        log[0] = '\0';
+        if (program)
+            glGetProgramInfoLog(object, length + 1, NULL, log);
+        else
+            glGetShaderInfoLog(object, length + 1, NULL, log);
+        keep_error_lines(log);
     }
-    rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s: %s", what, log);
+    if (program)
+        glDeleteProgram(object);
+    else
+        glDeleteShader(object);
+    rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s: %s", what, log != NULL ? log : fallback);
+    free(log);
     return false;
 }
 
@@ -117,11 +159,20 @@ static void name_modules_in_log(rt_error *error)
  * the shader or 0 with error set, its messages naming the modules. */
 static GLuint compile_fragment_program(uintptr_t program, const char *defines, rt_error *error)
 {
-    const char *parts[2 + 2 * GPU_MAX_SHADER_MODULES];
+    const char *parts[3 + 2 * GPU_MAX_SHADER_MODULES];
     char line_directives[GPU_MAX_SHADER_MODULES][32];
     int count = 0;
     parts[count++] = "#version 450 core\n";
     parts[count++] = defines;
+    /* RTSPHERES_TEST_SHADER_LINE: a line of GLSL put before the first module, for the test
+     * that a shader that does not compile is a message naming its error
+     * (tests/render/test-bad-input.sh). */
+    const char *test_line = getenv("RTSPHERES_TEST_SHADER_LINE");
+    char test_part[256];
+    if (test_line != NULL) {
+        snprintf(test_part, sizeof test_part, "%s\n", test_line);
+        parts[count++] = test_part;
+    }
     for (int i = 0; shader_modules[i].path != NULL; i++) {
         if (i == GPU_MAX_SHADER_MODULES) {
             rt_error_set(error, RT_ERROR_RUNTIME, "GPU: core/shader_sources.S lists more than %d shader modules "

@@ -80,4 +80,17 @@ check three-balls-aovs scenes/three-balls.txt --aovs
 # reads from 8 samples a pixel on.
 check cornell-denoise scenes/cornell.txt --denoise --spp 8
 
+# A tracer that does not compile (a driver's compiler that rejects it) is exit 1 and a
+# message with the compiler's error, not the warnings Mesa puts before it (one for every
+# global read before it is written: they alone filled the message), and no image.
+# RTSPHERES_TEST_SHADER_LINE puts a line of GLSL before the first module (core/gpu_program.c).
+rm -f "$scratch/broken.exr"
+RTSPHERES_TEST_SHADER_LINE='float broken_line = undeclared_name_for_the_test;' expect_exit \
+    "a tracer that does not compile is the compiler's error" 1 \
+    "GPU: the fragment shader does not compile: .*error.*undeclared_name_for_the_test" \
+    "$program" render scenes/cornell.txt -o "$scratch/broken.exr" --size 16x16 --spp 1 --quiet
+if grep -qi 'warning' "$scratch/stderr"; then fail "no compiler warnings in the message" "$(head -c 300 "$scratch/stderr")"
+elif [ -e "$scratch/broken.exr" ]; then fail "no image from a tracer that does not compile" "broken.exr written"
+else pass "the message holds the error alone, and no image is written"; fi
+
 finish
