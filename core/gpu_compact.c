@@ -185,8 +185,10 @@ static rt_status start_round(gpu_tracer *tracer, int first_run, rt_error *error)
         used_x = c->blocks ? (width / 4) * 4 : width;
     else
         used_x = c->blocks ? (slot_count + 7) / 8 * 4 : slot_count;
-    /* Slot 0's column is the tallest (blocks are dealt to it first). */
-    int tallest_last = c->tile_columns >= 2 ? (slot_count - 1) / 8 / c->tile_columns * c->tile_columns * 8 : slot_count - 1;
+    /* The last slot of slot 0's column, the tallest (blocks are dealt to it first). */
+    int tallest_last = slot_count - 1;
+    if (c->tile_columns >= 2)
+        tallest_last = tallest_last / 8 / c->tile_columns * c->tile_columns * 8;
     slot_of(tallest_last, width, c->blocks, c->tile_columns, &(int){0}, &used_y);
     used_y = c->blocks ? (used_y | 1) + 1 : used_y + 1;
     for (size_t i = 0; i < (size_t)width * used_y; i++) {
