@@ -17,11 +17,11 @@
  * eight consecutive slots take a 4 x 2 block, which is what llvmpipe shades as one vector
  * (and a quarter of a GPU's 8 x 4 warp), and on llvmpipe the blocks are dealt to as many
  * 64-wide tile columns as it has rasteriser threads, so that the threads finish together
- * (slot_of). Every run starts with no path in flight and sums
- * of zero (the map's round number, glsl/main.glsl read_state), and the host adds the
- * runs' sums to the pixel's, run after run in order: so a pixel's result depends on its
- * samples and runs, never on how many pixels the list has or where their slots are, and
- * a tile of a render equals the render's pixels to the bit (core/render.h). Reads of the
+ * (slot_of). Every run starts with no path in flight and sums of zero (the map's round
+ * number, glsl/main.glsl read_state), and the host adds the runs' sums to the pixel's,
+ * run after run in order: so a pixel's result depends on its samples and runs, never on
+ * how many pixels the list has or where their slots are, and a tile of a render equals
+ * the render's pixels to the bit (core/render.h). Reads of the
  * state are served from the host's sums plus the current slots (gpu_compact_read). When
  * the runs of all pixels need more slots than the textures have, they go in rounds, each
  * added to the host's sums before the next starts. */

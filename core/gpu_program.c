@@ -26,17 +26,25 @@ rt_status gpu_check_gl(const char *step, rt_error *error)
     return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s failed (%s, 0x%04x)", step, name, code);
 }
 
+/* True when the length characters at line say "error", in any case. */
+static bool says_error(const char *line, size_t length)
+{
+    for (size_t i = 0; i + 5 <= length; i++)
+        if (strncasecmp(line + i, "error", 5) == 0)
+            return true;
+    return false;
+}
+
 /* Removes from log (a compiler's or linker's, one message a line) every line that does
- * not say "error" (in any case), when some line does: Mesa puts a warning before the
- * errors for every global the tracer reads before it writes, and those alone would fill
- * the message (rt_error's 1,024 bytes) before the error that failed the build. */
+ * not say "error", when some line does: Mesa puts a warning before the errors for every
+ * global the tracer reads before it writes, and those alone would fill the message
+ * (rt_error's 1,024 bytes) before the error that failed the build. */
 static void keep_error_lines(char *log)
 {
     bool any_error = false;
     for (const char *line = log; *line != '\0' && !any_error;) {
         size_t length = strcspn(line, "\n");
-        for (size_t i = 0; i + 5 <= length && !any_error; i++)
-            any_error = strncasecmp(line + i, "error", 5) == 0;
+        any_error = says_error(line, length);
         line += length + (line[length] == '\n');
     }
     if (!any_error)
@@ -44,10 +52,7 @@ static void keep_error_lines(char *log)
     char *kept = log;
     for (const char *line = log; *line != '\0';) {
         size_t length = strcspn(line, "\n"), whole = length + (line[length] == '\n');
-        bool error_line = false;
-        for (size_t i = 0; i + 5 <= length && !error_line; i++)
-            error_line = strncasecmp(line + i, "error", 5) == 0;
-        if (error_line) {
+        if (says_error(line, length)) {
             memmove(kept, line, whole);
             kept += whole;
         }
@@ -71,7 +76,6 @@ static bool gl_object_built(GLuint object, bool program, const char *what, rt_er
     }
     if (ok)
         return true;
-    char fallback[1] = "";
     char *log = length > 0 ? malloc((size_t)length + 1) : NULL;
     if (log != NULL) {
         log[0] = '\0';
@@ -85,7 +89,7 @@ static bool gl_object_built(GLuint object, bool program, const char *what, rt_er
         glDeleteProgram(object);
     else
         glDeleteShader(object);
-    rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s: %s", what, log != NULL ? log : fallback);
+    rt_error_set(error, RT_ERROR_RUNTIME, "GPU: %s: %s", what, log != NULL ? log : "");
     free(log);
     return false;
 }
@@ -166,7 +170,7 @@ static GLuint compile_fragment_program(uintptr_t program, const char *defines, r
     parts[count++] = defines;
     /* RTSPHERES_TEST_SHADER_LINE: a line of GLSL put before the first module, for the test
      * that a shader that does not compile is a message naming its error
-     * (tests/render/test-bad-input.sh). */
+     * (tests/render/test-tracer-variants.sh). */
     const char *test_line = getenv("RTSPHERES_TEST_SHADER_LINE");
     char test_part[256];
     if (test_line != NULL) {
