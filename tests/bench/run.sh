@@ -11,7 +11,8 @@
 # wrapper (peak_rss.c), the chart (plot.cpp, OpenImageIO) and the mesh generator.
 #
 # The set (sizes and spp as run by default):
-#   startup, startup-cached  weekend at 64x36, 1 spp: process start to the first finished
+#   startup, startup-cached  weekend at 64x36, 1 spp: the command's start in main (after the
+#                  dynamic loader's 0.2 s, docs/performance.md "Ideas") to the first finished
 #                  pass with Mesa's shader cache off (a first run: context, parse, BVH,
 #                  upload and the whole shader compile; the "cold start") and on
 #   weekend        scenes/weekend.txt 1200x675, BENCH_SPP spp, depth 50, and right after
