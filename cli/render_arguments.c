@@ -55,7 +55,7 @@ static void print_help(FILE *stream)
             "                         error of its mean luminance is under T (e.g. 0.05) and its\n"
             "                         3x3 neighbours' is too; --spp is the most it takes\n"
             "      --min-spp N        samples every pixel takes before that check (default 16)\n"
-            "      --time-limit SECS  end within about one pass of SECS seconds after the command\n"
+            "      --time-limit SECS  end within about one pass of SECS seconds after the process\n"
             "                         started (per image with --frames), writing what it has\n"
             "                         (continue it with --resume OUTPUT.exr)\n"
             "      --samples-map FILE also write each pixel's samples / spp as a grey image\n"

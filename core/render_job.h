@@ -54,7 +54,7 @@
  *                           many seconds after its start (render_options.deadline), and
  *                           is written with what it has (rtspheres:stop_reason time)
  *   time_limit_start        the clock_seconds() time the first image's limit counts from
- *                           (`rtspheres render`: its command's start); 0: the job's start.
+ *                           (`rtspheres render`: its process's start); 0: the job's start.
  *                           Every later frame's counts from when it begins: the limit is
  *                           per image, so a job of F frames ends within about F times it
  *   memory_budget           bytes an image's render may take on the device and the host

@@ -13,13 +13,14 @@
 #include "version.h"
 
 void render_stats_init(render_stats *stats, const gpu_info *device, int threads_requested, double context_seconds,
-                       const char *scene, const char *output)
+                       double before_command_seconds, const char *scene, const char *output)
 {
     memset(stats, 0, sizeof *stats);
     if (device != NULL)
         stats->device = *device;
     stats->threads_requested = threads_requested;
     stats->context_seconds = context_seconds;
+    stats->before_command_seconds = before_command_seconds;
     stats->scene = scene;
     stats->output = output;
 }
@@ -71,6 +72,7 @@ static render_stats_image *add_entry(render_stats *stats, const render_job_image
     entry->plan.output = entry->output;
     entry->peak_rss_bytes = peak_rss_bytes();
     entry->first_pass_after_start = -1;
+    entry->first_pass_after_process_start = -1;
     return entry;
 }
 
@@ -88,6 +90,8 @@ rt_status render_stats_add_rendered(render_stats *stats, const render_job_image 
     entry->result.aovs = (rt_image){0};
     entry->result.light_groups = (rt_image){0};
     entry->first_pass_after_start = first_pass_after_start;
+    entry->first_pass_after_process_start =
+        first_pass_after_start < 0 ? -1 : first_pass_after_start + stats->before_command_seconds;
     /* Per-pixel samples: the samples channel (the fourth) of the result. */
     const rt_image *pixels = &result->image;
     size_t count = (size_t)pixels->width * pixels->height;
@@ -227,6 +231,7 @@ static void write_result(json_object *object, const render_stats_image *entry)
     field_number(&times, "compile", r->compile_seconds);
     field_number(&times, "first_pass", r->first_pass_seconds);
     field_number(&times, "first_pass_after_command_start", entry->first_pass_after_start);
+    field_number(&times, "first_pass_after_process_start", entry->first_pass_after_process_start);
     field_number(&times, "after_first_pass", r->steady_seconds);
     end_object(&times);
     json_object scene = begin_object(object, "scene");

@@ -45,12 +45,16 @@ typedef struct render_stats_image {
     double first_pass_after_start;   /* seconds from the command's start to its first
                                       * pass's end (context, parse, BVH, upload, compile);
                                       * < 0: unknown */
+    double first_pass_after_process_start;   /* the same from the process's start (the
+                                              * libraries' loading before main in it) */
 } render_stats_image;
 
 typedef struct render_stats {
     gpu_info device;
     int threads_requested;       /* --threads, 0: none */
     double context_seconds;      /* creating the GPU context */
+    double before_command_seconds;   /* from the process's start to the command's (the
+                                      * libraries' loading before main, core/clock.h) */
     const char *scene;           /* the scene file, as given */
     const char *output;          /* the output name or pattern, as given */
     render_stats_image *images;
@@ -62,7 +66,7 @@ typedef struct render_stats {
 
 /* Starts *stats for a job of scene and output on device (copied). Allocates nothing. */
 void render_stats_init(render_stats *stats, const gpu_info *device, int threads_requested, double context_seconds,
-                       const char *scene, const char *output);
+                       double before_command_seconds, const char *scene, const char *output);
 
 /* Adds a rendered image with its result (render_job_callbacks.image_written): sizes, the
  * per-pixel samples (the result's samples channel), timings, figures, peak memory.
