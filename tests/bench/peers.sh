@@ -290,6 +290,16 @@ quality_compare() {
                 "rtspheres at that time RMSE $at_time ($(ratio "$at_time" "$cycles_rmse")x), for that RMSE" \
                 "$for_rmse s ($(ratio "$for_rmse" "$cycles_time")x)"
         done
+        # The issue's "with --noise-threshold better still": the adaptive ladder's RMSE at
+        # Cycles' render time (log-log between its thresholds' points, as above).
+        cycles_time=$(value "cycles:$label@$quality_point" 7)
+        cycles_rmse=$(value "cycles:$label@$quality_point" 19)
+        adaptive_at_time=$(awk -F '\t' -v prefix="$label@nt" 'index($1, prefix) == 1 && $7 != "-" && $19 != "-" {
+            print $7, $19 }' "$rows" | loglog_at "$cycles_time")
+        quality_fact "$label" adaptive_rmse_at_cycles_render_time "$adaptive_at_time"
+        quality_fact "$label" adaptive_rmse_ratio_equal_render_time "$(ratio "$adaptive_at_time" "$cycles_rmse")"
+        echo "  $label with --noise-threshold, render s: at Cycles' $quality_point-spp time RMSE $adaptive_at_time" \
+            "($(ratio "$adaptive_at_time" "$cycles_rmse")x Cycles')"
     fi
     adaptive_time=$(awk -F '\t' -v prefix="$label@nt" 'index($1, prefix) == 1 && $7 != "-" && $19 != "-" {
         print $19, $7 }' "$rows" | loglog_at "$own_rmse")

@@ -555,6 +555,12 @@ targets=$work/targets.tsv
         "$(ratio "$(value weekend 7)" "$(value cycles-weekend 7)")"
     printf 'cornell_rmse_ratio_equal_time\t%s\t<=\t1\tx\tCornell RMSE at equal time (Cycles %s spp), rtspheres / Cycles\n' \
         "$(quality_value cornell rmse_ratio_equal_render_time)" "$quality_point"
+    # "... with --noise-threshold better still": below the fixed spp ladder's ratio.
+    fixed_ratio=$(quality_value cornell rmse_ratio_equal_render_time)
+    adaptive_ratio=$(quality_value cornell adaptive_rmse_ratio_equal_render_time)
+    [ "$fixed_ratio" != - ] || adaptive_ratio=-
+    printf 'cornell_adaptive_rmse_ratio_equal_time\t%s\t<\t%s\tx\tCornell RMSE at equal time with --noise-threshold, rtspheres / Cycles (below the fixed spp ratio)\n' \
+        "$adaptive_ratio" "$fixed_ratio"
     for label in cornell three-balls; do
         printf '%s_adaptive_time_ratio\t%s\t<=\t0.5\tx\t%s\n' "$(echo "$label" | tr - _)" \
             "$(quality_value "$label" adaptive_time_ratio)" \
