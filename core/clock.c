@@ -15,19 +15,16 @@ double clock_process_start(void)
     char line[1024];
     bool read = fgets(line, sizeof line, stat) != NULL;
     fclose(stat);
-    /* proc(5): field 2 is the command name in parentheses (it may hold spaces), field 22
-     * the start time in clock ticks since boot, 20 fields after the last ')'. */
-    const char *field = read ? strrchr(line, ')') : NULL;
+    /* proc(5): the command name (field 2) is in parentheses and may hold spaces, so the
+     * fields are counted from its last ')'; field 22 is the start in clock ticks since boot. */
+    const char *space = read ? strrchr(line, ')') : NULL;
+    for (int field = 3; space != NULL && field <= 22; field++)
+        space = strchr(space + 1, ' ');   /* the space before field `field` */
     unsigned long long start_ticks = 0;
-    int index = 2;
-    for (; field != NULL && index < 22; index++) {
-        field = strchr(field + 1, ' ');
-        if (field != NULL && index == 21 && sscanf(field + 1, "%llu", &start_ticks) != 1)
-            field = NULL;
-    }
     long ticks_per_second = sysconf(_SC_CLK_TCK);
     struct timespec boot;
-    if (field == NULL || start_ticks == 0 || ticks_per_second <= 0 || clock_gettime(CLOCK_BOOTTIME, &boot) != 0)
+    if (space == NULL || sscanf(space + 1, "%llu", &start_ticks) != 1 || start_ticks == 0 || ticks_per_second <= 0
+        || clock_gettime(CLOCK_BOOTTIME, &boot) != 0)
         return now;
     /* The start time counts from boot on the clock that includes suspends (CLOCK_BOOTTIME):
      * the process's age is measured there and taken off the monotonic now. */
