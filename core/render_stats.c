@@ -72,7 +72,6 @@ static render_stats_image *add_entry(render_stats *stats, const render_job_image
     entry->plan.output = entry->output;
     entry->peak_rss_bytes = peak_rss_bytes();
     entry->first_pass_after_start = -1;
-    entry->first_pass_after_process_start = -1;
     return entry;
 }
 
@@ -90,8 +89,6 @@ rt_status render_stats_add_rendered(render_stats *stats, const render_job_image 
     entry->result.aovs = (rt_image){0};
     entry->result.light_groups = (rt_image){0};
     entry->first_pass_after_start = first_pass_after_start;
-    entry->first_pass_after_process_start =
-        first_pass_after_start < 0 ? -1 : first_pass_after_start + stats->before_command_seconds;
     /* Per-pixel samples: the samples channel (the fourth) of the result. */
     const rt_image *pixels = &result->image;
     size_t count = (size_t)pixels->width * pixels->height;
@@ -201,8 +198,8 @@ static void end_object(json_object *object)
     fprintf(object->out, "\n%*s}", object->indent - 2, "");
 }
 
-/* Writes a rendered image's figures into object. */
-static void write_result(json_object *object, const render_stats_image *entry)
+/* Writes a rendered image's figures into object; before_command_seconds as in render_stats. */
+static void write_result(json_object *object, const render_stats_image *entry, double before_command_seconds)
 {
     const render_result *r = &entry->result;
     double seconds = r->seconds > 0 ? r->seconds : 0;
@@ -231,7 +228,8 @@ static void write_result(json_object *object, const render_stats_image *entry)
     field_number(&times, "compile", r->compile_seconds);
     field_number(&times, "first_pass", r->first_pass_seconds);
     field_number(&times, "first_pass_after_command_start", entry->first_pass_after_start);
-    field_number(&times, "first_pass_after_process_start", entry->first_pass_after_process_start);
+    field_number(&times, "first_pass_after_process_start",
+                 entry->first_pass_after_start < 0 ? -1 : entry->first_pass_after_start + before_command_seconds);
     field_number(&times, "after_first_pass", r->steady_seconds);
     end_object(&times);
     json_object scene = begin_object(object, "scene");
@@ -252,8 +250,8 @@ static void write_result(json_object *object, const render_stats_image *entry)
     field_string(object, "scene_hash", hash);
 }
 
-/* Writes one image's object. */
-static void write_image(FILE *out, const render_stats_image *entry)
+/* Writes one image's object; before_command_seconds as in render_stats. */
+static void write_image(FILE *out, const render_stats_image *entry, double before_command_seconds)
 {
     json_object object = {.out = out, .indent = 6};
     fputs("    {", out);
@@ -272,7 +270,7 @@ static void write_image(FILE *out, const render_stats_image *entry)
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)entry->plan.options_hash);
     field_string(&object, "options_hash", hash);
     if (entry->has_result)
-        write_result(&object, entry);
+        write_result(&object, entry, before_command_seconds);
     field_number(&object, "peak_rss_bytes", (double)entry->peak_rss_bytes);
     fputs("\n    }", out);
 }
@@ -309,7 +307,7 @@ static void write_document(FILE *out, const render_stats *stats)
     for (int i = 0; i < stats->image_count; i++) {
         const render_stats_image *entry = &stats->images[i];
         fputs(i > 0 ? ",\n" : "\n", out);
-        write_image(out, entry);
+        write_image(out, entry, stats->before_command_seconds);
         rendered += entry->outcome == RENDER_STATS_RENDERED;
         skipped += entry->outcome == RENDER_STATS_SKIPPED;
         failed += entry->outcome == RENDER_STATS_FAILED || entry->outcome == RENDER_STATS_INTERRUPTED;

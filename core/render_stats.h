@@ -45,8 +45,6 @@ typedef struct render_stats_image {
     double first_pass_after_start;   /* seconds from the command's start to its first
                                       * pass's end (context, parse, BVH, upload, compile);
                                       * < 0: unknown */
-    double first_pass_after_process_start;   /* the same from the process's start (the
-                                              * libraries' loading before main in it) */
 } render_stats_image;
 
 typedef struct render_stats {
