@@ -86,6 +86,66 @@ rt_status adaptive_create(int width, int height, float threshold, uint32_t min_s
     return RT_OK;
 }
 
+/* True when count is one of the schedule's check counts; *before gets the check before it
+ * (0 for the first) and *checks how many come before it. */
+static bool is_check_count(const adaptive_sampler *sampler, uint32_t count, uint32_t *before, int *checks)
+{
+    uint32_t previous = 0;
+    int made = 0;
+    for (uint32_t n = adaptive_next_check(0, sampler->min_spp, sampler->max_spp);;
+         n = adaptive_next_check(n, sampler->min_spp, sampler->max_spp)) {
+        if (n == count) {
+            *before = previous;
+            *checks = made;
+            return true;
+        }
+        if (n > count || n >= sampler->max_spp)
+            return false;
+        previous = n;
+        made++;
+    }
+}
+
+rt_status adaptive_resume(adaptive_sampler *sampler, const uint32_t *limits, const uint32_t *samples,
+                          rt_error *error)
+{
+    size_t pixels = (size_t)sampler->width * sampler->height;
+    uint32_t next = 0;
+    for (size_t i = 0; i < pixels; i++)
+        next = limits[i] > next ? limits[i] : next;
+    uint32_t before = 0;
+    int checks = 0;
+    if (!is_check_count(sampler, next, &before, &checks))
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "RENDER: the partial render's adaptive state waits for a check at %u samples, which is "
+                            "not of this render's schedule (--min-spp %u, --spp %u): resume with the options it "
+                            "was rendered with", next, sampler->min_spp, sampler->max_spp);
+    bool stopped_early = false;
+    for (size_t i = 0; i < pixels; i++) {
+        uint32_t unused;
+        int unused_checks;
+        bool going = limits[i] == next;
+        if (going ? samples[i] > next
+                  : samples[i] != limits[i] || !is_check_count(sampler, limits[i], &unused, &unused_checks)) {
+            return rt_error_set(error, RT_ERROR_INPUT,
+                                "RENDER: the partial render's adaptive state at pixel %zu,%zu (%u samples, limit %u) "
+                                "is not of this render's schedule (--min-spp %u, --spp %u, next check at %u)",
+                                i % (size_t)sampler->width, i / (size_t)sampler->width, samples[i], limits[i],
+                                sampler->min_spp, sampler->max_spp, next);
+        }
+        stopped_early |= !going;
+    }
+    for (size_t i = 0; i < pixels; i++) {
+        sampler->going[i] = limits[i] == next;
+        sampler->limits[i] = limits[i];
+    }
+    sampler->checked_at = before;
+    sampler->next_check = next;
+    sampler->stopped_early = stopped_early;
+    sampler->noise.checks = checks;
+    return RT_OK;
+}
+
 const uint32_t *adaptive_limits(const adaptive_sampler *sampler)
 {
     return sampler->limits;

@@ -76,6 +76,19 @@ rt_status adaptive_create(int width, int height, float threshold, uint32_t min_s
 
 void adaptive_free(adaptive_sampler *sampler);
 
+/* Puts a new sampler (adaptive_create) where a stopped render's sampler was just before a
+ * check, so that the render continues as if it had not stopped (core/render.c, --resume):
+ * limits holds each pixel's limit at that point and samples its finished samples (width *
+ * height each, rows top to bottom). The next check is the largest limit, c: the pixels whose
+ * limit is c go on (samples at most c), the others stopped at an earlier check (their limit
+ * is their samples, itself a check's count). Before the first check every limit is the
+ * first check's count; at a check every pixel going has reached it, so every limit equals
+ * the pixel's samples. RT_ERROR_INPUT naming the first pixel (x, y from the top left) that
+ * breaks these rules, as limits of another --min-spp or --spp would; the sampler is
+ * unchanged then. */
+rt_status adaptive_resume(adaptive_sampler *sampler, const uint32_t *limits, const uint32_t *samples,
+                          rt_error *error);
+
 /* The per-pixel sample limits to give the tracer: width * height counts, rows top to
  * bottom (a stopped pixel's limit is the samples it has). */
 const uint32_t *adaptive_limits(const adaptive_sampler *sampler);

@@ -225,6 +225,10 @@ typedef struct gpu_tracer_parameters {
                                            * (sum r, g, b, finished samples) to continue from;
                                            * a pixel with n finished samples goes on with
                                            * sample index sample_start + n */
+    const float *resume_luminance_squares;  /* NULL, or with resume width*height floats, rows
+                                           * top to bottom: each pixel's sum of squared
+                                           * luminance over those samples (what adaptive
+                                           * sampling's checks read; zero when NULL) */
 } gpu_tracer_parameters;
 
 /* What one pass reports. */

@@ -167,8 +167,11 @@ rt_status gpu_state_create_sums(gpu_tracer *tracer, rt_error *error);
 /* Loads a partial result (resume: width x height x 4 floats, rows top to bottom, the sums
  * of R, G, B and the finished samples: gpu.h gpu_tracer_parameters) into state set 0, which the first pass reads: the sums, and the
  * finished counts as "samples started" (a path that was in flight is traced again: its
- * random numbers are the same). RT_ERROR_RUNTIME when memory runs out. */
-rt_status gpu_state_load_resume(gpu_tracer *tracer, const float *resume, rt_error *error);
+ * random numbers are the same), and luminance_squares (NULL: zero; else width x height
+ * floats) as the statistics' sums of squared luminance. RT_ERROR_RUNTIME when memory runs
+ * out. */
+rt_status gpu_state_load_resume(gpu_tracer *tracer, const float *resume, const float *luminance_squares,
+                                rt_error *error);
 
 /* ---- core/gpu_program.c: programs from the modules of core/shader_sources.S ---------- */
 

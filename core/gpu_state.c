@@ -171,29 +171,42 @@ rt_status gpu_state_create_sums(gpu_tracer *tracer, rt_error *error)
     return status;
 }
 
-rt_status gpu_state_load_resume(gpu_tracer *tracer, const float *resume, rt_error *error)
+rt_status gpu_state_load_resume(gpu_tracer *tracer, const float *resume, const float *luminance_squares,
+                                rt_error *error)
 {
     size_t pixel_count = (size_t)tracer->width * tracer->height;
     float *sums = large_pages_alloc(pixel_count * 4 * sizeof(float));
     uint32_t *counters = large_pages_calloc(pixel_count * 4, sizeof(uint32_t));
-    if (sums == NULL || counters == NULL) {
+    float *statistics = luminance_squares != NULL ? large_pages_calloc(pixel_count * 4, sizeof(float)) : NULL;
+    if (sums == NULL || counters == NULL || (luminance_squares != NULL && statistics == NULL)) {
         free(sums);
         free(counters);
+        free(statistics);
         return rt_error_set(error, RT_ERROR_RUNTIME, "GPU: out of memory loading the partial render");
     }
     size_t row_floats = (size_t)tracer->width * 4;
     for (int row = 0; row < tracer->height; row++) {
         /* Rows top to bottom in memory; GL's row 0 is the bottom. */
-        const float *source = resume + (size_t)(tracer->height - 1 - row) * row_floats;
+        size_t source_row = (size_t)(tracer->height - 1 - row);
+        const float *source = resume + source_row * row_floats;
         memcpy(sums + (size_t)row * row_floats, source, row_floats * sizeof(float));
-        for (int x = 0; x < tracer->width; x++)
-            counters[((size_t)row * tracer->width + x) * 4] = (uint32_t)source[x * 4 + 3];
+        for (int x = 0; x < tracer->width; x++) {
+            size_t pixel = (size_t)row * tracer->width + x;
+            counters[pixel * 4] = (uint32_t)source[x * 4 + 3];
+            if (statistics != NULL)   /* glsl/path_state.glsl: statistics.z */
+                statistics[pixel * 4 + 2] = luminance_squares[source_row * tracer->width + x];
+        }
     }
     glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][TRACER_STATE_ACCUMULATED]);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA, GL_FLOAT, sums);
     glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][TRACER_STATE_COUNTERS]);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA_INTEGER, GL_UNSIGNED_INT, counters);
+    if (statistics != NULL) {
+        glBindTexture(GL_TEXTURE_2D, tracer->state_textures[0][TRACER_STATE_STATISTICS]);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tracer->width, tracer->height, GL_RGBA, GL_FLOAT, statistics);
+    }
     free(sums);
     free(counters);
+    free(statistics);
     return gpu_check_gl("loading the partial render", error);
 }

@@ -239,7 +239,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     if (status == RT_OK)
         status = gpu_state_create(tracer, error);
     if (status == RT_OK && parameters->resume != NULL)
-        status = gpu_state_load_resume(tracer, parameters->resume, error);
+        status = gpu_state_load_resume(tracer, parameters->resume, parameters->resume_luminance_squares, error);
     tracer->timings.state_seconds = clock_seconds() - step_start;
     if (status != RT_OK) {
         gpu_tracer_destroy(tracer);
@@ -252,6 +252,7 @@ rt_status gpu_tracer_create(gpu_context *context, const uint32_t *packed_texels,
     glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, TRACER_COUNTER_BINDING, tracer->counter_buffer);
     tracer->parameters = *parameters;
     tracer->parameters.resume = NULL;
+    tracer->parameters.resume_luminance_squares = NULL;
     glGenBuffers(1, &tracer->parameter_buffer);
     upload_parameters(tracer);
     status = gpu_state_create_sums(tracer, error);

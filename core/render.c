@@ -50,8 +50,10 @@ uint64_t render_bytes_per_pixel(const render_options *options, int light_group_c
         bytes += (uint64_t)light_group_count * (16 + 2 * 16 + 2 * 12);
     if (options->noise_threshold > 0)   /* the checks' read-back, limits, the sampler's arrays; */
         bytes += 16 + 4 + 4 + 16        /* compacted passes (core/gpu_compact.c): the host's sums, */
-                 + 3 * 16 + 4 + 4 + 2 * 16;   /* started, limits, the pixel map on the device and
-                                               * the host */
+                 + 3 * 16 + 4 + 4 + 2 * 16    /* started, limits, the pixel map on the device and */
+                 + 2 * 4 * RENDER_ADAPTIVE_STATE_CHANNELS;   /* the host; at a stop the state
+                                                              * layer and its copy joined to the
+                                                              * AOVs (render_job.c) */
     return bytes;
 }
 
@@ -455,42 +457,109 @@ static rt_status add_direct_emission_layer(gpu_tracer *tracer, int width, int he
     return status;
 }
 
-/* Turns a partial result (R, G, B means and a samples channel, region-sized) back into the
- * tracer's sums. Returns an allocated width*height*4 array or NULL with error set. */
-static float *resume_sums(const rt_image *partial, int width, int height, uint32_t samples_per_pixel,
-                          uint64_t *samples_done, rt_error *error)
+void render_resume_free(render_resume *resume)
 {
-    int samples_channel = -1;
+    free(resume->sums);
+    free(resume->luminance_squares);
+    free(resume->limits);
+    free(resume->samples);
+    memset(resume, 0, sizeof *resume);
+}
+
+/* The channel of partial named name, or -1. */
+static int find_channel(const rt_image *partial, const char *name)
+{
     for (int c = 0; c < partial->channels; c++)
-        if (strcmp(partial->channel_names[c], "samples") == 0)
-            samples_channel = c;
-    if (partial->width != width || partial->height != height || partial->channels < 4 || samples_channel < 0) {
-        rt_error_set(error, RT_ERROR_INPUT,
-                     "RENDER: the partial render is %dx%d with %d channels; resuming needs %dx%d with R, G, B and "
-                     "samples", partial->width, partial->height, partial->channels, width, height);
-        return NULL;
+        if (strcmp(partial->channel_names[c], name) == 0)
+            return c;
+    return -1;
+}
+
+bool render_partial_has_adaptive_state(const rt_image *partial)
+{
+    static const char *const names[RENDER_ADAPTIVE_STATE_CHANNELS] = RENDER_ADAPTIVE_STATE_CHANNEL_NAMES;
+    for (int i = 0; i < RENDER_ADAPTIVE_STATE_CHANNELS; i++)
+        if (find_channel(partial, names[i]) < 0)
+            return false;
+    return true;
+}
+
+/* Checks that count is a pixel's sample count of a render of samples_per_pixel. */
+static rt_status check_count(float count, const char *what, size_t pixel, uint32_t samples_per_pixel,
+                             rt_error *error)
+{
+    if (count >= 0 && count <= (float)samples_per_pixel && count == floorf(count))
+        return RT_OK;
+    return rt_error_set(error, RT_ERROR_INPUT, "RENDER: the partial render has %g %s at pixel %zu, outside 0..%u",
+                        count, what, pixel, samples_per_pixel);
+}
+
+/* Turns a partial result (region-sized: R, G, B means and a samples channel, and maybe the
+ * adaptive state layer, render.h) into what the render continues from (*resume; the caller
+ * frees it with render_resume_free()): the sums of the state layer when the partial has
+ * it (its limits and samples too when adaptive), else means * samples. An adaptive render
+ * needs the layer. Nothing to free on failure. */
+static rt_status resume_from_partial(const rt_image *partial, int width, int height, uint32_t samples_per_pixel,
+                                     bool adaptive, render_resume *resume, rt_error *error)
+{
+    memset(resume, 0, sizeof *resume);
+    int samples_channel = find_channel(partial, "samples");
+    if (partial->width != width || partial->height != height || partial->channels < 4 || samples_channel < 0)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "RENDER: the partial render is %dx%d with %d channels; resuming needs %dx%d with R, G, B "
+                            "and samples", partial->width, partial->height, partial->channels, width, height);
+    static const char *const state_names[RENDER_ADAPTIVE_STATE_CHANNELS] = RENDER_ADAPTIVE_STATE_CHANNEL_NAMES;
+    int state[RENDER_ADAPTIVE_STATE_CHANNELS], found = 0;
+    for (int i = 0; i < RENDER_ADAPTIVE_STATE_CHANNELS; i++)
+        found += (state[i] = find_channel(partial, state_names[i])) >= 0;
+    if (found != 0 && found != RENDER_ADAPTIVE_STATE_CHANNELS)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "RENDER: the partial render has %d of the %d channels of the adaptive state (%s ... %s)",
+                            found, RENDER_ADAPTIVE_STATE_CHANNELS, state_names[0],
+                            state_names[RENDER_ADAPTIVE_STATE_CHANNELS - 1]);
+    bool has_state = found == RENDER_ADAPTIVE_STATE_CHANNELS;
+    if (adaptive && !has_state)
+        return rt_error_set(error, RT_ERROR_INPUT,
+                            "RENDER: an adaptive render (noise threshold) resumes from the adaptive state a partial "
+                            "file of one keeps (%s, ...), and this partial has none: it was rendered without "
+                            "--noise-threshold, or by an rtspheres from before that layer; resume it without "
+                            "--noise-threshold, or render afresh", state_names[0]);
+    size_t pixels = (size_t)width * height;
+    resume->sums = large_pages_alloc(pixels * 4 * sizeof(float));
+    if (has_state) {
+        resume->luminance_squares = large_pages_alloc(pixels * sizeof(float));
+        if (adaptive) {
+            resume->limits = large_pages_alloc(pixels * sizeof(uint32_t));
+            resume->samples = large_pages_alloc(pixels * sizeof(uint32_t));
+        }
     }
-    float *sums = large_pages_alloc((size_t)width * height * 4 * sizeof(float));
-    if (sums == NULL) {
-        rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
-        return NULL;
+    if (resume->sums == NULL || (has_state && resume->luminance_squares == NULL)
+        || (has_state && adaptive && (resume->limits == NULL || resume->samples == NULL))) {
+        render_resume_free(resume);
+        return rt_error_set(error, RT_ERROR_RUNTIME, "RENDER: out of memory");
     }
-    *samples_done = 0;
-    for (size_t i = 0; i < (size_t)width * height; i++) {
+    for (size_t i = 0; i < pixels; i++) {
         const float *pixel = partial->pixels + i * partial->channels;
-        float count = pixel[samples_channel];
-        if (!(count >= 0) || count > (float)samples_per_pixel || count != floorf(count)) {
-            free(sums);
-            rt_error_set(error, RT_ERROR_INPUT, "RENDER: the partial render has %g samples at pixel %zu, outside 0..%u",
-                         count, i, samples_per_pixel);
-            return NULL;
+        float count = has_state ? pixel[state[3]] : pixel[samples_channel];
+        rt_status status = check_count(count, "samples", i, samples_per_pixel, error);
+        if (status == RT_OK && has_state)
+            status = check_count(pixel[state[5]], "as its adaptive limit", i, samples_per_pixel, error);
+        if (status != RT_OK) {
+            render_resume_free(resume);
+            return status;
         }
         for (int c = 0; c < 3; c++)
-            sums[i * 4 + c] = pixel[c] * count;
-        sums[i * 4 + 3] = count;
-        *samples_done += (uint64_t)count;
+            resume->sums[i * 4 + c] = has_state ? pixel[state[c]] : pixel[c] * count;
+        resume->sums[i * 4 + 3] = count;
+        resume->samples_total += (uint64_t)count;
+        if (has_state)
+            resume->luminance_squares[i] = pixel[state[4]];
+        if (resume->limits != NULL) {
+            resume->limits[i] = (uint32_t)pixel[state[5]];
+            resume->samples[i] = (uint32_t)count;
+        }
     }
-    return sums;
+    return RT_OK;
 }
 
 /* The part of render_scene before the passes: checks the region, frames the camera,
@@ -498,10 +567,11 @@ static float *resume_sums(const rt_image *partial, int width, int height, uint32
  * checks the resumed partial against the hash and creates the tracer (*tracer, which the
  * caller destroys) with the partial's sums. *region is the region of the result, *traced
  * the region the tracer renders (region, and with adaptive sampling the pixels around it
- * whose decisions reach into it), *samples_resumed the samples the partial brought and
- * *pass_work_budget the first pass's budget. On failure nothing is left to free. */
+ * whose decisions reach into it), *resume what the partial brought (the caller frees it
+ * with render_resume_free()) and *pass_work_budget the first pass's budget. On failure
+ * nothing is left to free. */
 static rt_status set_up_tracer(gpu_context *context, const scene *s, const render_options *options,
-                               render_result *result, int region[4], int traced[4], uint64_t *samples_resumed,
+                               render_result *result, int region[4], int traced[4], render_resume *resume,
                                gpu_tracer **tracer, uint32_t *pass_work_budget, rt_error *error)
 {
     region[0] = 0;
@@ -517,10 +587,7 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
         memcpy(region, r, 4 * sizeof *region);
     }
     memcpy(result->region, region, sizeof result->region);
-    if (options->noise_threshold > 0 && options->resume != NULL)
-        return rt_error_set(error, RT_ERROR_INPUT,
-                            "RENDER: an adaptive render (noise threshold) cannot resume a partial render: the "
-                            "partial keeps no per-pixel variance");
+    memset(resume, 0, sizeof *resume);
     /* Adaptive decisions reach adaptive_reach() pixels: the tracer renders that much around
      * the region, so that the region's pixels are the full render's (render.h). */
     memcpy(traced, region, 4 * sizeof *traced);
@@ -531,6 +598,12 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
         traced[1] = region[1] - reach > 0 ? region[1] - reach : 0;
         traced[2] = region[2] + reach < s->render.width ? region[2] + reach : s->render.width;
         traced[3] = region[3] + reach < s->render.height ? region[3] + reach : s->render.height;
+        if (options->resume != NULL && memcmp(traced, region, sizeof *traced * 4) != 0)
+            return rt_error_set(error, RT_ERROR_INPUT,
+                                "RENDER: an adaptive render of part of the image (--crop, --tile, --shard-by tiles) "
+                                "cannot resume: its decisions reach %d pixels past the part, whose state a partial "
+                                "file does not hold; render the part afresh",
+                                reach);
     }
     /* A partial file keeps no light groups (and its paths in flight are traced again). */
     if (options->light_groups && options->resume != NULL)
@@ -582,21 +655,21 @@ static rt_status set_up_tracer(gpu_context *context, const scene *s, const rende
     parameters.omitted_features = omitted_features(&packed, options, parameters.shader.camera_media);
     result->threaded_walk = (parameters.omitted_features & GPU_OMIT_STACK_WALK) != 0;
     *pass_work_budget = parameters.shader.pass_work_budget;
-    *samples_resumed = 0;
-    float *sums = NULL;
     if (options->resume != NULL) {
-        sums = resume_sums(options->resume, width, height, (uint32_t)s->render.samples_per_pixel, samples_resumed,
-                           error);
-        if (sums == NULL) {
+        status = resume_from_partial(options->resume, width, height, (uint32_t)s->render.samples_per_pixel,
+                                     options->noise_threshold > 0, resume, error);
+        if (status != RT_OK) {
             packed_scene_free(&packed);
-            return RT_ERROR_INPUT;
+            return status;
         }
-        parameters.resume = sums;
+        parameters.resume = resume->sums;
+        parameters.resume_luminance_squares = resume->luminance_squares;
     }
     status = gpu_tracer_create(context, packed.texels, packed.texel_count, packed.texel_hash, &parameters, tracer,
                                error);
     packed_scene_free(&packed);
-    free(sums);
+    if (status != RT_OK)
+        render_resume_free(resume);
     return status;
 }
 
@@ -692,11 +765,10 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
         options = &defaults;
 
     int region[4], traced[4];
-    uint64_t samples_resumed = 0;
+    render_resume resume;
     uint32_t budget = 0;
     gpu_tracer *tracer = NULL;
-    rt_status status =
-        set_up_tracer(context, s, options, result, region, traced, &samples_resumed, &tracer, &budget, error);
+    rt_status status = set_up_tracer(context, s, options, result, region, traced, &resume, &tracer, &budget, error);
     if (status != RT_OK)
         return status;
     result->reused_scene = gpu_tracer_reused_scene(tracer);
@@ -710,13 +782,14 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
 
     render_progress progress = {
         .samples_total = (uint64_t)traced_width * traced_height * s->render.samples_per_pixel,
-        .samples_done = samples_resumed,
+        .samples_done = resume.samples_total,
         .pixel_count = traced_width * traced_height,
         .noise_threshold = options->noise_threshold,
     };
     render_stop_reason stop = RENDER_STOP_SAMPLES;
     status = render_run_passes(context, tracer, options, (uint32_t)s->render.samples_per_pixel, traced, region,
-                               budget, start, &progress, &stop, result, error);
+                               budget, &resume, start, &progress, &stop, result, error);
+    render_resume_free(&resume);
     if (status == RT_OK)
         status = read_result(context, tracer, s, options, traced_width, traced_height, result, error);
     gpu_tracer_destroy(tracer);
@@ -734,8 +807,10 @@ rt_status render_scene(gpu_context *context, const scene *s, const render_option
             image_free(&result->light_groups);
         }
     }
-    if (status != RT_OK)
+    if (status != RT_OK) {
+        image_free(&result->adaptive_state);
         return status;
+    }
 
     result->samples_min = UINT32_MAX;
     for (size_t i = 0; i < (size_t)result->image.width * result->image.height; i++) {

@@ -36,7 +36,9 @@
  * each check the passes trace only the pixels still going (compacted: gpu.h
  * gpu_tracer_set_pass_pixels), and the samples channel holds each pixel's count. With a region, the tracer renders the pixels within adaptive_reach() of
  * it too (and drops them), so a region's decisions, and so its pixels, are exactly the
- * full render's. resume is refused with a threshold (the partial keeps no squares).
+ * full render's. A stopped render of the whole image leaves its adaptive state
+ * (render_result.adaptive_state), from which resume continues it to the bit; resume of a
+ * region is refused (its margin's state is not kept).
  *
  * The deadline (a clock_seconds() time, core/clock.h): before each pass after the first
  * the render predicts its end from the last pass; a pass that would end past the deadline
@@ -134,15 +136,20 @@ typedef struct render_options {
     /* Continue a partial render: an image of the region with R, G, B means and a
      * "samples" channel (as render_scene returns and an EXR keeps). A pixel with n
      * samples goes on from sample index sample_start + n, so the result equals an
-     * uninterrupted render up to float rounding of mean * n. NULL: start afresh. */
+     * uninterrupted render up to float rounding of mean * n. NULL: start afresh. When it
+     * also has the adaptive state layer (render_result.adaptive_state) the render goes on
+     * from that state instead: an adaptive render (noise_threshold, of the whole image:
+     * region all zero) then equals the uninterrupted one to the bit, and a fixed one to
+     * float rounding; an adaptive render needs that layer. */
     const rt_image *resume;
     uint64_t resume_scene_hash;  /* with resume: must equal this render's scene_hash (0: unchecked) */
     /* Every checkpoint_seconds (0: never), checkpoint() receives the image so far (the
-     * same layout as the result), the samples it holds and the render's scene_hash; a non-OK status stops the
-     * render with that status. */
+     * same layout as the result), the adaptive state layer (render_result.adaptive_state;
+     * an image without pixels when there is none), the samples the image holds and the
+     * render's scene_hash; a non-OK status stops the render with that status. */
     double checkpoint_seconds;
-    rt_status (*checkpoint)(void *checkpoint_context, const rt_image *partial, uint64_t samples, uint64_t scene_hash,
-                            rt_error *error);
+    rt_status (*checkpoint)(void *checkpoint_context, const rt_image *partial, const rt_image *adaptive_state,
+                            uint64_t samples, uint64_t scene_hash, rt_error *error);
     void *checkpoint_context;
     /* Every preview_seconds (0: never), between passes, preview() receives the image so far
      * (the same layout as the result: means and samples); for a live view (--display). */
@@ -176,6 +183,11 @@ typedef struct render_result {
                                   * R, G, B up to float rounding (an interrupted render's
                                   * groups also hold part of the paths then in flight);
                                   * free with image_free() */
+    rt_image adaptive_state;     /* with noise_threshold, of the whole image (region all
+                                  * zero), when the passes stopped before the end (time,
+                                  * interrupt): what resume continues from, the channels of
+                                  * RENDER_ADAPTIVE_STATE_CHANNEL_NAMES (below). Empty
+                                  * otherwise; free with image_free() */
     uint64_t samples;            /* samples finished over all pixels */
     uint32_t samples_min, samples_max;   /* the fewest and most samples a pixel finished */
     double seconds;              /* whole render, including set-up */
@@ -213,6 +225,21 @@ typedef struct render_result {
                                   * packed scene, camera, sky, full size, max depth. Parts of
                                   * one render share it; `merge` refuses mixed hashes. */
 } render_result;
+
+/* The adaptive state layer (render_result.adaptive_state, render_options.resume): where
+ * an adaptive render stood at its last check, or before its first, whose samples are each
+ * pixel's first ones, so that a render resumed from it continues the same samples to the
+ * same decisions. Per pixel, float32: the sums (not means) of R, G, B over the pixel's
+ * finished samples, their count, the sum of their squared luminance (core/luminance.h),
+ * and the pixel's sample limit (adaptive.h adaptive_resume). A pixel's samples after that
+ * check (in R, G, B and samples, which the layer leaves as they are) are traced again. */
+#define RENDER_ADAPTIVE_STATE_CHANNELS 6
+#define RENDER_ADAPTIVE_STATE_CHANNEL_NAMES \
+    {"adaptive.sum.R", "adaptive.sum.G", "adaptive.sum.B", "adaptive.samples", "adaptive.sum.Y2", "adaptive.limit"}
+
+/* True when partial (a partial render read back, render_options.resume) has the adaptive
+ * state layer, which an adaptive render needs to resume it. */
+bool render_partial_has_adaptive_state(const rt_image *partial);
 
 /* Returns options with every field at its default (all zero). */
 render_options render_options_defaults(void);

@@ -38,17 +38,35 @@ uint64_t render_sample_total(const rt_image *image);
 rt_status render_crop_to_region(rt_image *image, const int traced[4],
                                 const int region[4], rt_error *error);
 
+/* What a render resumed from a partial file continues from (core/render.c): the sums
+ * the tracer starts with (gpu.h gpu_tracer_parameters.resume, and with the adaptive state
+ * layer its luminance_squares), and for adaptive sampling each pixel's sample limit and
+ * finished samples (adaptive.h adaptive_resume; NULL: start the schedule afresh). All
+ * traced-region-sized, rows top to bottom; freed with render_resume_free(). */
+typedef struct render_resume {
+    float *sums;                 /* 4 floats a pixel: sum R, G, B, samples */
+    float *luminance_squares;    /* NULL: not kept (a partial without the adaptive state) */
+    uint32_t *limits, *samples;  /* NULL: no adaptive state */
+    uint64_t samples_total;
+} render_resume;
+
+void render_resume_free(render_resume *resume);
+
 /* The passes of render_scene over the traced region: runs them until every
  * pixel has its samples, adaptive sampling stops every pixel, the deadline
  * comes or a stop is requested
  * (*stop says which), adapting the budget (from initial_budget) unless the
  * options fix it, reporting progress (*progress, whose samples_done starts at
  * the resumed samples) and writing checkpoints (of region); fills the result's
- * pass timings. start is the render's start (clock_seconds). */
+ * pass timings. resume (NULL: none) gives adaptive sampling the state it
+ * continues from. When an adaptive render of the whole image stops before its
+ * end, result->adaptive_state receives its state (render.h). start is the
+ * render's start (clock_seconds). */
 rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer,
                             const render_options *options,
                             uint32_t samples_per_pixel, const int traced[4],
                             const int region[4], uint32_t initial_budget,
+                            const render_resume *resume,
                             double start, render_progress *progress,
                             render_stop_reason *stop, render_result *result,
                             rt_error *error);

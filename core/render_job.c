@@ -119,11 +119,23 @@ float job_output_exposure(const render_job *job)
 
 /* Writes pixels (R, G, B means, samples, of the image's region) to path with the
  * metadata of image; complete says whether the render ended by its own rule. result gives
- * the AOV layers, region, path segments, scene hash, time and (but for a checkpoint, whose
- * passes have not ended) the stop reason. */
+ * the layers (the AOVs, then the adaptive state when there is one), region, path segments,
+ * scene hash, time and (but for a checkpoint, whose passes have not ended) the stop
+ * reason. */
 static rt_status write_image(const job_image *image, const rt_image *pixels, const char *path, uint64_t samples,
                              bool complete, bool checkpoint, const render_result *result, rt_error *error)
 {
+    rt_image layers = {0};
+    const rt_image *written = &result->aovs;
+    if (result->adaptive_state.pixels != NULL) {
+        written = &result->adaptive_state;
+        if (result->aovs.pixels != NULL) {
+            rt_status status = image_append_channels(&result->aovs, &result->adaptive_state, &layers, error);
+            if (status != RT_OK)
+                return status;
+            written = &layers;
+        }
+    }
     const scene_render_settings *settings = &image->scene.render;
     rt_image placed = *pixels;
     placed.x = result->region[0];
@@ -133,15 +145,18 @@ static rt_status write_image(const job_image *image, const rt_image *pixels, con
     render_output_metadata metadata;
     job_metadata_texts texts;
     job_image_metadata(image, path, samples, complete, checkpoint, result, &metadata, &texts);
-    return render_output_write(path, &placed, &result->aovs, &metadata, job_output_exposure(image->run->job), error);
+    rt_status status =
+        render_output_write(path, &placed, written, &metadata, job_output_exposure(image->run->job), error);
+    image_free(&layers);
+    return status;
 }
 
 /* render_options.checkpoint: writes the image so far to the partial file. */
-static rt_status write_checkpoint(void *context, const rt_image *partial, uint64_t samples, uint64_t scene_hash,
-                                  rt_error *error)
+static rt_status write_checkpoint(void *context, const rt_image *partial, const rt_image *adaptive_state,
+                                  uint64_t samples, uint64_t scene_hash, rt_error *error)
 {
     const job_image *image = context;
-    render_result result = {.scene_hash = scene_hash};
+    render_result result = {.scene_hash = scene_hash, .adaptive_state = *adaptive_state};
     memcpy(result.region, image->plan.window, sizeof result.region);
     rt_status status = write_image(image, partial, image->plan.partial, samples, false, true, &result, error);
     const render_job_callbacks *callbacks = &image->run->callbacks;
@@ -262,8 +277,9 @@ static rt_status finish_image(job_image *image, render_result *result, rt_status
     if (render_status == RT_ERROR_INTERRUPTED) {
         /* The partial goes next to the output, never over it: the user's last good image
          * stays, and --resume continues from the partial. Like a checkpoint it holds the
-         * raw means and sample counts: --resume adds samples to them, so denoised, blurred
-         * or tone-mapped colour there would be processed twice. */
+         * raw means and sample counts (and an adaptive render's state, render.h): --resume
+         * adds samples to them, so denoised, blurred or tone-mapped colour there would be
+         * processed twice. */
         rt_error write_error = {{0}};
         if (write_image(image, &result->image, plan->partial, result->samples, false, false, result, &write_error)
             != RT_OK)
@@ -375,6 +391,7 @@ static rt_status render_image(job_image *image, rt_image resume_image, uint64_t 
         image_free(&result.image);
         image_free(&result.aovs);
         image_free(&result.light_groups);
+        image_free(&result.adaptive_state);
     }
     image_free(&resume_image);
     return status;

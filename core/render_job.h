@@ -302,7 +302,7 @@ const char *render_job_shard_kind_name(render_job_shard_kind kind);
  * (see the job); a shard by samples with a sample range; a shard by tiles with crop or
  * tile; a samples map with several frames or of an unknown
  * format; a minimum spp without a noise threshold; a noise threshold with a shard by samples,
- * a sample range or resume; a sweep with frames, resume or a define
+ * a sample range, or resume of part of the image (crop, tile, shard by tiles); a sweep with frames, resume or a define
  * of one of its columns, two of its rows writing one file (the table's file:line). */
 rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_error *error);
 

@@ -130,12 +130,14 @@ static bool load_for_resume(const char *path, const render_job_image *image, con
     return false;
 }
 
-/* Why this job cannot resume any file (NULL: it can): the options render_job_check() and
- * render_scene() refuse with a resume. */
-static const char *resume_refused(const render_job *job)
+/* Why this job cannot resume any file of image (NULL: it can): the options
+ * render_job_check() and render_scene() refuse with a resume. */
+static const char *resume_refused(const render_job *job, const render_job_image *image, const scene *s)
 {
-    if (job->tracer.noise_threshold > 0)
-        return "--noise-threshold cannot resume (a partial keeps no variance)";
+    const int *w = image->window;
+    bool whole = w[0] == 0 && w[1] == 0 && w[2] == s->render.width && w[3] == s->render.height;
+    if (job->tracer.noise_threshold > 0 && !whole)
+        return "--noise-threshold over part of the image cannot resume (its decisions reach past the part)";
     if (job->variance)
         return "--variance cannot resume (a partial keeps no squares)";
     if (job->light_groups)
@@ -192,7 +194,7 @@ rt_status render_job_examine_existing(const render_job *job, const render_job_im
         }
     }
     /* 2. The partial file, then an incomplete raw output: resume one of them. */
-    const char *refused = resume_refused(job);
+    const char *refused = resume_refused(job, image, s);
     const char *candidates[2] = {partial_there ? image->partial : NULL, NULL};
     if (incomplete_output && image_format_of(image->output) == IMAGE_FORMAT_EXR && !job->denoise
         && !(job->blur_sigma > 0))
@@ -225,6 +227,14 @@ rt_status render_job_examine_existing(const render_job *job, const render_job_im
         }
         if (!load_for_resume(path, image, s, resume, resume_scene_hash, text, sizeof text)) {
             snprintf(i == 0 ? partial_state : output_state, sizeof partial_state, "%s", text);
+            continue;
+        }
+        if (job->tracer.noise_threshold > 0 && !render_partial_has_adaptive_state(resume)) {
+            image_free(resume);
+            *resume_scene_hash = 0;
+            snprintf(i == 0 ? partial_state : output_state, sizeof partial_state,
+                     "%s has no adaptive state to resume with --noise-threshold (written by an older rtspheres)",
+                     path);
             continue;
         }
         decision->kind = RENDER_JOB_EXISTING_RESUME;

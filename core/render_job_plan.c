@@ -246,10 +246,12 @@ rt_status render_job_check(const render_job *job, render_job_plan *plan, rt_erro
         return rt_error_set(error, RT_ERROR_INPUT,
                             "--noise-threshold cannot be combined with --samples: each part would stop its "
                             "pixels on its own samples; render all samples, or split by --tile or --crop");
-    if (job->resume_path != NULL)
+    /* A region's decisions reach past it (core/render.c), and a partial keeps only the region. */
+    if (job->resume_path != NULL && (has_crop(job) || job->tile_count || (job->shard_count && plan->shard_by == RENDER_SHARD_TILES)))
         return rt_error_set(error, RT_ERROR_INPUT,
-                            "--noise-threshold cannot --resume: the partial file keeps no per-pixel variance "
-                            "for the threshold; resume without it");
+                            "--noise-threshold cannot --resume part of an image (--crop, --tile, --shard-by tiles): "
+                            "its pixels' decisions depend on pixels past the part, which the partial file does not "
+                            "hold; render the part afresh");
     return RT_OK;
 }
 

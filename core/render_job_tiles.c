@@ -569,6 +569,7 @@ rt_status job_render_tiles(job_image *image, const render_options *options, cons
             image_free(&result.image);
             image_free(&result.aovs);
             image_free(&result.light_groups);
+            image_free(&result.adaptive_state);
         }
     }
     pack_bvh_cache_free(tile_cache);

@@ -1,6 +1,7 @@
 /* render_passes.c: the pass loop of a render (render_internal.h render_run_passes): the
  * pass budget, adaptive sampling's checks (core/adaptive.h), the deadline, checkpoints and
  * previews between passes. Plain C: the GL work is the GPU module's. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -44,6 +45,7 @@ typedef struct adaptive_run {
     adaptive_sampler *sampler;
     float *rgba, *luminance_squares;
     uint32_t *pixels;            /* the pixels still going (adaptive_going_pixels) */
+    bool checked;                /* rgba and luminance_squares hold this run's last check */
 } adaptive_run;
 
 static void end_adaptive(adaptive_run *run)
@@ -56,17 +58,24 @@ static void end_adaptive(adaptive_run *run)
 }
 
 /* Starts adaptive sampling for a width x height tracer when the options ask for it: the
- * sampler, its buffers and the first limits on the tracer. Nothing to free on failure. */
+ * sampler (where resume's state left it, when it has one), its buffers and the first
+ * limits on the tracer. Nothing to free on failure. */
 static rt_status start_adaptive(gpu_tracer *tracer, const render_options *options, uint32_t samples_per_pixel,
-                                int width, int height, adaptive_run *run, rt_error *error)
+                                int width, int height, const render_resume *resume, adaptive_run *run,
+                                rt_error *error)
 {
     memset(run, 0, sizeof *run);
     if (!(options->noise_threshold > 0))
         return RT_OK;
     rt_status status = adaptive_create(width, height, options->noise_threshold, options->min_spp, samples_per_pixel,
                                        &run->sampler, error);
-    if (status != RT_OK)
+    if (status == RT_OK && resume != NULL && resume->limits != NULL)
+        status = adaptive_resume(run->sampler, resume->limits, resume->samples, error);
+    if (status != RT_OK) {
+        adaptive_free(run->sampler);
+        run->sampler = NULL;
         return status;
+    }
     size_t pixels = (size_t)width * height;
     run->rgba = large_pages_alloc(pixels * 4 * sizeof *run->rgba);
     run->luminance_squares = large_pages_alloc(pixels * sizeof *run->luminance_squares);
@@ -87,6 +96,7 @@ static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, bool *don
     rt_status status = gpu_tracer_read(tracer, run->rgba, run->luminance_squares, NULL, error);
     if (status != RT_OK)
         return status;
+    run->checked = true;
     *done = adaptive_check(run->sampler, run->rgba, run->luminance_squares) == 0;
     if (*done)
         return RT_OK;
@@ -122,11 +132,41 @@ static bool pass_fits_deadline(gpu_tracer *tracer, const render_options *options
     return true;
 }
 
+/* Makes the adaptive state layer (render.h) of a width x height render stopped between
+ * passes into *layer (the caller frees it): the sums of the last check this run made,
+ * whose limits were the samples; before any, the sums as they stand, every pixel's
+ * samples its first ones, with the sampler's limits (the first check's, or a resumed
+ * state's). */
+static rt_status adaptive_state_layer(gpu_tracer *tracer, adaptive_run *run, int width, int height,
+                                      rt_image *layer, rt_error *error)
+{
+    if (!run->checked) {
+        rt_status status = gpu_tracer_read(tracer, run->rgba, run->luminance_squares, NULL, error);
+        if (status != RT_OK)
+            return status;
+    }
+    rt_status status = image_create(layer, width, height, RENDER_ADAPTIVE_STATE_CHANNELS, error);
+    if (status != RT_OK)
+        return status;
+    static const char *const names[RENDER_ADAPTIVE_STATE_CHANNELS] = RENDER_ADAPTIVE_STATE_CHANNEL_NAMES;
+    for (int c = 0; c < RENDER_ADAPTIVE_STATE_CHANNELS; c++)
+        snprintf(layer->channel_names[c], IMAGE_CHANNEL_NAME_MAX, "%s", names[c]);
+    const uint32_t *limits = adaptive_limits(run->sampler);
+    for (size_t i = 0; i < (size_t)width * height; i++) {
+        float *pixel = layer->pixels + i * RENDER_ADAPTIVE_STATE_CHANNELS;
+        memcpy(pixel, run->rgba + 4 * i, 4 * sizeof *pixel);
+        pixel[4] = run->luminance_squares[i];
+        pixel[5] = run->checked ? run->rgba[4 * i + 3] : (float)limits[i];
+    }
+    return RT_OK;
+}
+
 /* Reads the image so far once (cut to region) and hands it to options->checkpoint when
- * checkpoint_due and to options->preview (--display) when preview_due. */
-static rt_status write_partial(gpu_tracer *tracer, const render_options *options, const int traced[4],
-                               const int region[4], uint64_t scene_hash, bool checkpoint_due, bool preview_due,
-                               rt_error *error)
+ * checkpoint_due, with the adaptive state layer when adaptive sampling runs over the
+ * whole image, and to options->preview (--display) when preview_due. */
+static rt_status write_partial(gpu_tracer *tracer, const render_options *options, adaptive_run *adaptive,
+                               const int traced[4], const int region[4], uint64_t scene_hash, bool checkpoint_due,
+                               bool preview_due, rt_error *error)
 {
     rt_image partial;
     uint64_t partial_samples;
@@ -138,8 +178,13 @@ static rt_status write_partial(gpu_tracer *tracer, const render_options *options
         status = render_crop_to_region(&partial, traced, region, error);
         partial_samples = status == RT_OK ? render_sample_total(&partial) : 0;
     }
+    rt_image state = {0};
+    if (status == RT_OK && checkpoint_due && adaptive->sampler != NULL && memcmp(traced, region, 4 * sizeof *traced) == 0)
+        status = adaptive_state_layer(tracer, adaptive, partial.width, partial.height, &state, error);
     if (status == RT_OK && checkpoint_due)
-        status = options->checkpoint(options->checkpoint_context, &partial, partial_samples, scene_hash, error);
+        status = options->checkpoint(options->checkpoint_context, &partial, &state, partial_samples, scene_hash,
+                                     error);
+    image_free(&state);
     if (status == RT_OK && preview_due)
         options->preview(options->preview_context, &partial);
     image_free(&partial);
@@ -148,8 +193,9 @@ static rt_status write_partial(gpu_tracer *tracer, const render_options *options
 
 rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const render_options *options,
                             uint32_t samples_per_pixel, const int traced[4], const int region[4],
-                            uint32_t initial_budget, double start, render_progress *progress,
-                            render_stop_reason *stop, render_result *result, rt_error *error)
+                            uint32_t initial_budget, const render_resume *resume, double start,
+                            render_progress *progress, render_stop_reason *stop, render_result *result,
+                            rt_error *error)
 {
     double last_checkpoint = clock_seconds(), last_preview = clock_seconds();
     double first_pass_end = 0, last_pass_seconds = 0;
@@ -164,7 +210,11 @@ rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const rend
                                                                                : MAXIMUM_ADAPTIVE_BUDGET;
     adaptive_run adaptive;
     rt_status status = start_adaptive(tracer, options, samples_per_pixel, traced[2] - traced[0],
-                                      traced[3] - traced[1], &adaptive, error);
+                                      traced[3] - traced[1], resume, &adaptive, error);
+    /* RTSPHERES_TEST_STOP_AFTER_PASSES=N: stop after N passes as a time limit would, so
+     * that a test can make partial files at chosen points (tests/render/test-adaptive.sh). */
+    const char *test_stop = getenv("RTSPHERES_TEST_STOP_AFTER_PASSES");
+    int stop_after_passes = test_stop != NULL ? atoi(test_stop) : 0;
     *stop = RENDER_STOP_SAMPLES;
     /* Finished pixels are marked for full passes to skip (gpu.h gpu_tracer_cull_finished)
      * once at most half the pixels go on, and again each time those fall to a quarter: at
@@ -181,7 +231,8 @@ rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const rend
     uint64_t cull_at_most = traced_pixels / 2;
     bool marked = false;
     for (bool done = false; status == RT_OK && !done;) {
-        if (!pass_fits_deadline(tracer, options, last_pass_seconds, adaptive_budget, &budget)) {
+        if (!pass_fits_deadline(tracer, options, last_pass_seconds, adaptive_budget, &budget)
+            || (stop_after_passes > 0 && progress->passes >= stop_after_passes)) {
             *stop = RENDER_STOP_TIME;
             break;
         }
@@ -241,14 +292,19 @@ rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const rend
         bool preview_due = options->preview != NULL && options->preview_seconds > 0
                            && clock_seconds() - last_preview >= options->preview_seconds;
         if (status == RT_OK && (checkpoint_due || preview_due)) {
-            status = write_partial(tracer, options, traced, region, result->scene_hash, checkpoint_due, preview_due,
-                                   error);
+            status = write_partial(tracer, options, &adaptive, traced, region, result->scene_hash, checkpoint_due,
+                                   preview_due, error);
             if (checkpoint_due)
                 last_checkpoint = clock_seconds();
             if (preview_due)
                 last_preview = clock_seconds();
         }
     }
+    /* Stopped before the end: what a resume continues from. */
+    if (status == RT_OK && adaptive.sampler != NULL && (*stop == RENDER_STOP_TIME || *stop == RENDER_STOP_INTERRUPTED)
+        && memcmp(traced, region, 4 * sizeof *traced) == 0)
+        status = adaptive_state_layer(tracer, &adaptive, traced[2] - traced[0], traced[3] - traced[1],
+                                      &result->adaptive_state, error);
     end_adaptive(&adaptive);
     return status;
 }

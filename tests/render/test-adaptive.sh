@@ -137,6 +137,61 @@ if "$program" render scenes/cornell.txt -o "$scratch/cornell-rounds.exr" --size 
         "$scratch/cornell-rounds-64.exr" "$scratch/cornell-rounds.exr"
 else fail "compacted runs in rounds" "a render failed"; fi
 
+# ---- a stopped adaptive render resumes to the uninterrupted image bit for bit, sample
+# counts too: its partial keeps the adaptive state (render.h: the sums at its last check,
+# or before its first, whose samples are each pixel's first ones), from which the resumed
+# render makes the same checks (adaptive.h adaptive_resume). Stopped (as --time-limit
+# stops, RTSPHERES_TEST_STOP_AFTER_PASSES) before the first check (3 passes of 200 units),
+# just after it (45) and between later checks (80: some pixels have stopped, and the
+# samples traced since the last check, in R, G, B and samples, are traced again); a
+# render resumed from the last stopped again before its first check, and resumed again.
+# The reference is cornell-rounds.exr above (the same options; the budget changes nothing).
+options="--size 48x48 --spp 256 --noise-threshold 0.1"
+"$program" stats "$scratch/cornell-rounds.exr" | grep "^channel samples" >"$scratch/whole.samples"
+for passes in 3 45 80; do
+    part=$scratch/stopped-$passes.exr resumed=$scratch/resumed-$passes.exr
+    # shellcheck disable=SC2086 # $options is a list of options
+    if RTSPHERES_TEST_STOP_AFTER_PASSES=$passes "$program" render scenes/cornell.txt -o "$part" $options \
+            --pass-budget 200 --quiet && [ "$(metadata "$part" stop_reason)" = time ] &&
+            "$program" render scenes/cornell.txt -o "$resumed" $options --resume "$part" --quiet; then
+        state=$(channel_mean "$part" adaptive.samples) traced=$(channel_mean "$part" samples)
+        "$program" stats "$resumed" | grep "^channel samples" >"$scratch/resumed.samples"
+        if "$program" diff "$resumed" "$scratch/cornell-rounds.exr" --fail 0 --failpercent 0 >"$scratch/diff" 2>&1 &&
+                cmp -s "$scratch/resumed.samples" "$scratch/whole.samples"; then
+            pass "an adaptive render stopped after $passes passes (state $state of $traced samples a pixel) resumes bit for bit"
+        else fail "an adaptive render stopped after $passes passes resumes bit for bit" \
+            "$(tr '\n' ' ' <"$scratch/diff") $(cat "$scratch/resumed.samples") against $(cat "$scratch/whole.samples")"; fi
+    else fail "an adaptive render stopped after $passes passes resumes" "a render failed, or no stop_reason time"; fi
+done
+state=$(channel_mean "$scratch/stopped-80.exr" adaptive.samples) traced=$(channel_mean "$scratch/stopped-80.exr" samples)
+if awk -v s="$state" -v t="$traced" 'BEGIN { exit !(s > 16 && s < t) }'; then
+    pass "the render stopped after 80 passes had made checks and traced past the last ($state < $traced)"
+else fail "the render stopped after 80 passes is between checks" "state $state, traced $traced samples a pixel"; fi
+# shellcheck disable=SC2086
+if RTSPHERES_TEST_STOP_AFTER_PASSES=2 "$program" render scenes/cornell.txt -o "$scratch/stopped-twice.exr" $options \
+        --pass-budget 200 --resume "$scratch/stopped-80.exr" --quiet &&
+        "$program" render scenes/cornell.txt -o "$scratch/resumed-twice.exr" $options \
+        --resume "$scratch/stopped-twice.exr" --quiet; then
+    same "an adaptive render resumed, stopped again and resumed again equals the uninterrupted one bit for bit" \
+        "$scratch/resumed-twice.exr" "$scratch/cornell-rounds.exr"
+else fail "an adaptive render resumed twice" "a render failed"; fi
+# Without --noise-threshold the same partial continues as a fixed render, from the state
+# (each pixel's first samples; R, G, B and samples hold others too): the fixed render's
+# image to float rounding (its sums were added in runs), every pixel with every sample.
+if "$program" render scenes/cornell.txt -o "$scratch/cornell-fixed.exr" --size 48x48 --spp 256 --quiet &&
+        "$program" render scenes/cornell.txt -o "$scratch/fixed-resumed.exr" --size 48x48 --spp 256 \
+        --resume "$scratch/stopped-80.exr" --quiet &&
+        "$program" diff "$scratch/fixed-resumed.exr" "$scratch/cornell-fixed.exr" --fail 1e-5 --failpercent 0 \
+        >"$scratch/diff" 2>&1 && [ "$(channel_range "$scratch/fixed-resumed.exr" samples)" = "256 256" ]; then
+    pass "an adaptive partial resumed without --noise-threshold gives the fixed render ($(grep "^max error" "$scratch/diff"))"
+else fail "an adaptive partial resumed without --noise-threshold" "$(tr '\n' ' ' <"$scratch/diff")"; fi
+# Another --min-spp has other checks (20, 40, 60, ...): the state does not fit them.
+# shellcheck disable=SC2086
+expect_refusal "resuming an adaptive partial with another --min-spp is refused" \
+    "of this render's schedule .--min-spp 20, --spp 256" "$scratch/refused" \
+    "$program" render scenes/cornell.txt -o "$scratch/refused/x.exr" $options --min-spp 20 \
+    --resume "$scratch/stopped-80.exr"
+
 # ---- where the slots lie changes no pixel: on llvmpipe with two or more rasteriser threads
 # a compacted pass deals its blocks of slots to 64-wide tile columns (core/gpu_compact.c
 # balanced_tile_columns), elsewhere along whole rows; 136x64 has room for two columns, and
@@ -164,8 +219,12 @@ expect_refusal "--noise-threshold with --shard (by samples, the default for one 
     "$program" render "$scene" -o "$dir/x.exr" --noise-threshold 0.05 --shard 1/2
 expect_refusal "--noise-threshold with --samples is refused" "cannot be combined with --samples" "$dir" \
     "$program" render "$scene" -o "$dir/x.exr" --noise-threshold 0.05 --samples 0:16
-expect_refusal "--noise-threshold with --resume is refused" "cannot --resume: the partial file keeps no" "$dir" \
-    "$program" render "$scene" -o "$dir/x.exr" --noise-threshold 0.05 --resume "$adaptive"
+expect_refusal "--noise-threshold resuming a partial without the adaptive state is refused" \
+    "resumes from the adaptive state a partial file of one keeps .adaptive.sum.R, ...., and this partial has none" \
+    "$dir" "$program" render "$scene" -o "$dir/x.exr" --noise-threshold 0.05 --spp 32 --resume "$coarse"
+expect_refusal "--noise-threshold resuming part of an image is refused" \
+    "cannot --resume part of an image .--crop, --tile, --shard-by tiles." "$dir" \
+    "$program" render "$scene" -o "$dir/x.exr" --noise-threshold 0.05 --crop 0,0,16,16 --resume "$adaptive"
 expect_refusal "--min-spp without --noise-threshold is refused" "--min-spp does nothing without --noise-threshold" \
     "$dir" "$program" render "$scene" -o "$dir/x.exr" --min-spp 8
 for bad in 0 -1 abc nan; do

@@ -183,4 +183,26 @@ if grep -q "^rtspheres: resuming: .*cut.partial.exr holds $partial_samples sampl
 else
     fail "--skip-existing resumes a partial" "$(head -c 400 "$scratch/resume.log") $(head -c 300 "$scratch/diff")"
 fi
+# An adaptive render cut short (after 6 passes, as a time limit would stop it) leaves an
+# incomplete output with its adaptive state (render.h): --skip-existing continues it to the
+# uninterrupted image bit for bit, sample counts too.
+adaptive="--size 32x18 --spp 128 --seed 5 --noise-threshold 0.1"
+# shellcheck disable=SC2086
+"$program" render "$scene" -o "$scratch/adaptive-whole.exr" $adaptive --quiet
+# shellcheck disable=SC2086
+RTSPHERES_TEST_STOP_AFTER_PASSES=6 "$program" render "$scene" -o "$scratch/adaptive-cut.exr" $adaptive \
+    --pass-budget 100 --quiet
+cut_samples=$(channel_mean "$scratch/adaptive-cut.exr" samples)
+# shellcheck disable=SC2086
+"$program" render "$scene" -o "$scratch/adaptive-cut.exr" $adaptive --skip-existing 2>"$scratch/adaptive-resume.log"
+if grep -q "^rtspheres: resuming: .*adaptive-cut.exr is incomplete .*stopped by time.*; continuing it" \
+        "$scratch/adaptive-resume.log" &&
+   "$program" diff "$scratch/adaptive-cut.exr" "$scratch/adaptive-whole.exr" --fail 0 --failpercent 0 \
+        >"$scratch/diff" 2>&1 &&
+   [ "$(channel_range "$scratch/adaptive-cut.exr" samples)" = "$(channel_range "$scratch/adaptive-whole.exr" samples)" ] &&
+   [ "$(channel_mean "$scratch/adaptive-cut.exr" samples)" = "$(channel_mean "$scratch/adaptive-whole.exr" samples)" ]; then
+    pass "--skip-existing continues an adaptive render cut short ($cut_samples samples a pixel) bit for bit"
+else
+    fail "--skip-existing continues an adaptive render" "$(head -c 400 "$scratch/adaptive-resume.log") $(head -c 300 "$scratch/diff")"
+fi
 finish

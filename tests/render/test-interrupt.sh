@@ -133,6 +133,44 @@ else fail "--checkpoint writes the partial during the render" "no cp.partial.exr
 kill -s KILL "$pid" 2>/dev/null
 wait "$pid" 2>/dev/null
 
+# An adaptive render (--noise-threshold; about 1.5 s here) interrupted by SIGINT, and one
+# killed after a checkpoint: each partial keeps the adaptive state (render.h: the sums at
+# the last check, or before the first), and --resume continues it to the uninterrupted
+# image bit for bit, with the same sample counts (tests/render/test-adaptive.sh stops
+# renders at chosen passes).
+adaptive="--noise-threshold 0.003"
+# shellcheck disable=SC2086
+"$program" render $scene -o "$scratch/adaptive-reference.exr" $options $adaptive --quiet
+"$program" stats "$scratch/adaptive-reference.exr" | grep "^channel samples" >"$scratch/reference.samples"
+# resumes_exactly NAME PARTIAL: one check: PARTIAL has the adaptive state and resumes to
+# the reference's pixels and counts.
+resumes_exactly() {
+    # shellcheck disable=SC2086
+    if [ -n "$(channel_mean "$2" adaptive.samples)" ] &&
+            "$program" render $scene -o "$scratch/adaptive-resumed.exr" $options $adaptive --resume "$2" --quiet &&
+            "$program" diff "$scratch/adaptive-resumed.exr" "$scratch/adaptive-reference.exr" --fail 0 --failpercent 0 \
+                >"$scratch/diff.txt" 2>&1; then
+        "$program" stats "$scratch/adaptive-resumed.exr" | grep "^channel samples" >"$scratch/resumed.samples"
+        if cmp -s "$scratch/resumed.samples" "$scratch/reference.samples"; then
+            pass "$1 (its state $(channel_mean "$2" adaptive.samples) samples a pixel)"
+        else fail "$1" "samples $(cat "$scratch/resumed.samples") against $(cat "$scratch/reference.samples")"; fi
+    else fail "$1" "no adaptive state in $2, or the resume failed or differs: $(tr '\n' ' ' <"$scratch/diff.txt")"; fi
+}
+# shellcheck disable=SC2086
+code=$(interrupt_running INT "$scratch/adaptive.exr" $adaptive)
+if [ "$code" = 1 ]; then resumes_exactly "an interrupted adaptive render resumes bit for bit" "$scratch/adaptive.partial.exr"
+else fail "an interrupted adaptive render" "exit $code; $(cat "$scratch/interrupt.err")"; fi
+# shellcheck disable=SC2086
+"$program" render $scene -o "$scratch/adaptive-cp.exr" $options $adaptive --checkpoint 0.05 --quiet &
+pid=$!
+wait_for_file "$scratch/adaptive-cp.partial.exr"
+sleep 0.4
+kill -s KILL "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+if [ -f "$scratch/adaptive-cp.partial.exr" ]; then
+    resumes_exactly "an adaptive render's checkpoint resumes bit for bit" "$scratch/adaptive-cp.partial.exr"
+else echo "SKIP an adaptive render's checkpoint resumes: the render finished before it was killed (a fast device)"; fi
+
 # A second signal ends the render at once (the default action): death by SIGINT.
 # shellcheck disable=SC2086
 # Long passes (the largest budget the device allows, over a 1280x720 image: about 0.45 s

@@ -164,6 +164,79 @@ static void runs_follow_the_checks(void **state)
     adaptive_free(more);
 }
 
+/* A sampler resumed from a stopped render's limits and samples (adaptive_resume) makes
+ * the check it was waiting for as the sampler that never stopped does: the same pixels
+ * go on, with the same limits and runs. Before the first check every pixel goes on,
+ * whatever it has finished; limits of another schedule are refused. */
+static void resume_where_it_stopped(void **state)
+{
+    (void)state;
+    adaptive_sampler *original = NULL, *resumed = NULL;
+    assert_int_equal(adaptive_create(8, 8, 0.05f, 16, 256, &original, NULL), RT_OK);
+    float rgba[64 * 4], squares[64];
+    make_sums(rgba, squares, 16, 0.5f, 2, 2);
+    assert_int_equal(adaptive_check(original, rgba, squares), 9);
+    /* Waiting for the check at 32: the pixels going have 32 samples, the rest their 16. */
+    uint32_t limits[64], samples[64];
+    make_sums(rgba, squares, 32, 0.5f, 2, 2);
+    for (int i = 0; i < 64; i++) {
+        if (adaptive_limits(original)[i] == 16) {
+            for (int c = 0; c < 4; c++)
+                rgba[4 * i + c] /= 2;
+            squares[i] /= 2;
+        }
+        samples[i] = limits[i] = (uint32_t)rgba[4 * i + 3];
+    }
+    assert_int_equal(adaptive_create(8, 8, 0.05f, 16, 256, &resumed, NULL), RT_OK);
+    assert_int_equal(adaptive_resume(resumed, limits, samples, NULL), RT_OK);
+    assert_memory_equal(adaptive_limits(resumed), limits, sizeof limits);
+    assert_true(adaptive_stopped_early(resumed));
+    /* (2, 2) is still noisy: it and its neighbours go on. */
+    assert_int_equal(adaptive_check(original, rgba, squares), 9);
+    assert_int_equal(adaptive_check(resumed, rgba, squares), 9);
+    assert_memory_equal(adaptive_limits(resumed), adaptive_limits(original), sizeof limits);
+    assert_int_equal(adaptive_limits(resumed)[2 * 8 + 2], 48);
+    assert_int_equal(adaptive_runs(resumed), adaptive_runs(original));
+    adaptive_noise noise_original, noise_resumed;
+    adaptive_get_noise(original, &noise_original);
+    adaptive_get_noise(resumed, &noise_resumed);
+    assert_int_equal(noise_resumed.checks, noise_original.checks);
+    adaptive_free(resumed);
+
+    /* Before the first check: every pixel goes on to 16, whatever it has. */
+    for (int i = 0; i < 64; i++) {
+        limits[i] = 16;
+        samples[i] = (uint32_t)(i % 17);
+    }
+    assert_int_equal(adaptive_create(8, 8, 0.05f, 16, 256, &resumed, NULL), RT_OK);
+    assert_int_equal(adaptive_resume(resumed, limits, samples, NULL), RT_OK);
+    uint32_t pixels[64];
+    assert_int_equal(adaptive_going_pixels(resumed, pixels), 64);
+    assert_false(adaptive_stopped_early(resumed));
+
+    /* Not this schedule: a next check at 24 (min-spp 16 checks at 16, 32, 48, ...); a
+     * stopped pixel whose samples are not its limit; a pixel going past the check. */
+    rt_error error = {{0}};
+    for (int i = 0; i < 64; i++)
+        samples[i] = limits[i] = 24;
+    assert_int_equal(adaptive_resume(resumed, limits, samples, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "check at 24 samples"));
+    for (int i = 0; i < 64; i++)
+        samples[i] = limits[i] = 32;
+    samples[9] = limits[9] = 16;
+    samples[9] = 15;
+    assert_int_equal(adaptive_resume(resumed, limits, samples, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "pixel 1,1 (15 samples, limit 16)"));
+    samples[9] = 16;
+    samples[10] = 33;
+    assert_int_equal(adaptive_resume(resumed, limits, samples, &error), RT_ERROR_INPUT);
+    assert_non_null(strstr(error.message, "pixel 2,1 (33 samples, limit 32)"));
+    samples[10] = 32;
+    assert_int_equal(adaptive_resume(resumed, limits, samples, &error), RT_OK);
+    adaptive_free(resumed);
+    adaptive_free(original);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -173,6 +246,7 @@ int main(void)
         cmocka_unit_test(dark_pixels_and_max),
         cmocka_unit_test(going_pixels),
         cmocka_unit_test(runs_follow_the_checks),
+        cmocka_unit_test(resume_where_it_stopped),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -329,9 +329,13 @@ static void part_rules(void **state)
     refused(&job, "--noise-threshold cannot be combined with --samples: each part would stop its pixels on its "
                   "own samples; render all samples, or split by --tile or --crop");
     job.sample_count = 0;
+    /* Resuming: the whole image (its partial keeps the adaptive state), not a part of it. */
     job.resume_path = "a.partial.exr";
-    refused(&job, "--noise-threshold cannot --resume: the partial file keeps no per-pixel variance for the "
-                  "threshold; resume without it");
+    assert_int_equal(render_job_check(&job, &plan, NULL), RT_OK);
+    job.crop[2] = job.crop[3] = 2;
+    refused(&job, "--noise-threshold cannot --resume part of an image (--crop, --tile, --shard-by tiles): its "
+                  "pixels' decisions depend on pixels past the part, which the partial file does not hold; render "
+                  "the part afresh");
 }
 
 static void shards(void **state)
