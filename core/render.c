@@ -466,20 +466,11 @@ void render_resume_free(render_resume *resume)
     memset(resume, 0, sizeof *resume);
 }
 
-/* The channel of partial named name, or -1. */
-static int find_channel(const rt_image *partial, const char *name)
-{
-    for (int c = 0; c < partial->channels; c++)
-        if (strcmp(partial->channel_names[c], name) == 0)
-            return c;
-    return -1;
-}
-
 bool render_partial_has_adaptive_state(const rt_image *partial)
 {
     static const char *const names[RENDER_ADAPTIVE_STATE_CHANNELS] = RENDER_ADAPTIVE_STATE_CHANNEL_NAMES;
     for (int i = 0; i < RENDER_ADAPTIVE_STATE_CHANNELS; i++)
-        if (find_channel(partial, names[i]) < 0)
+        if (image_channel_index(partial, names[i]) < 0)
             return false;
     return true;
 }
@@ -503,7 +494,7 @@ static rt_status resume_from_partial(const rt_image *partial, int width, int hei
                                      bool adaptive, render_resume *resume, rt_error *error)
 {
     memset(resume, 0, sizeof *resume);
-    int samples_channel = find_channel(partial, "samples");
+    int samples_channel = image_channel_index(partial, "samples");
     if (partial->width != width || partial->height != height || partial->channels < 4 || samples_channel < 0)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "RENDER: the partial render is %dx%d with %d channels; resuming needs %dx%d with R, G, B "
@@ -511,7 +502,7 @@ static rt_status resume_from_partial(const rt_image *partial, int width, int hei
     static const char *const state_names[RENDER_ADAPTIVE_STATE_CHANNELS] = RENDER_ADAPTIVE_STATE_CHANNEL_NAMES;
     int state[RENDER_ADAPTIVE_STATE_CHANNELS], found = 0;
     for (int i = 0; i < RENDER_ADAPTIVE_STATE_CHANNELS; i++)
-        found += (state[i] = find_channel(partial, state_names[i])) >= 0;
+        found += (state[i] = image_channel_index(partial, state_names[i])) >= 0;
     if (found != 0 && found != RENDER_ADAPTIVE_STATE_CHANNELS)
         return rt_error_set(error, RT_ERROR_INPUT,
                             "RENDER: the partial render has %d of the %d channels of the adaptive state (%s ... %s)",
