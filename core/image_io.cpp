@@ -967,6 +967,27 @@ rt_status image_append_channels(const rt_image *a, const rt_image *b, rt_image *
     return RT_OK;
 }
 
+rt_status image_color_map(const rt_image *image, int channel, const char *map, rt_image *out, rt_error *error)
+{
+    std::memset(out, 0, sizeof *out);
+    if (channel < 0 || channel >= image->channels)
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: no channel %d to map in an image of %d channels", channel,
+                            image->channels);
+    rt_status status = image_create(out, image->width, image->height, 3, error);
+    if (status != RT_OK)
+        return status;
+    try {
+        OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(wrap(image), channel, map);
+        check(mapped.initialized(), mapped);
+        check(mapped.get_pixels(mapped.roi(), OIIO::TypeDesc::FLOAT, out->pixels), mapped);
+    } catch (const std::exception &e) {
+        image_free(out);
+        return rt_error_set(error, RT_ERROR_INPUT, "IMAGE: cannot apply the colour map '%s': %s", map,
+                            one_line(e.what()).c_str());
+    }
+    return RT_OK;
+}
+
 int image_channel_index(const rt_image *image, const char *name)
 {
     for (int c = 0; c < image->channels; c++)

@@ -96,6 +96,14 @@ rt_status image_create(rt_image *image, int width, int height, int channels, rt_
  * RT_ERROR_INPUT; more than IMAGE_MAX_CHANNELS together: RT_ERROR_INPUT. */
 rt_status image_append_channels(const rt_image *a, const rt_image *b, rt_image *out, rt_error *error);
 
+/* Maps channel of image, values 0 to 1, through OpenImageIO's colour map named map
+ * ("inferno", "viridis", "magma", "plasma", "turbo", "heat", ...) into *out, a new RGB image
+ * of image's size (the caller frees it; empty on failure). The maps' colours are linear
+ * values (matplotlib's inferno at 0.5, sRGB 0.735 0.216 0.330, is 0.500 0.038 0.089 here),
+ * so that an 8-bit file, whose writer encodes them, shows the map's own colours.
+ * RT_ERROR_INPUT for a channel image has not or a map OpenImageIO does not know. */
+rt_status image_color_map(const rt_image *image, int channel, const char *map, rt_image *out, rt_error *error);
+
 /* Returns the index of the channel of image named name (exactly), or -1. */
 int image_channel_index(const rt_image *image, const char *name);
 

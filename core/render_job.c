@@ -3,6 +3,7 @@
 #include "render_job.h"
 #include "render_job_internal.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -231,19 +232,30 @@ static rt_status postprocess_result(const render_job *job, const char *output, r
     return status;
 }
 
-/* Writes the samples channel of image (R, G, B, samples) to path as grey samples / spp. */
+rt_status job_samples_map(const rt_image *rows, int samples_per_pixel, rt_image *map, rt_error *error)
+{
+    rt_image scale;
+    rt_status status = image_create(&scale, rows->width, rows->height, 1, error);
+    if (status != RT_OK)
+        return status;
+    double top = log1p((double)samples_per_pixel);
+    for (size_t i = 0; i < (size_t)rows->width * rows->height; i++)
+        scale.pixels[i] = (float)(log1p((double)rows->pixels[i * rows->channels + 3]) / top);
+    status = image_color_map(&scale, 0, "inferno", map, error);
+    image_free(&scale);
+    return status;
+}
+
+/* Writes the heat map of image's samples channel (job_samples_map) to path. */
 static rt_status write_samples_map(const char *path, const rt_image *image, int samples_per_pixel, rt_error *error)
 {
     rt_image map;
-    rt_status status = image_create(&map, image->width, image->height, 3, error);
-    if (status != RT_OK)
-        return status;
-    for (size_t i = 0; i < (size_t)image->width * image->height; i++)
-        for (int c = 0; c < 3; c++)
-            map.pixels[3 * i + c] = image->pixels[4 * i + 3] / (float)samples_per_pixel;
-    image_write_options options = image_write_options_defaults();
-    status = image_write(path, &map, &options, error);
-    image_free(&map);
+    rt_status status = job_samples_map(image, samples_per_pixel, &map, error);
+    if (status == RT_OK) {
+        image_write_options options = image_write_options_defaults();
+        status = image_write(path, &map, &options, error);
+        image_free(&map);
+    }
     return status;
 }
 

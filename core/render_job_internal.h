@@ -49,6 +49,15 @@ void job_image_metadata(const job_image *image, const char *path, uint64_t sampl
  * 0 after a tone-mapping operator, which applied it already. */
 float job_output_exposure(const render_job *job);
 
+/* Makes the heat map of the samples channel (the fourth) of rows, an image of R, G, B,
+ * samples and any more channels, into *map (new, RGB, rows' size; the caller frees it):
+ * OpenImageIO's "inferno" colour map (black, purple, red, orange, yellow) over
+ * log(1 + n) / log(1 + samples_per_pixel), so that both the pixels of --min-spp and the
+ * few that took hundreds show (each doubling of the count is the same step along the map:
+ * at 1024 spp, 16 samples are 0.41 of the way, 64 0.60, 256 0.80), in linear values as
+ * image_write() takes them. Errors: image_create()'s, image_color_map()'s. */
+rt_status job_samples_map(const rt_image *rows, int samples_per_pixel, rt_image *map, rt_error *error);
+
 /* The tiles of one image (render_job.h, "Tiles"): columns x rows over its window. */
 typedef struct job_tile_grid {
     int count;                           /* columns * rows; 1: the image is not tiled */

@@ -442,7 +442,7 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     uint64_t budget = job->memory_budget ? job->memory_budget : render_job_default_memory_budget();
     int band_rows = (int)(budget / 8 / row_bytes);
     band_rows = band_rows < 1 ? 1 : band_rows > height ? height : band_rows;
-    rt_image band = {0}, colour = {0}, grey = {0};
+    rt_image band = {0}, colour = {0};
     if (status == RT_OK)
         status = image_create(&band, width, band_rows, layout.channels, error);
     if (status == RT_OK && filtered) {
@@ -467,11 +467,9 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
     }
     if (status == RT_OK && tonemap)
         status = image_create(&colour, width, band_rows, 3, error);
-    if (status == RT_OK && map != NULL)
-        status = image_create(&grey, width, band_rows, 3, error);
     for (int y = 0; y < height && status == RT_OK; y += band_rows) {
         int rows = height - y < band_rows ? height - y : band_rows;
-        band.height = colour.height = grey.height = rows;
+        band.height = colour.height = rows;
         status = read_output_band(run, filtered ? &post : NULL, y, &band, error);
         size_t pixels = (size_t)width * rows;
         if (status == RT_OK && tonemap) {
@@ -484,15 +482,16 @@ static rt_status write_from_spool(tile_run *run, rt_error *error)
         if (status == RT_OK)
             status = render_output_stream_rows(output, &band, error);
         if (status == RT_OK && map != NULL) {
-            for (size_t i = 0; i < pixels; i++)
-                for (int c = 0; c < 3; c++)
-                    grey.pixels[3 * i + c] = band.pixels[i * layout.channels + 3] / (float)image->plan.samples_per_pixel;
-            status = image_stream_write_rows(map, &grey, error);
+            rt_image rows_map;
+            status = job_samples_map(&band, image->plan.samples_per_pixel, &rows_map, error);
+            if (status == RT_OK) {
+                status = image_stream_write_rows(map, &rows_map, error);
+                image_free(&rows_map);
+            }
         }
     }
     image_free(&band);
     image_free(&colour);
-    image_free(&grey);
     image_free(&post.source);
     image_free(&post.colour);
     image_free(&post.raw);

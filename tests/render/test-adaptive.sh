@@ -11,7 +11,7 @@
 # between sphere and sky, is noisy and takes more.
 out="$scratch/furnace.exr"
 if "$program" render scenes/furnace.txt -o "$out" --size 64x64 --spp 256 --noise-threshold 0.01 --min-spp 8 \
-        --quiet; then
+        --samples-map "$scratch/furnace-map.exr" --quiet; then
     stats_of "$out" --crop 20,20,44,44
     range=$(stat_range G)
     if within "${range% *}" 0.5 0.001 && within "${range#* }" 0.5 0.001; then
@@ -31,6 +31,27 @@ if "$program" render scenes/furnace.txt -o "$out" --size 64x64 --spp 256 --noise
 else
     fail "adaptive furnace" "render failed"
 fi
+
+# ---- the samples map (--samples-map): a heat map, one colour where the counts are one (the
+# sphere's pixels, all at --min-spp), brighter where there are more (inferno's colours
+# brighten along the map), and inferno's yellow at --spp (a fixed render: every pixel; R and G
+# near 1, B under half of them)
+if stats_of "$scratch/furnace-map.exr" --crop 20,20,44,44; then
+    inside=$(stat_range G) inside_red=$(stat_range R)
+    stats_of "$scratch/furnace-map.exr"
+    whole=$(stat_range G)
+    if [ "${inside% *}" = "${inside#* }" ] && [ "${inside_red% *}" = "${inside_red#* }" ] &&
+            awk -v i="${inside#* }" -v w="${whole#* }" 'BEGIN { exit !(w > i + 0.05) }'; then
+        pass "the samples map is one colour over the sphere's pixels (G $inside) and brighter at the silhouette (G up to ${whole#* })"
+    else fail "the samples map of the adaptive furnace" "inside G $inside, R $inside_red; whole image G $whole"; fi
+else fail "the samples map" "no map written"; fi
+if "$program" render scenes/furnace.txt -o "$scratch/fixed-map-render.exr" --size 16x16 --spp 4 \
+        --samples-map "$scratch/fixed-map.exr" --quiet && stats_of "$scratch/fixed-map.exr" &&
+        awk -v r="$(stat_range R)" -v g="$(stat_range G)" -v b="$(stat_range B)" 'BEGIN {
+            split(r, R, " "); split(g, G, " "); split(b, B, " ")
+            exit !(R[1] == R[2] && G[1] == G[2] && B[1] == B[2] && R[1] > 0.9 && G[1] > 0.9 && B[1] < 0.5 * R[1]) }'; then
+    pass "a render whose pixels all took --spp has the map's yellow everywhere (R $(stat_range R))"
+else fail "the samples map at --spp" "R $(stat_range R), G $(stat_range G), B $(stat_range B)"; fi
 
 # ---- a plane under a uniform sky with a glass ball (tests/render/scenes/adaptive-glass-ball.txt)
 scene=tests/render/scenes/adaptive-glass-ball.txt

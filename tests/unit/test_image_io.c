@@ -728,11 +728,37 @@ static void test_read_directory(void **state)
     check_read_fails(s->directory);
 }
 
+/* A colour map (OpenImageIO's): a ramp 0, 0.5, 1 through "inferno" gives black, then
+ * matplotlib's inferno(0.5), sRGB 0.735 0.216 0.330, as linear values (0.500 0.038 0.089),
+ * then its yellow end, sRGB 0.988 0.998 0.645 (linear 0.973 0.996 0.374); an unknown map or
+ * a channel the image has not is refused. */
+static void test_color_map(void **state)
+{
+    (void)state;
+    rt_image ramp, map;
+    assert_int_equal(image_create(&ramp, 3, 1, 2, NULL), RT_OK);
+    const float values[6] = {9, 0.0f, 9, 0.5f, 9, 1.0f};
+    memcpy(ramp.pixels, values, sizeof values);
+    assert_int_equal(image_color_map(&ramp, 1, "inferno", &map, NULL), RT_OK);
+    assert_int_equal(map.channels, 3);
+    const float expected[9] = {0.0f, 0.0f, 0.0f, 0.500f, 0.038f, 0.089f, 0.973f, 0.996f, 0.374f};
+    for (int i = 0; i < 9; i++)
+        assert_true(fabsf(map.pixels[i] - expected[i]) < 0.01f);
+    image_free(&map);
+    rt_error error = {{0}};
+    assert_int_equal(image_color_map(&ramp, 1, "no such map", &map, &error), RT_ERROR_INPUT);
+    assert_null(map.pixels);
+    assert_non_null(strstr(error.message, "no such map"));
+    assert_int_equal(image_color_map(&ramp, 2, "inferno", &map, &error), RT_ERROR_INPUT);
+    image_free(&ramp);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_create_and_free),
         cmocka_unit_test(test_append_channels),
+        cmocka_unit_test(test_color_map),
         scratch_test(test_exr_round_trip_exact),
         scratch_test(test_exr_channel_names_and_attributes),
         scratch_test(test_read_all_attributes),
