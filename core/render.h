@@ -139,8 +139,10 @@ typedef struct render_options {
      * uninterrupted render up to float rounding of mean * n. NULL: start afresh. When it
      * also has the adaptive state layer (render_result.adaptive_state) the render goes on
      * from that state instead: an adaptive render (noise_threshold, of the whole image:
-     * region all zero) then equals the uninterrupted one to the bit, and a fixed one to
-     * float rounding; an adaptive render needs that layer. */
+     * region all zero) then equals the uninterrupted one to the bit (without
+     * direct_emission, which a resume cannot continue: the program without it rounds
+     * some sums differently), and a fixed one to float rounding; an adaptive render
+     * needs that layer. */
     const rt_image *resume;
     uint64_t resume_scene_hash;  /* with resume: must equal this render's scene_hash (0: unchecked) */
     /* Every checkpoint_seconds (0: never), checkpoint() receives the image so far (the

@@ -196,6 +196,18 @@ if RTSPHERES_TEST_STOP_AFTER_PASSES=2 "$program" render scenes/cornell.txt -o "$
     same "an adaptive render resumed, stopped again and resumed again equals the uninterrupted one bit for bit" \
         "$scratch/resumed-twice.exr" "$scratch/cornell-rounds.exr"
 else fail "an adaptive render resumed twice" "a render failed"; fi
+# With --aovs a resumed render leaves out the emission sums (a partial keeps none): another
+# tracer program, whose sums round differently, so the image is the same to float rounding.
+# shellcheck disable=SC2086
+if "$program" render scenes/cornell.txt -o "$scratch/aovs-whole.exr" $options --aovs --quiet &&
+        RTSPHERES_TEST_STOP_AFTER_PASSES=60 "$program" render scenes/cornell.txt -o "$scratch/aovs-part.exr" $options \
+        --aovs --pass-budget 200 --quiet &&
+        "$program" render scenes/cornell.txt -o "$scratch/aovs-resumed.exr" $options --aovs \
+        --resume "$scratch/aovs-part.exr" --quiet &&
+        "$program" diff "$scratch/aovs-resumed.exr" "$scratch/aovs-whole.exr" --fail 1e-5 --failpercent 0 \
+        >"$scratch/diff" 2>&1; then
+    pass "an adaptive render with --aovs resumes to float rounding ($(grep "^max error" "$scratch/diff"))"
+else fail "an adaptive render with --aovs resumes" "$(tr '\n' ' ' <"$scratch/diff")"; fi
 # Without --noise-threshold the same partial continues as a fixed render, from the state
 # (each pixel's first samples; R, G, B and samples hold others too): the fixed render's
 # image to float rounding (its sums were added in runs), every pixel with every sample.
