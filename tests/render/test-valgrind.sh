@@ -101,4 +101,17 @@ check_memcheck render 0
 if [ -s "$scratch/tiny.exr" ]; then pass "valgrind render wrote its image"
 else fail "valgrind render wrote its image" "no $scratch/tiny.exr"; fi
 
+# An adaptive render resumed from its state (render.h, adaptive.h adaptive_resume) and
+# stopped again after checks and compacted passes, which writes the state anew: a partial
+# made without valgrind first (stopped after two checks: 4 and 8 samples).
+adaptive="--spp 64 --noise-threshold 0.2 --min-spp 4 --pass-budget 400"
+# shellcheck disable=SC2086 # $adaptive is a list of options
+if RTSPHERES_TEST_STOP_AFTER_PASSES=5 "$program" render "$scratch/tiny.txt" -o "$scratch/adaptive.exr" $adaptive \
+        --quiet; then
+    # shellcheck disable=SC2086
+    RTSPHERES_TEST_STOP_AFTER_PASSES=3 GALLIVM_PERF=nopt LP_NUM_THREADS=0 run_memcheck adaptive-resume render \
+        "$scratch/tiny.txt" -o "$scratch/adaptive-resumed.exr" $adaptive --resume "$scratch/adaptive.exr" --quiet
+    check_memcheck adaptive-resume 0
+else fail "valgrind adaptive-resume" "the partial render without valgrind failed"; fi
+
 finish
