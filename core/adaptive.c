@@ -86,8 +86,8 @@ rt_status adaptive_create(int width, int height, float threshold, uint32_t min_s
     return RT_OK;
 }
 
-/* True when count is one of the schedule's check counts; *before gets the check before it
- * (0 for the first) and *checks how many come before it. */
+/* True when count is one of the schedule's check counts; *before (when not NULL) gets the
+ * check before it (0 for the first) and *checks (when not NULL) how many come before it. */
 static bool is_check_count(const adaptive_sampler *sampler, uint32_t count, uint32_t *before, int *checks)
 {
     uint32_t previous = 0;
@@ -95,8 +95,10 @@ static bool is_check_count(const adaptive_sampler *sampler, uint32_t count, uint
     for (uint32_t n = adaptive_next_check(0, sampler->min_spp, sampler->max_spp);;
          n = adaptive_next_check(n, sampler->min_spp, sampler->max_spp)) {
         if (n == count) {
-            *before = previous;
-            *checks = made;
+            if (before != NULL)
+                *before = previous;
+            if (checks != NULL)
+                *checks = made;
             return true;
         }
         if (n > count || n >= sampler->max_spp)
@@ -122,11 +124,8 @@ rt_status adaptive_resume(adaptive_sampler *sampler, const uint32_t *limits, con
                             "was rendered with", next, sampler->min_spp, sampler->max_spp);
     bool stopped_early = false;
     for (size_t i = 0; i < pixels; i++) {
-        uint32_t unused;
-        int unused_checks;
         bool going = limits[i] == next;
-        if (going ? samples[i] > next
-                  : samples[i] != limits[i] || !is_check_count(sampler, limits[i], &unused, &unused_checks)) {
+        if (going ? samples[i] > next : samples[i] != limits[i] || !is_check_count(sampler, limits[i], NULL, NULL)) {
             return rt_error_set(error, RT_ERROR_INPUT,
                                 "RENDER: the partial render's adaptive state at pixel %zu,%zu (%u samples, limit %u) "
                                 "is not of this render's schedule (--min-spp %u, --spp %u, next check at %u)",

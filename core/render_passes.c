@@ -89,15 +89,25 @@ static rt_status start_adaptive(gpu_tracer *tracer, const render_options *option
 }
 
 /* The check once every pixel going has reached its limit: new limits on the tracer, and
- * the pixels still going as the pixels its passes trace (compacted: gpu.h); *done when no
- * pixel goes on. */
-static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, bool *done, rt_error *error)
+ * the pixels still going as the pixels its passes trace (compacted: gpu.h); the noise in
+ * *progress; *done when no pixel goes on, and then *stop RENDER_STOP_NOISE when the
+ * threshold stopped some pixel before the most samples. */
+static rt_status check_adaptive(gpu_tracer *tracer, adaptive_run *run, render_progress *progress,
+                                render_stop_reason *stop, bool *done, rt_error *error)
 {
     rt_status status = gpu_tracer_read(tracer, run->rgba, run->luminance_squares, NULL, error);
     if (status != RT_OK)
         return status;
     run->checked = true;
     *done = adaptive_check(run->sampler, run->rgba, run->luminance_squares) == 0;
+    adaptive_noise noise;
+    adaptive_get_noise(run->sampler, &noise);
+    progress->noise_checks = noise.checks;
+    progress->noisy_pixels = noise.unconverged_pixels;
+    progress->going_pixels = noise.going_pixels;
+    progress->noise_error = noise.mean_error;
+    if (*done && adaptive_stopped_early(run->sampler))
+        *stop = RENDER_STOP_NOISE;
     if (*done)
         return RT_OK;
     status = gpu_tracer_set_sample_limits(tracer, adaptive_limits(run->sampler), error);
@@ -269,17 +279,8 @@ rt_status render_run_passes(gpu_context *context, gpu_tracer *tracer, const rend
         }
         if (status == RT_OK && report.unfinished_pixels == 0) {
             done = true;
-            if (adaptive.sampler != NULL) {
-                status = check_adaptive(tracer, &adaptive, &done, error);
-                adaptive_noise noise;
-                adaptive_get_noise(adaptive.sampler, &noise);
-                progress->noise_checks = noise.checks;
-                progress->noisy_pixels = noise.unconverged_pixels;
-                progress->going_pixels = noise.going_pixels;
-                progress->noise_error = noise.mean_error;
-            }
-            if (done && adaptive.sampler != NULL && adaptive_stopped_early(adaptive.sampler))
-                *stop = RENDER_STOP_NOISE;
+            if (adaptive.sampler != NULL)
+                status = check_adaptive(tracer, &adaptive, progress, stop, &done, error);
             continue;
         }
         if (options->stop_requested != NULL && *options->stop_requested) {
